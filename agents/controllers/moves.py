@@ -1,0 +1,152 @@
+"""Local moves shared by the grid controllers: update-value, descent, exploration.
+
+Every choice among equals is uniform, drawn from the counter-based generator
+(see swarm.rng), so a controller's decision depends only on (seed, agent, tick).
+"""
+
+import numpy as np
+from numba import njit
+
+from agents.controllers.layout import (
+    A_DEPOSIT,
+    A_LOAD,
+    A_MARK,
+    A_MOVE,
+    A_TRAIL_ID,
+    A_TRAIL_OP,
+    A_UNLOAD,
+    MARK,
+    MARK_NONE,
+    N_DIRS,
+    OBST,
+    STAY,
+    TRAIL_KEEP,
+)
+from swarm.rng import draw_below
+
+
+@njit(cache=True, inline="always")
+def reset_action(act):
+    act[A_MOVE] = STAY
+    act[A_MARK] = MARK_NONE
+    act[A_TRAIL_OP] = TRAIL_KEEP
+    act[A_TRAIL_ID] = 0
+    act[A_LOAD] = 0
+    act[A_UNLOAD] = 0
+    act[A_DEPOSIT] = 0
+
+
+@njit(cache=True, inline="always")
+def update_value(pi):
+    """Algorithm 2's UPDATE-VALUE: min(val, 1 + min(4-neighbour values))."""
+    best = MARK_NONE
+    for k in range(1, 5):
+        if pi[OBST + k] == 0 and pi[MARK + k] < best:
+            best = pi[MARK + k]
+    val = pi[MARK]
+    if best != MARK_NONE and best + 1 < val:
+        val = best + 1
+    return val
+
+
+@njit(cache=True, inline="always")
+def pick(cands, n, seed, agent, tick, draw):
+    """A uniform pick among the first n entries of cands (n >= 1)."""
+    if n == 1:
+        return cands[0]
+    return cands[draw_below(seed, agent, tick, draw, n)]
+
+
+@njit(cache=True)
+def random_free_dir(pi, seed, agent, tick, draw):
+    """A uniformly random non-obstacle neighbour, or STAY when boxed in."""
+    cands = np.empty(N_DIRS, dtype=np.int64)
+    n = 0
+    for d in range(N_DIRS):
+        if pi[OBST + 1 + d] == 0:
+            cands[n] = d
+            n += 1
+    if n == 0:
+        return STAY
+    return pick(cands, n, seed, agent, tick, draw)
+
+
+@njit(cache=True)
+def explore_dir(pi, seed, agent, tick, draw):
+    """Algorithm 2's move: a random unmarked neighbour if any, else any free one."""
+    cands = np.empty(N_DIRS, dtype=np.int64)
+    n = 0
+    for d in range(N_DIRS):
+        if pi[OBST + 1 + d] == 0 and pi[MARK + 1 + d] == MARK_NONE:
+            cands[n] = d
+            n += 1
+    if n == 0:
+        return random_free_dir(pi, seed, agent, tick, draw)
+    return pick(cands, n, seed, agent, tick, draw)
+
+
+@njit(cache=True)
+def descent_dir(pi, seed, agent, tick, draw):
+    """RETURN TO BASE: the neighbour with the least mark (ties uniform)."""
+    cands = np.empty(N_DIRS, dtype=np.int64)
+    n = 0
+    best = MARK_NONE
+    for d in range(N_DIRS):
+        if pi[OBST + 1 + d] != 0:
+            continue
+        m = pi[MARK + 1 + d]
+        if m < best:
+            best = m
+            n = 0
+        if m == best and m != MARK_NONE:
+            cands[n] = d
+            n += 1
+    if n == 0:
+        return random_free_dir(pi, seed, agent, tick, draw)
+    return pick(cands, n, seed, agent, tick, draw)
+
+
+@njit(cache=True)
+def extreme_dir_among(pi, layer, want, exclude, seed, agent, tick, draw, highest):
+    """Among free neighbours whose `layer` value equals `want` (want < 0: any
+    non-zero value) and that are not `exclude`, the one with the highest
+    (or least) mark; -1 when there is none.  Used to climb and follow trails."""
+    cands = np.empty(N_DIRS, dtype=np.int64)
+    n = 0
+    best = np.int64(0)
+    for d in range(N_DIRS):
+        if d == exclude or pi[OBST + 1 + d] != 0:
+            continue
+        v = pi[layer + 1 + d]
+        if (want < 0 and v == 0) or (want >= 0 and v != want):
+            continue
+        m = pi[MARK + 1 + d]
+        better = n == 0 or (m > best if highest else m < best)
+        if better:
+            best = m
+            n = 0
+        if m == best:
+            cands[n] = d
+            n += 1
+    if n == 0:
+        return np.int64(-1)
+    return pick(cands, n, seed, agent, tick, draw)
+
+
+@njit(cache=True)
+def resource_dir(pi, layer, seed, agent, tick, draw):
+    """A neighbour holding resource (uniform among several), -1 if none."""
+    cands = np.empty(N_DIRS, dtype=np.int64)
+    n = 0
+    for d in range(N_DIRS):
+        if pi[OBST + 1 + d] == 0 and pi[layer + 1 + d] != 0:
+            cands[n] = d
+            n += 1
+    if n == 0:
+        return np.int64(-1)
+    return pick(cands, n, seed, agent, tick, draw)
+
+
+@njit(cache=True, inline="always")
+def opposite(d):
+    return (d + 2) % N_DIRS

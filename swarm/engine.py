@@ -1,0 +1,186 @@
+"""The in-process engine: the whole swarm in one process, compiled with numba.
+
+It is both the fast tool for experiments and the yardstick of the distributed
+runtime: it runs exactly the tick of world_server.grid (perceive all, decide
+all, apply in agent-id order) with the controllers' own compiled steps.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from agents.controllers import ANT, controller_kind, controller_params, step_controller
+from agents.controllers.layout import new_memory, new_perception
+from swarm.scenario import Layout, Scenario, ScenarioError
+from world_server.grid import (
+    C_DELIVERED,
+    C_EXPLORED,
+    C_OPTIMAL,
+    C_REJECTED,
+    L_OBST,
+    W_DIFFUSION,
+    W_EVAPORATION,
+    GridWorld,
+    apply_actions,
+    diffuse_evaporate,
+    perceive,
+)
+
+UNTIL_FORAGED = 0
+UNTIL_CONVERGED = 1
+UNTIL_BOTH = 2
+UNTIL = {"foraged": UNTIL_FORAGED, "converged": UNTIL_CONVERGED, "both": UNTIL_BOTH}
+DEFAULT_MAX_ITERATIONS = 1_000_000
+
+
+@njit(cache=True)
+def is_done(until, counters, total, reachable):
+    foraged = counters[C_DELIVERED] >= total
+    converged = counters[C_OPTIMAL] == reachable
+    if until == UNTIL_FORAGED:
+        return foraged
+    if until == UNTIL_CONVERGED:
+        return converged
+    return foraged and converged
+
+
+@njit(cache=True)
+def run_ticks(
+    kind, layers, pher, pher_scratch, base_r, base_c, pos, payload, mem, acts,
+    cparams, wparams, counters, seed, tick0, n_ticks, until, total, reachable,
+):  # fmt: skip
+    """Run up to n_ticks ticks from tick0; stop early once `until` holds.
+    Returns the number of ticks run."""
+    pi, pf = np.empty(24, np.int64), np.empty(5, np.float64)
+    n = pos.shape[0]
+    pher_on = kind == ANT
+    for t in range(n_ticks):
+        tick = tick0 + t
+        for a in range(n):
+            perceive(layers, pher, base_r, base_c, pos[a, 0], pos[a, 1], payload[a], pi, pf)
+            step_controller(kind, pi, pf, mem[a], acts[a], cparams, seed, a, tick)
+        apply_actions(layers, pher, base_r, base_c, pos, payload, acts, tick, wparams, counters)
+        if pher_on:
+            diffuse_evaporate(
+                pher, layers[L_OBST], wparams[W_DIFFUSION], wparams[W_EVAPORATION], pher_scratch
+            )
+        if is_done(until, counters, total, reachable):
+            return t + 1
+    return n_ticks
+
+
+@dataclass
+class RunResult:
+    summary: dict[str, Any]
+
+    @property
+    def iterations(self) -> int:
+        return int(self.summary["iterations"])
+
+    @property
+    def finished(self) -> bool:
+        return bool(self.summary["finished"])
+
+
+class Engine:
+    """A seeded swarm on one grid.  `run()` to completion or `step(n)` ticks."""
+
+    def __init__(self, scenario: Scenario, layout: Layout | None = None):
+        self.scenario = scenario
+        self.kind = controller_kind(scenario.controller)
+        self.world = GridWorld(scenario, layout)
+        self.mem = new_memory(scenario.agents)
+        self.cparams = controller_params(
+            scenario.controller,
+            cmarking={"climb_patience": scenario.cmarking.climb_patience},
+            ant={"threshold": scenario.ant.threshold},
+        )
+        self.tick = 0
+        self.wall_seconds = 0.0
+        # Warm the compiled step on a scratch perception (and fail early).
+        self._pi, self._pf = new_perception()
+
+    def step(self, n: int = 1, until: str = "foraged") -> int:
+        """Run up to n ticks (fewer if `until` is reached); return ticks run."""
+        w = self.world
+        started = time.perf_counter()
+        ran = run_ticks(
+            self.kind, w.layers, w.pher, w.pher_scratch, w.base[0], w.base[1], w.pos, w.payload,
+            self.mem, w.acts, self.cparams, w.wparams, w.counters, np.int64(self.scenario.seed),
+            self.tick, n, UNTIL[until], w.total, w.reachable,
+        )  # fmt: skip
+        self.wall_seconds += time.perf_counter() - started
+        self.tick += int(ran)
+        return int(ran)
+
+    def done(self, until: str = "foraged") -> bool:
+        w = self.world
+        return bool(is_done(UNTIL[until], w.counters, w.total, w.reachable))
+
+    def run(
+        self,
+        until: str = "foraged",
+        max_iterations: int = DEFAULT_MAX_ITERATIONS,
+        progress: bool = False,
+        chunk: int = 5000,
+    ) -> RunResult:
+        if until not in UNTIL:
+            raise ValueError(f"unknown --until {until!r}: choose foraged, converged or both")
+        if until != "foraged" and self.scenario.controller == "ant":
+            raise ScenarioError(
+                "command line", "until", "ants build no marks; only --until foraged applies to them"
+            )
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=self.world.total, unit="unit", desc="delivered", leave=False)
+        try:
+            while not self.done(until) and self.tick < max_iterations:
+                self.step(min(chunk, max_iterations - self.tick), until)
+                if bar is not None:
+                    bar.n = self.world.delivered
+                    bar.set_postfix(tick=self.tick, explored=int(self.world.counters[C_EXPLORED]))
+                    bar.refresh()
+        finally:
+            if bar is not None:
+                bar.close()
+        return RunResult(self.summary(until))
+
+    def summary(self, until: str = "foraged") -> dict[str, Any]:
+        w = self.world
+        s = self.scenario
+        steps = self.tick * s.agents
+        return {
+            "scenario": s.name,
+            "controller": s.controller,
+            "agents": s.agents,
+            "seed": s.seed,
+            "until": until,
+            "iterations": self.tick,
+            "finished": self.done(until),
+            "delivered": w.delivered,
+            "total": w.total,
+            "in_transit": w.in_transit,
+            "apf_optimal": w.apf_optimal(),
+            "optimal_cells": int(w.counters[C_OPTIMAL]),
+            "explored_cells": int(w.counters[C_EXPLORED]),
+            "reachable_cells": w.reachable,
+            "rejected_moves": int(w.counters[C_REJECTED]),
+            "grid": list(w.layout.shape),
+            "wall_seconds": round(self.wall_seconds, 4),
+            "agent_steps_per_second": round(steps / self.wall_seconds)
+            if self.wall_seconds
+            else None,
+        }
+
+
+def run_scenario(
+    scenario: Scenario, until: str = "foraged", max_iterations: int = DEFAULT_MAX_ITERATIONS
+) -> dict:
+    return Engine(scenario).run(until, max_iterations).summary

@@ -1,0 +1,243 @@
+"""The authoritative grid world and its tick rules.
+
+One tick (lock-step semantics, identical in every engine):
+
+1. every agent perceives the start-of-tick world (`perceive`);
+2. every agent's controller chooses one action;
+3. the world applies the actions in agent-id order (`apply_actions`):
+   mark writes merge by min (order-free, as UPDATE-VALUE only lowers marks);
+   trail paints of one tick on one cell merge by max trail id (the newest
+   trail wins) and replace what was there; an erase clears the cell only if it
+   holds the erased colour and nobody painted it this tick; loads are served
+   in agent-id order (the lower id is served first when two agents empty one
+   cell); unloads count only at the base; moves into an obstacle or off the
+   grid are rejected and counted.  Agents may share a cell (as in the paper);
+4. pheromone (ant model only) diffuses and evaporates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from agents.controllers.layout import (
+    A_DEPOSIT,
+    A_LOAD,
+    A_MARK,
+    A_MOVE,
+    A_TRAIL_ID,
+    A_TRAIL_OP,
+    A_UNLOAD,
+    ACT_LEN,
+    AT_BASE,
+    CARRY,
+    COMPASS_DC,
+    COMPASS_DR,
+    DIR_DC,
+    DIR_DR,
+    MARK,
+    MARK_NONE,
+    N_DIRS,
+    OBST,
+    PHER,
+    RES,
+    TRAIL,
+    TRAIL_ERASE,
+    TRAIL_PAINT,
+)
+from swarm.scenario import Layout, Scenario
+
+# Integer layers of the grid, stacked in one (N_LAYERS, H, W) array.
+L_OBST = 0
+L_MARK = 1
+L_TRAIL = 2
+L_PAINT_TICK = 3  # last tick the cell was painted (merge rule for paints)
+L_RES = 4
+L_BFS = 5  # ground truth: BFS distance from the base, -1 if unreachable
+N_LAYERS = 6
+
+# Counters kept by apply_actions.
+C_DELIVERED = 0
+C_EXPLORED = 1  # marked cells
+C_OPTIMAL = 2  # reachable cells whose mark equals the BFS distance
+C_REJECTED = 3  # moves into walls or off the grid
+C_LOADS = 4
+N_COUNTERS = 5
+
+# World parameters (float64 vector).
+W_QMAX = 0
+W_DEPOSIT = 1
+W_DIFFUSION = 2
+W_EVAPORATION = 3
+N_WPARAMS = 4
+
+
+@njit(cache=True)
+def perceive(layers, pher, base_r, base_c, r, c, payload, pi, pf):
+    """Fill the perception of an agent at (r, c): its cell and 4 neighbours."""
+    h = layers.shape[1]
+    w = layers.shape[2]
+    for k in range(5):
+        rr = r
+        cc = c
+        if k > 0:
+            rr = r + DIR_DR[k - 1]
+            cc = c + DIR_DC[k - 1]
+        if rr < 0 or rr >= h or cc < 0 or cc >= w or layers[L_OBST, rr, cc] != 0:
+            pi[OBST + k] = 1
+            pi[MARK + k] = MARK_NONE
+            pi[TRAIL + k] = 0
+            pi[RES + k] = 0
+            pf[PHER + k] = 0.0
+        else:
+            pi[OBST + k] = 0
+            pi[MARK + k] = layers[L_MARK, rr, cc]
+            pi[TRAIL + k] = layers[L_TRAIL, rr, cc]
+            pi[RES + k] = 1 if layers[L_RES, rr, cc] > 0 else 0
+            pf[PHER + k] = pher[rr, cc]
+    pi[AT_BASE] = 1 if (r == base_r and c == base_c) else 0
+    pi[COMPASS_DR] = np.sign(base_r - r)
+    pi[COMPASS_DC] = np.sign(base_c - c)
+    pi[CARRY] = payload
+
+
+@njit(cache=True, inline="always")
+def write_mark(layers, r, c, value, counters):
+    old = layers[L_MARK, r, c]
+    if value >= old:
+        return
+    truth = layers[L_BFS, r, c]
+    if old == MARK_NONE:
+        counters[C_EXPLORED] += 1
+    if old == truth:
+        counters[C_OPTIMAL] -= 1
+    if value == truth:
+        counters[C_OPTIMAL] += 1
+    layers[L_MARK, r, c] = value
+
+
+@njit(cache=True)
+def apply_actions(layers, pher, base_r, base_c, pos, payload, acts, tick, wparams, counters):
+    """Apply every agent's action for `tick`, in agent-id order (module doc)."""
+    h = layers.shape[1]
+    w = layers.shape[2]
+    qmax = np.int64(wparams[W_QMAX])
+    for a in range(pos.shape[0]):
+        r = pos[a, 0]
+        c = pos[a, 1]
+        act = acts[a]
+        write_mark(layers, r, c, act[A_MARK], counters)
+        op = act[A_TRAIL_OP]
+        if op == TRAIL_PAINT and not (r == base_r and c == base_c):
+            if layers[L_PAINT_TICK, r, c] == tick:
+                layers[L_TRAIL, r, c] = max(layers[L_TRAIL, r, c], act[A_TRAIL_ID])
+            else:
+                layers[L_TRAIL, r, c] = act[A_TRAIL_ID]
+                layers[L_PAINT_TICK, r, c] = tick
+        elif op == TRAIL_ERASE:
+            if layers[L_PAINT_TICK, r, c] != tick and layers[L_TRAIL, r, c] == act[A_TRAIL_ID]:
+                layers[L_TRAIL, r, c] = 0
+        if act[A_LOAD] != 0 and layers[L_RES, r, c] > 0 and payload[a] < qmax:
+            amount = min(qmax - payload[a], layers[L_RES, r, c])
+            layers[L_RES, r, c] -= amount
+            payload[a] += amount
+            counters[C_LOADS] += 1
+        if act[A_UNLOAD] != 0 and r == base_r and c == base_c:
+            counters[C_DELIVERED] += payload[a]
+            payload[a] = 0
+        if act[A_DEPOSIT] != 0:
+            pher[r, c] += wparams[W_DEPOSIT]
+        d = act[A_MOVE]
+        if 0 <= d < N_DIRS:
+            nr = r + DIR_DR[d]
+            nc = c + DIR_DC[d]
+            if 0 <= nr < h and 0 <= nc < w and layers[L_OBST, nr, nc] == 0:
+                pos[a, 0] = nr
+                pos[a, 1] = nc
+            else:
+                counters[C_REJECTED] += 1
+
+
+@njit(cache=True)
+def diffuse_evaporate(pher, obst, diffusion, evaporation, out):
+    """Each free cell keeps (1 - diffusion) of its pheromone and gives
+    diffusion/4 to each neighbour; shares aimed at walls or off the grid stay
+    home.  Then everything evaporates by `evaporation`.  Result in `pher`."""
+    h, w = pher.shape
+    share = diffusion / 4.0
+    keep = 1.0 - evaporation
+    for r in range(h):
+        for c in range(w):
+            if obst[r, c] != 0:
+                out[r, c] = 0.0
+                continue
+            p = pher[r, c]
+            total = (1.0 - diffusion) * p
+            for k in range(N_DIRS):
+                nr = r + DIR_DR[k]
+                nc = c + DIR_DC[k]
+                if 0 <= nr < h and 0 <= nc < w and obst[nr, nc] == 0:
+                    total += share * pher[nr, nc]
+                else:
+                    total += share * p
+            out[r, c] = total * keep
+    pher[:, :] = out
+
+
+class GridWorld:
+    """The grid's state: layers, pheromone, agents' positions and payloads."""
+
+    def __init__(self, scenario: Scenario, layout: Layout | None = None):
+        layout = layout if layout is not None else scenario.layout()
+        h, w = layout.shape
+        self.scenario = scenario
+        self.layout = layout
+        self.base = layout.base
+        self.layers = np.zeros((N_LAYERS, h, w), dtype=np.int64)
+        self.layers[L_OBST] = layout.obstacles
+        self.layers[L_MARK] = MARK_NONE
+        self.layers[L_MARK][layout.base] = 0
+        self.layers[L_PAINT_TICK] = -1
+        self.layers[L_RES] = layout.resources
+        self.layers[L_BFS] = layout.bfs
+        self.pher = np.zeros((h, w), dtype=np.float64)
+        self.pher_scratch = np.zeros((h, w), dtype=np.float64)
+        n = scenario.agents
+        self.pos = np.tile(np.array(layout.base, dtype=np.int64), (n, 1))
+        self.payload = np.zeros(n, dtype=np.int64)
+        self.acts = np.zeros((n, ACT_LEN), dtype=np.int64)
+        self.counters = np.zeros(N_COUNTERS, dtype=np.int64)
+        self.counters[C_EXPLORED] = 1
+        self.counters[C_OPTIMAL] = 1
+        self.total = int(layout.resources.sum())
+        self.reachable = layout.reachable_cells
+        a = scenario.ant
+        self.wparams = np.array(
+            [scenario.q_max, a.deposit, a.diffusion, a.evaporation], dtype=np.float64
+        )
+
+    @property
+    def marks(self) -> np.ndarray:
+        return self.layers[L_MARK]
+
+    @property
+    def trails(self) -> np.ndarray:
+        return self.layers[L_TRAIL]
+
+    @property
+    def resources(self) -> np.ndarray:
+        return self.layers[L_RES]
+
+    @property
+    def delivered(self) -> int:
+        return int(self.counters[C_DELIVERED])
+
+    @property
+    def in_transit(self) -> int:
+        return int(self.payload.sum())
+
+    def marked_mask(self) -> np.ndarray:
+        return self.marks != MARK_NONE
+
+    def apf_optimal(self) -> bool:
+        return int(self.counters[C_OPTIMAL]) == self.reachable
