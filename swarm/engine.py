@@ -98,7 +98,7 @@ class Engine:
         self.cparams = controller_params(
             scenario.controller,
             cmarking={"climb_patience": scenario.cmarking.climb_patience},
-            ant={"threshold": scenario.ant.threshold},
+            ant={"threshold": scenario.ant.threshold, "detour": scenario.ant.detour},
         )
         self.tick = 0
         self.wall_seconds = 0.0

@@ -51,7 +51,8 @@ class AntParams:
     diffusion: float = 0.95
     evaporation: float = 0.005
     deposit: float = 1.0
-    threshold: float = 0.01
+    threshold: float = 0.3
+    detour: float = 8
 
 
 @dataclass(frozen=True)
@@ -330,6 +331,8 @@ def check_scenario(s: Scenario) -> None:
         raise ScenarioError(src, "ant.deposit", f"expected a positive amount, got {a.deposit}")
     if not (a.threshold >= 0 and np.isfinite(a.threshold)):
         raise ScenarioError(src, "ant.threshold", f"expected an amount >= 0, got {a.threshold}")
+    if not 0 <= a.detour <= 10_000:
+        raise ScenarioError(src, "ant.detour", f"expected 0 to 10000 steps, got {a.detour}")
     if s.cmarking.climb_patience < 1:
         raise ScenarioError(src, "cmarking.climb_patience", "expected a step count >= 1")
     if s.generator is not None:
@@ -374,7 +377,7 @@ def _check_ascii(s: Scenario) -> None:
                 raise ScenarioError(
                     s.source,
                     _map_where(s, i),
-                    f"column {j + 1}: unexpected {ch!r}; use # obstacle, . free, B base, R resource",
+                    f"column {j + 1}: unexpected {ch!r}; use # obstacle . free B base R resource",
                 )
             if ch == "B":
                 bases.append((i, j))

@@ -72,7 +72,7 @@ W_EVAPORATION = 3
 N_WPARAMS = 4
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def perceive(layers, pher, base_r, base_c, r, c, payload, pi, pf):
     """Fill the perception of an agent at (r, c): its cell and 4 neighbours."""
     h = layers.shape[1]
@@ -96,8 +96,8 @@ def perceive(layers, pher, base_r, base_c, r, c, payload, pi, pf):
             pi[RES + k] = 1 if layers[L_RES, rr, cc] > 0 else 0
             pf[PHER + k] = pher[rr, cc]
     pi[AT_BASE] = 1 if (r == base_r and c == base_c) else 0
-    pi[COMPASS_DR] = np.sign(base_r - r)
-    pi[COMPASS_DC] = np.sign(base_c - c)
+    pi[COMPASS_DR] = (base_r > r) - (base_r < r)
+    pi[COMPASS_DC] = (base_c > c) - (base_c < c)
     pi[CARRY] = payload
 
 

@@ -8,7 +8,13 @@ so there is exactly one implementation of every controller's step.
 import numpy as np
 from numba import njit
 
-from agents.controllers.ant import DEFAULT_THRESHOLD, P_THRESHOLD, ant_step
+from agents.controllers.ant import (
+    DEFAULT_DETOUR,
+    DEFAULT_THRESHOLD,
+    P_DETOUR,
+    P_THRESHOLD,
+    ant_step,
+)
 from agents.controllers.cmarking import DEFAULT_CLIMB_PATIENCE, P_CLIMB_PATIENCE, cmarking_step
 from agents.controllers.marking import marking_step
 
@@ -47,4 +53,5 @@ def controller_params(
         params[P_CLIMB_PATIENCE] = (cmarking or {}).get("climb_patience", DEFAULT_CLIMB_PATIENCE)
     elif name == "ant":
         params[P_THRESHOLD] = (ant or {}).get("threshold", DEFAULT_THRESHOLD)
+        params[P_DETOUR] = (ant or {}).get("detour", DEFAULT_DETOUR)
     return params

@@ -8,9 +8,11 @@ pheromone, if it holds at least `threshold`; otherwise they walk at random.
 Climbing only away from the base keeps them from following the trail to the
 nest, where every trail converges (the grid analogue of the classic model's
 "nest scent").  An ant whose compass directions are both blocked moves to a
-random free neighbour, so ants can get stuck in cavities, as the paper shows.
+random free neighbour and keeps walking at random for `detour` steps, which
+gets it out of small pockets (with detour 0 ants freeze in cavities, as the
+paper's Figure 11.a shows; deep cavities still hold them for long).
 
-Params: params[P_THRESHOLD].  Diffusion, evaporation and the deposit amount
+Params: params[P_THRESHOLD], params[P_DETOUR].  Diffusion, evaporation and the deposit amount
 are properties of the world (world_server.grid).
 """
 
@@ -26,6 +28,7 @@ from agents.controllers.layout import (
     COMPASS_DR,
     DIR_DC,
     DIR_DR,
+    M_DETOUR,
     M_LOADING,
     M_MODE,
     N_DIRS,
@@ -37,7 +40,9 @@ from agents.controllers.layout import (
 from agents.controllers.moves import pick, random_free_dir, reset_action
 
 P_THRESHOLD = 0
-DEFAULT_THRESHOLD = 0.01
+P_DETOUR = 1
+DEFAULT_THRESHOLD = 0.3
+DEFAULT_DETOUR = 8
 
 
 @njit(cache=True, inline="always")
@@ -47,25 +52,27 @@ def toward_base(pi, d):
     return (dr != 0 and dr == pi[COMPASS_DR]) or (dc != 0 and dc == pi[COMPASS_DC])
 
 
-@njit(cache=True)
-def compass_dir(pi, seed, agent, tick):
-    cands = np.empty(N_DIRS, dtype=np.int64)
-    n = 0
+@njit(cache=True, inline="always")
+def compass_dir(pi, mem, params, seed, agent, tick):
+    """Home by compass; when both compass directions are walled, detour."""
+    if mem[M_DETOUR] > 0:
+        mem[M_DETOUR] -= 1
+        return random_free_dir(pi, seed, agent, tick, 5)
+    m = 0
     for d in range(N_DIRS):
         if pi[OBST + 1 + d] == 0 and toward_base(pi, d):
-            cands[n] = d
-            n += 1
-    if n == 0:
+            m |= 1 << d
+    if m == 0:
+        mem[M_DETOUR] = np.int64(params[P_DETOUR])
         return random_free_dir(pi, seed, agent, tick, 5)
-    return pick(cands, n, seed, agent, tick, 1)
+    return pick(m, seed, agent, tick, 1)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def climb_pheromone_dir(pi, pf, threshold, seed, agent, tick):
     """The free neighbour leading away from the base with the most pheromone
     (>= threshold), -1 if none qualifies."""
-    cands = np.empty(N_DIRS, dtype=np.int64)
-    n = 0
+    m = 0
     best = threshold
     for d in range(N_DIRS):
         if pi[OBST + 1 + d] != 0 or toward_base(pi, d):
@@ -73,16 +80,13 @@ def climb_pheromone_dir(pi, pf, threshold, seed, agent, tick):
         p = pf[PHER + 1 + d]
         if p > best:
             best = p
-            n = 0
+            m = 0
         if p == best and p >= threshold:
-            cands[n] = d
-            n += 1
-    if n == 0:
-        return np.int64(-1)
-    return pick(cands, n, seed, agent, tick, 2)
+            m |= 1 << d
+    return pick(m, seed, agent, tick, 2)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def ant_step(pi, pf, mem, act, params, seed, agent, tick):
     reset_action(act)
     if mem[M_LOADING]:
@@ -92,7 +96,7 @@ def ant_step(pi, pf, mem, act, params, seed, agent, tick):
     if mem[M_MODE] == RETURN:
         if not unload_if_home(pi, mem, act):
             act[A_DEPOSIT] = 1
-            act[A_MOVE] = compass_dir(pi, seed, agent, tick)
+            act[A_MOVE] = compass_dir(pi, mem, params, seed, agent, tick)
             return
     if seek_resource(pi, mem, act, seed, agent, tick):
         return

@@ -70,7 +70,7 @@ def new_trail_id(tick, agent):
     return ((tick + 1) << 20) | (agent + 1)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def begin_return(pi, mem, tick, agent):
     """LOADING, read one tick after the LOAD: choose the kind of return from
     what is left on the cell (the world resolved every agent's load)."""
@@ -92,7 +92,7 @@ def begin_return(pi, mem, tick, agent):
         mem[M_MODE] = RETURN
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def erase_step(pi, mem, act, seed, agent, tick):
     """Wipe colour mem[M_TRAIL] here and head for the least-valued neighbour of
     that colour; -1 when the colour goes no further."""
@@ -113,7 +113,7 @@ def next_to_base(pi):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def start_erasing(pi, mem, act, seed, agent, tick):
     """The trail under the agent leads nowhere (dead end, or a loop of trail
     cells): wipe this cell whatever touches it, which is what breaks a loop,
@@ -132,7 +132,7 @@ def start_erasing(pi, mem, act, seed, agent, tick):
     mem[M_PREV] = opposite(d) if d < N_DIRS else -1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def returning_step(pi, mem, act, params, seed, agent, tick):
     mode = mem[M_MODE]
     if mode == RETURN_REMOVE:
@@ -150,7 +150,7 @@ def returning_step(pi, mem, act, params, seed, agent, tick):
         mem[M_PREV] = opposite(act[A_MOVE])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def search_step(pi, mem, act, params, seed, agent, tick):
     """SEARCH & CLIMB TRAIL."""
     if seek_resource(pi, mem, act, seed, agent, tick):
@@ -183,7 +183,7 @@ def search_step(pi, mem, act, params, seed, agent, tick):
     mem[M_PREV] = opposite(d) if d < N_DIRS else -1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def cmarking_step(pi, pf, mem, act, params, seed, agent, tick):
     reset_action(act)
     act[A_MARK] = update_value(pi)

@@ -20,7 +20,7 @@ from agents.controllers.layout import (
 from agents.controllers.moves import opposite, resource_dir
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def settle_mode(pi, mem):
     """Returning agents carry; searching agents do not.  After a restart the
     agent may find itself carrying in SEARCH mode: it then goes home."""
@@ -28,7 +28,7 @@ def settle_mode(pi, mem):
         mem[M_MODE] = RETURN
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def unload_if_home(pi, mem, act):
     """At the base a returning agent drops its load and searches again in the
     same tick.  It keeps the memory of the cell it came from, so, as the
@@ -43,7 +43,7 @@ def unload_if_home(pi, mem, act):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def seek_resource(pi, mem, act, seed, agent, tick):
     """SEARCH's first rule.  On a resource cell: LOAD (the tick is spent
     loading, the outcome is read next tick).  Next to one: move into it.

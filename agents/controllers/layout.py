@@ -72,6 +72,7 @@ M_CLIMB_MAX = 3  # highest mark seen on the current climb
 M_CLIMB_STALL = 4  # climb steps since that maximum last rose
 M_CLIMBING = 5  # 1 if the last move was a climb along a trail
 M_LOADING = 6  # 1 if the last action was LOAD (the outcome is read this tick)
+M_DETOUR = 7  # ants: random steps left after the compass way home was blocked
 MEM_LEN = 8
 
 # Controller modes (shared names so the recorder can label them).

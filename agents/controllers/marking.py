@@ -18,7 +18,7 @@ from agents.controllers.layout import (
 from agents.controllers.moves import descent_dir, explore_dir, opposite, reset_action, update_value
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def marking_step(pi, pf, mem, act, params, seed, agent, tick):
     reset_action(act)
     act[A_MARK] = update_value(pi)

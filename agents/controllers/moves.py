@@ -1,7 +1,9 @@
 """Local moves shared by the grid controllers: update-value, descent, exploration.
 
-Every choice among equals is uniform, drawn from the counter-based generator
-(see swarm.rng), so a controller's decision depends only on (seed, agent, tick).
+Candidate neighbours are kept as 4-bit masks (bit d = direction d), so the
+hot path allocates nothing.  Every choice among equals is uniform, drawn from
+the counter-based generator (swarm.rng): a controller's decision depends only
+on (seed, agent, tick).
 """
 
 import numpy as np
@@ -50,69 +52,73 @@ def update_value(pi):
 
 
 @njit(cache=True, inline="always")
-def pick(cands, n, seed, agent, tick, draw):
-    """A uniform pick among the first n entries of cands (n >= 1)."""
-    if n == 1:
-        return cands[0]
-    return cands[draw_below(seed, agent, tick, draw, n)]
+def pick(mask, seed, agent, tick, draw):
+    """A uniform pick among the directions set in a 4-bit mask; -1 if empty."""
+    n = (mask & 1) + ((mask >> 1) & 1) + ((mask >> 2) & 1) + ((mask >> 3) & 1)
+    if n == 0:
+        return np.int64(-1)
+    k = np.int64(0) if n == 1 else draw_below(seed, agent, tick, draw, n)
+    for d in range(N_DIRS):
+        if (mask >> d) & 1:
+            if k == 0:
+                return np.int64(d)
+            k -= 1
+    return np.int64(-1)
 
 
-@njit(cache=True)
-def random_free_dir(pi, seed, agent, tick, draw):
-    """A uniformly random non-obstacle neighbour, or STAY when boxed in."""
-    cands = np.empty(N_DIRS, dtype=np.int64)
-    n = 0
+@njit(cache=True, inline="always")
+def free_mask(pi):
+    m = 0
     for d in range(N_DIRS):
         if pi[OBST + 1 + d] == 0:
-            cands[n] = d
-            n += 1
-    if n == 0:
-        return STAY
-    return pick(cands, n, seed, agent, tick, draw)
+            m |= 1 << d
+    return m
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
+def random_free_dir(pi, seed, agent, tick, draw):
+    """A uniformly random non-obstacle neighbour, or STAY when boxed in."""
+    d = pick(free_mask(pi), seed, agent, tick, draw)
+    return STAY if d < 0 else d
+
+
+@njit(cache=True, inline="always")
 def explore_dir(pi, seed, agent, tick, draw):
     """Algorithm 2's move: a random unmarked neighbour if any, else any free one."""
-    cands = np.empty(N_DIRS, dtype=np.int64)
-    n = 0
+    m = 0
     for d in range(N_DIRS):
         if pi[OBST + 1 + d] == 0 and pi[MARK + 1 + d] == MARK_NONE:
-            cands[n] = d
-            n += 1
-    if n == 0:
+            m |= 1 << d
+    if m == 0:
         return random_free_dir(pi, seed, agent, tick, draw)
-    return pick(cands, n, seed, agent, tick, draw)
+    return pick(m, seed, agent, tick, draw)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def descent_dir(pi, seed, agent, tick, draw):
     """RETURN TO BASE: the neighbour with the least mark (ties uniform)."""
-    cands = np.empty(N_DIRS, dtype=np.int64)
-    n = 0
+    m = 0
     best = MARK_NONE
     for d in range(N_DIRS):
         if pi[OBST + 1 + d] != 0:
             continue
-        m = pi[MARK + 1 + d]
-        if m < best:
-            best = m
-            n = 0
-        if m == best and m != MARK_NONE:
-            cands[n] = d
-            n += 1
-    if n == 0:
+        v = pi[MARK + 1 + d]
+        if v < best:
+            best = v
+            m = 0
+        if v == best and v != MARK_NONE:
+            m |= 1 << d
+    if m == 0:
         return random_free_dir(pi, seed, agent, tick, draw)
-    return pick(cands, n, seed, agent, tick, draw)
+    return pick(m, seed, agent, tick, draw)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def extreme_dir_among(pi, layer, want, exclude, seed, agent, tick, draw, highest):
     """Among free neighbours whose `layer` value equals `want` (want < 0: any
     non-zero value) and that are not `exclude`, the one with the highest
     (or least) mark; -1 when there is none.  Used to climb and follow trails."""
-    cands = np.empty(N_DIRS, dtype=np.int64)
-    n = 0
+    m = 0
     best = np.int64(0)
     for d in range(N_DIRS):
         if d == exclude or pi[OBST + 1 + d] != 0:
@@ -120,31 +126,23 @@ def extreme_dir_among(pi, layer, want, exclude, seed, agent, tick, draw, highest
         v = pi[layer + 1 + d]
         if (want < 0 and v == 0) or (want >= 0 and v != want):
             continue
-        m = pi[MARK + 1 + d]
-        better = n == 0 or (m > best if highest else m < best)
-        if better:
-            best = m
-            n = 0
-        if m == best:
-            cands[n] = d
-            n += 1
-    if n == 0:
-        return np.int64(-1)
-    return pick(cands, n, seed, agent, tick, draw)
+        mark = pi[MARK + 1 + d]
+        if m == 0 or (mark > best if highest else mark < best):
+            best = mark
+            m = 0
+        if mark == best:
+            m |= 1 << d
+    return pick(m, seed, agent, tick, draw)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def resource_dir(pi, layer, seed, agent, tick, draw):
     """A neighbour holding resource (uniform among several), -1 if none."""
-    cands = np.empty(N_DIRS, dtype=np.int64)
-    n = 0
+    m = 0
     for d in range(N_DIRS):
         if pi[OBST + 1 + d] == 0 and pi[layer + 1 + d] != 0:
-            cands[n] = d
-            n += 1
-    if n == 0:
-        return np.int64(-1)
-    return pick(cands, n, seed, agent, tick, draw)
+            m |= 1 << d
+    return pick(m, seed, agent, tick, draw)
 
 
 @njit(cache=True, inline="always")

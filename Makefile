@@ -1,0 +1,41 @@
+# swarm: two commands on a fresh machine with Python 3.11+ and make:
+#   make demo   installs everything and runs the default swarm
+#   make test   installs everything and runs the tests
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+
+.PHONY: install demo test lint experiments bench clean
+
+install: $(STAMP)
+
+$(STAMP): pyproject.toml
+	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "swarm needs Python 3.11 or newer"'
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e '.[dev]'
+	@touch $(STAMP)
+
+demo: install
+	$(BIN)/swarm run setup1 --agents 20 --seed 1
+
+test: install
+	$(BIN)/ruff check .
+	$(BIN)/python -m pytest -q
+
+lint: install
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+
+experiments: install
+	$(BIN)/swarm experiment table1 --reps 100
+	$(BIN)/swarm experiment table2 --reps 1000
+	$(BIN)/swarm experiment table3 --reps 20
+	$(BIN)/swarm experiment ants --reps 10
+
+bench: install
+	$(BIN)/swarm bench engine
+
+clean:
+	rm -rf $(VENV) build *.egg-info results .pytest_cache .ruff_cache

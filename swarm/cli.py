@@ -1,0 +1,157 @@
+"""The `swarm` command."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from swarm.scenario import PRESET_HELP, ScenarioError, bundled_scenarios, load_scenario
+
+DESCRIPTION = """\
+swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
+the plain marking agents and the pheromone ant baseline.
+
+examples:
+  swarm run setup1 --agents 20 --seed 3
+  swarm run maze --controller marking --until converged --json
+  swarm experiment table1 --reps 100
+  swarm bench engine
+"""
+
+
+def _positive(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
+    return value
+
+
+def _seed(text: str) -> int:
+    value = int(text)
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"expected a seed from 0 to 2**63-1, got {text}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="swarm", description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    run = sub.add_parser(
+        "run",
+        help="run a scenario to completion in one process",
+        description="Run a scenario in the in-process engine and print its summary.",
+    )
+    run.add_argument(
+        "scenario",
+        metavar="SCENARIO",
+        help=f"a TOML file, a preset ({PRESET_HELP}) or a bundled name ({', '.join(bundled_scenarios())})",
+    )
+    run.add_argument("--agents", type=_positive, help="number of agents (default: the scenario's)")
+    run.add_argument("--controller", choices=["cmarking", "marking", "ant"], help="controller to run")
+    run.add_argument("--seed", type=_seed, help="seed of the map and of every random choice")
+    run.add_argument(
+        "--until",
+        choices=["foraged", "converged", "both"],
+        default="foraged",
+        help="foraged: every unit delivered (default); converged: marks equal the BFS "
+        "distance on every reachable cell; both",
+    )
+    run.add_argument("--max-iterations", type=_positive, default=1_000_000, metavar="M",
+                     help="stop after M iterations if not done (default 1000000)")  # fmt: skip
+    run.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+
+    exp = sub.add_parser(
+        "experiment",
+        help="reproduce a table of the paper",
+        description="Rerun one of the paper's experiments and write runs.csv, summary.csv, "
+        "table.md (paper beside ours) and plot.png.",
+    )
+    from swarm.experiments import EXPERIMENTS
+
+    exp.add_argument("name", choices=list(EXPERIMENTS), metavar="NAME",
+                     help="; ".join(f"{e.name}: {e.title.split(': ', 1)[1]}" for e in EXPERIMENTS.values()))  # fmt: skip
+    exp.add_argument("--reps", type=_positive, help="runs per configuration (default per experiment)")
+    exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
+    exp.add_argument("--seed", type=_seed, default=0, help="first seed (runs use seed..seed+reps-1)")
+    exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
+
+    bench = sub.add_parser("bench", help="measure throughput", description="Measure throughput.")
+    bench.add_argument("target", choices=["engine"], help="engine: the in-process engine")
+    bench.add_argument("--json", action="store_true", help="print one JSON object")
+    bench.add_argument("--quick", action="store_true", help="shorter measurement")
+
+    sub.add_parser("scenarios", help="list presets and bundled scenarios")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    try:
+        return COMMANDS[args.command](args)
+    except ScenarioError as exc:
+        print(f"swarm: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("swarm: interrupted", file=sys.stderr)
+        return 130
+
+
+def cmd_run(args) -> int:
+    from swarm.engine import Engine
+
+    scenario = load_scenario(args.scenario).with_overrides(
+        agents=args.agents, controller=args.controller, seed=args.seed
+    )
+    engine = Engine(scenario)
+    summary = engine.run(args.until, args.max_iterations, progress=not args.json and sys.stderr.isatty()).summary
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        state = "finished" if summary["finished"] else f"NOT finished ({args.until})"
+        print(
+            f"{summary['scenario']}: {summary['controller']} x{summary['agents']}, seed {summary['seed']}: "
+            f"{state} after {summary['iterations']} iterations\n"
+            f"  delivered {summary['delivered']}/{summary['total']}, explored "
+            f"{summary['explored_cells']}/{summary['reachable_cells']} cells, optimal marks "
+            f"{summary['optimal_cells']}/{summary['reachable_cells']} (APF optimal: {summary['apf_optimal']})"
+        )
+    return 0 if summary["finished"] else 1
+
+
+def cmd_experiment(args) -> int:
+    from swarm.experiments import run_experiment
+
+    result = run_experiment(args.name, args.reps, args.jobs, args.seed, args.out)
+    print(result["markdown"])
+    print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from swarm.bench import bench_engine, format_engine_bench
+
+    result = bench_engine(quick=args.quick)
+    print(json.dumps(result) if args.json else format_engine_bench(result))
+    return 0
+
+
+def cmd_scenarios(args) -> int:
+    print(f"presets: {PRESET_HELP}")
+    print(f"bundled: {', '.join(bundled_scenarios())}  (in {Path(__file__).parent / 'scenarios'})")
+    return 0
+
+
+COMMANDS = {"run": cmd_run, "experiment": cmd_experiment, "bench": cmd_bench, "scenarios": cmd_scenarios}
+
+
+if __name__ == "__main__":
+    sys.exit(main())
