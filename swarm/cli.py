@@ -73,8 +73,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     from swarm.experiments import EXPERIMENTS
 
-    exp.add_argument("name", choices=list(EXPERIMENTS), metavar="NAME",
-                     help="; ".join(f"{e.name}: {e.title.split(': ', 1)[1]}" for e in EXPERIMENTS.values()))  # fmt: skip
+    names_help = "; ".join(f"{e.name}: {e.title.split(': ', 1)[1]}" for e in EXPERIMENTS.values())
+    exp.add_argument("name", choices=list(EXPERIMENTS), metavar="NAME", help=names_help)
     exp.add_argument("--reps", type=_positive, help="runs per configuration (default per experiment)")
     exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
     exp.add_argument("--seed", type=_seed, default=0, help="first seed (runs use seed..seed+reps-1)")

@@ -66,9 +66,7 @@ def run_ticks(
             step_controller(kind, pi, pf, mem[a], acts[a], cparams, seed, a, tick)
         apply_actions(layers, pher, base_r, base_c, pos, payload, acts, tick, wparams, counters)
         if pher_on:
-            diffuse_evaporate(
-                pher, layers[L_OBST], wparams[W_DIFFUSION], wparams[W_EVAPORATION], pher_scratch
-            )
+            diffuse_evaporate(pher, layers[L_OBST], wparams[W_DIFFUSION], wparams[W_EVAPORATION], pher_scratch)
         if is_done(until, counters, total, reachable):
             return t + 1
     return n_ticks
@@ -132,9 +130,7 @@ class Engine:
         if until not in UNTIL:
             raise ValueError(f"unknown --until {until!r}: choose foraged, converged or both")
         if until != "foraged" and self.scenario.controller == "ant":
-            raise ScenarioError(
-                "command line", "until", "ants build no marks; only --until foraged applies to them"
-            )
+            raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
         bar = None
         if progress:
             from tqdm import tqdm
@@ -174,13 +170,9 @@ class Engine:
             "rejected_moves": int(w.counters[C_REJECTED]),
             "grid": list(w.layout.shape),
             "wall_seconds": round(self.wall_seconds, 4),
-            "agent_steps_per_second": round(steps / self.wall_seconds)
-            if self.wall_seconds
-            else None,
+            "agent_steps_per_second": round(steps / self.wall_seconds) if self.wall_seconds else None,
         }
 
 
-def run_scenario(
-    scenario: Scenario, until: str = "foraged", max_iterations: int = DEFAULT_MAX_ITERATIONS
-) -> dict:
+def run_scenario(scenario: Scenario, until: str = "foraged", max_iterations: int = DEFAULT_MAX_ITERATIONS) -> dict:
     return Engine(scenario).run(until, max_iterations).summary

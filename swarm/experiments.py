@@ -211,8 +211,8 @@ def _ants_configs():
 def _ants_report(rows):
     summary, lines = [], []
     for size in ANT_SIZES:
-        cm, cm_std, cm_n, cm_unf = _stats(rows, size=size, controller="cmarking")
-        ant, ant_std, ant_n, ant_unf = _stats(rows, size=size, controller="ant")
+        cm, _, cm_n, cm_unf = _stats(rows, size=size, controller="cmarking")
+        ant, _, ant_n, ant_unf = _stats(rows, size=size, controller="ant")
         gap = 100 * (1 - cm / ant)
         summary.append({"size": size, "cmarking_mean": round(cm, 1), "ant_mean": round(ant, 1),
                         "gap_percent": round(gap, 1), "cmarking_unfinished": cm_unf,

@@ -43,6 +43,4 @@ def draw_below(seed, agent, tick, draw, n):
 @njit(cache=True, inline="always")
 def draw_unit(seed, agent, tick, draw):
     """A uniform float in [0, 1)."""
-    return np.float64(draw_u64(seed, agent, tick, draw) >> np.uint64(11)) * (
-        1.0 / 9007199254740992.0
-    )
+    return np.float64(draw_u64(seed, agent, tick, draw) >> np.uint64(11)) * (1.0 / 9007199254740992.0)

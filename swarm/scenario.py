@@ -180,8 +180,7 @@ def load_scenario(ref: str) -> Scenario:
         raise ScenarioError(
             ref,
             "scenario",
-            f"no such file or preset; presets: {PRESET_HELP}; "
-            f"bundled: {', '.join(bundled_scenarios())}",
+            f"no such file or preset; presets: {PRESET_HELP}; bundled: {', '.join(bundled_scenarios())}",
         )
     return parse_scenario_text(path.read_text(encoding="utf-8", errors="replace"), str(path))
 
@@ -200,9 +199,7 @@ def parse_scenario_text(text: str, source: str = "<string>") -> Scenario:
     _no_unknown(data, _TOP_KEYS, source, "top level")
     has_map, has_gen = "map" in data, "generator" in data
     if has_map == has_gen:
-        raise ScenarioError(
-            source, "map/generator", "give exactly one of [map] (ascii = ...) or [generator]"
-        )
+        raise ScenarioError(source, "map/generator", "give exactly one of [map] (ascii = ...) or [generator]")
     kw: dict[str, Any] = {"name": Path(source).stem, "source": source}
     if "name" in data:
         kw["name"] = _typed(data, "name", str, source)
@@ -235,24 +232,18 @@ def parse_scenario_text(text: str, source: str = "<string>") -> Scenario:
             width=_typed(section, "width", int, source, "generator.width"),
             height=_typed(section, "height", int, source, "generator.height"),
             obstacle_density=float(
-                _typed(
-                    section, "obstacle_density", (int, float), source, "generator.obstacle_density"
-                )
+                _typed(section, "obstacle_density", (int, float), source, "generator.obstacle_density")
             ),
             resources=_typed(section, "resources", int, source, "generator.resources"),
         )
     if "ant" in data:
         section = _section(data, "ant", source)
         _no_unknown(section, set(AntParams.__dataclass_fields__), source, "[ant]")
-        kw["ant"] = AntParams(
-            **{k: float(_typed(section, k, (int, float), source, f"ant.{k}")) for k in section}
-        )
+        kw["ant"] = AntParams(**{k: float(_typed(section, k, (int, float), source, f"ant.{k}")) for k in section})
     if "cmarking" in data:
         section = _section(data, "cmarking", source)
         _no_unknown(section, set(CMarkingParams.__dataclass_fields__), source, "[cmarking]")
-        kw["cmarking"] = CMarkingParams(
-            **{k: _typed(section, k, int, source, f"cmarking.{k}") for k in section}
-        )
+        kw["cmarking"] = CMarkingParams(**{k: _typed(section, k, int, source, f"cmarking.{k}") for k in section})
     scenario = Scenario(**kw)
     check_scenario(scenario)
     return scenario
@@ -317,16 +308,12 @@ def check_scenario(s: Scenario) -> None:
     if s.q_max < 1:
         raise ScenarioError(src, "q_max", f"expected a carrying capacity >= 1, got {s.q_max}")
     if not 1 <= s.quantity <= 2**40:
-        raise ScenarioError(
-            src, "quantity", f"expected 1 to 2**40 units per resource, got {s.quantity}"
-        )
+        raise ScenarioError(src, "quantity", f"expected 1 to 2**40 units per resource, got {s.quantity}")
     a = s.ant
     if not 0.0 <= a.diffusion <= 1.0:
         raise ScenarioError(src, "ant.diffusion", f"expected a rate in [0, 1], got {a.diffusion}")
     if not 0.0 <= a.evaporation <= 1.0:
-        raise ScenarioError(
-            src, "ant.evaporation", f"expected a rate in [0, 1], got {a.evaporation}"
-        )
+        raise ScenarioError(src, "ant.evaporation", f"expected a rate in [0, 1], got {a.evaporation}")
     if not (a.deposit > 0 and np.isfinite(a.deposit)):
         raise ScenarioError(src, "ant.deposit", f"expected a positive amount, got {a.deposit}")
     if not (a.threshold >= 0 and np.isfinite(a.threshold)):
@@ -339,17 +326,11 @@ def check_scenario(s: Scenario) -> None:
         g = s.generator
         for key, value in (("width", g.width), ("height", g.height)):
             if not 3 <= value <= 4096:
-                raise ScenarioError(
-                    src, f"generator.{key}", f"expected 3 to 4096 cells, got {value}"
-                )
+                raise ScenarioError(src, f"generator.{key}", f"expected 3 to 4096 cells, got {value}")
         if not 0.0 <= g.obstacle_density <= 0.6:
-            raise ScenarioError(
-                src, "generator.obstacle_density", f"expected 0 to 0.6, got {g.obstacle_density}"
-            )
+            raise ScenarioError(src, "generator.obstacle_density", f"expected 0 to 0.6, got {g.obstacle_density}")
         if not 0 <= g.resources <= g.width * g.height // 2:
-            raise ScenarioError(
-                src, "generator.resources", f"expected 0 to half the cells, got {g.resources}"
-            )
+            raise ScenarioError(src, "generator.resources", f"expected 0 to half the cells, got {g.resources}")
     else:
         _check_ascii(s)
 
@@ -369,9 +350,7 @@ def _check_ascii(s: Scenario) -> None:
     bases = []
     for i, row in enumerate(rows):
         if len(row) != width:
-            raise ScenarioError(
-                s.source, _map_where(s, i), f"has {len(row)} cells, expected {width} like row 1"
-            )
+            raise ScenarioError(s.source, _map_where(s, i), f"has {len(row)} cells, expected {width} like row 1")
         for j, ch in enumerate(row):
             if ch not in MAP_CHARS:
                 raise ScenarioError(
@@ -382,9 +361,7 @@ def _check_ascii(s: Scenario) -> None:
             if ch == "B":
                 bases.append((i, j))
     if len(bases) != 1:
-        raise ScenarioError(
-            s.source, "map.ascii", f"expected exactly one base B, found {len(bases)}"
-        )
+        raise ScenarioError(s.source, "map.ascii", f"expected exactly one base B, found {len(bases)}")
 
 
 def _layout_from_ascii(s: Scenario) -> Layout:
@@ -428,8 +405,7 @@ def generate_layout(g: Generator, quantity: int, seed: int, source: str = "gener
         raise ScenarioError(
             source,
             "generator.obstacle_density",
-            f"no map in {MAX_MAP_DRAWS} draws lets the base reach half the free cells; "
-            "lower the density",
+            f"no map in {MAX_MAP_DRAWS} draws lets the base reach half the free cells; lower the density",
         )
     resources = np.zeros(h * w, dtype=np.int64)
     resources[rng.choice(reachable, size=g.resources, replace=False)] = quantity

@@ -3,12 +3,34 @@
 import numpy as np
 
 from agents.controllers import CMARKING, controller_params, step_controller
-from agents.controllers.layout import (
-    A_LOAD, A_MARK, A_MOVE, A_TRAIL_ID, A_TRAIL_OP, CARRY, ERASE, M_CLIMBING, M_LOADING, M_MODE, M_PREV,
-    M_TRAIL, MARK, MARK_NONE, OBST, RES, RETURN_COLOUR, RETURN_REMOVE, SEARCH, TRAIL, TRAIL_ERASE,
-    TRAIL_PAINT, new_action, new_memory, new_perception,
-)  # fmt: skip
 from agents.controllers.cmarking import new_trail_id
+from agents.controllers.layout import (
+    A_LOAD,
+    A_MARK,
+    A_MOVE,
+    A_TRAIL_ID,
+    A_TRAIL_OP,
+    CARRY,
+    ERASE,
+    M_CLIMBING,
+    M_LOADING,
+    M_MODE,
+    M_PREV,
+    M_TRAIL,
+    MARK,
+    MARK_NONE,
+    OBST,
+    RES,
+    RETURN_COLOUR,
+    RETURN_REMOVE,
+    SEARCH,
+    TRAIL,
+    TRAIL_ERASE,
+    TRAIL_PAINT,
+    new_action,
+    new_memory,
+    new_perception,
+)  # fmt: skip
 
 N, E, S, W = 0, 1, 2, 3
 PARAMS = controller_params("cmarking")

@@ -4,7 +4,16 @@ erase merges, min-merged marks, rejected moves, unloads only at the base."""
 import numpy as np
 
 from agents.controllers.layout import (
-    A_LOAD, A_MARK, A_MOVE, A_TRAIL_ID, A_TRAIL_OP, A_UNLOAD, MARK_NONE, STAY, TRAIL_ERASE, TRAIL_PAINT,
+    A_LOAD,
+    A_MARK,
+    A_MOVE,
+    A_TRAIL_ID,
+    A_TRAIL_OP,
+    A_UNLOAD,
+    MARK_NONE,
+    STAY,
+    TRAIL_ERASE,
+    TRAIL_PAINT,
 )  # fmt: skip
 from swarm.engine import Engine
 from tests.helpers import ascii_scenario

@@ -212,9 +212,7 @@ class GridWorld:
         self.total = int(layout.resources.sum())
         self.reachable = layout.reachable_cells
         a = scenario.ant
-        self.wparams = np.array(
-            [scenario.q_max, a.deposit, a.diffusion, a.evaporation], dtype=np.float64
-        )
+        self.wparams = np.array([scenario.q_max, a.deposit, a.diffusion, a.evaporation], dtype=np.float64)
 
     @property
     def marks(self) -> np.ndarray:

@@ -39,14 +39,10 @@ def controller_kind(name: str) -> int:
     try:
         return CONTROLLERS[name]
     except KeyError:
-        raise ValueError(
-            f"unknown controller {name!r}: choose one of {', '.join(CONTROLLERS)}"
-        ) from None
+        raise ValueError(f"unknown controller {name!r}: choose one of {', '.join(CONTROLLERS)}") from None
 
 
-def controller_params(
-    name: str, cmarking: dict | None = None, ant: dict | None = None
-) -> np.ndarray:
+def controller_params(name: str, cmarking: dict | None = None, ant: dict | None = None) -> np.ndarray:
     """The float parameter vector of a controller, defaults filled in."""
     params = np.zeros(N_PARAMS, dtype=np.float64)
     if name == "cmarking":
