@@ -19,23 +19,20 @@ are properties of the world (world_server.grid).
 import numpy as np
 from numba import njit
 
-from agents.controllers.foraging import seek_resource, settle_mode, unload_if_home
+from agents.controllers.foraging import read_load_outcome, seek_resource, unload_if_home
 from agents.controllers.layout import (
     A_DEPOSIT,
     A_MOVE,
-    CARRY,
     COMPASS_DC,
     COMPASS_DR,
     DIR_DC,
     DIR_DR,
     M_DETOUR,
-    M_LOADING,
     M_MODE,
     N_DIRS,
     OBST,
     PHER,
     RETURN,
-    SEARCH,
 )
 from agents.controllers.moves import pick, random_free_dir, reset_action
 
@@ -89,10 +86,7 @@ def climb_pheromone_dir(pi, pf, threshold, seed, agent, tick):
 @njit(cache=True, inline="always")
 def ant_step(pi, pf, mem, act, params, seed, agent, tick):
     reset_action(act)
-    if mem[M_LOADING]:
-        mem[M_LOADING] = 0
-        mem[M_MODE] = RETURN if pi[CARRY] > 0 else SEARCH
-    settle_mode(pi, mem)
+    read_load_outcome(pi, mem)
     if mem[M_MODE] == RETURN:
         if not unload_if_home(pi, mem, act):
             act[A_DEPOSIT] = 1

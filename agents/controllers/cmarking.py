@@ -133,13 +133,21 @@ def start_erasing(pi, mem, act, seed, agent, tick):
 
 
 @njit(cache=True, inline="always")
+def follow_erasing(pi, mem, act, seed, agent, tick):
+    """One erasing step down the trail; False when the colour goes no further."""
+    d = erase_step(pi, mem, act, seed, agent, tick)
+    if d < 0:
+        return False
+    act[A_MOVE] = d
+    mem[M_PREV] = opposite(d)
+    return True
+
+
+@njit(cache=True, inline="always")
 def returning_step(pi, mem, act, params, seed, agent, tick):
     mode = mem[M_MODE]
     if mode == RETURN_REMOVE:
-        d = erase_step(pi, mem, act, seed, agent, tick)
-        if d >= 0:
-            act[A_MOVE] = d
-            mem[M_PREV] = opposite(d)
+        if follow_erasing(pi, mem, act, seed, agent, tick):
             return
         mem[M_MODE] = RETURN  # trail broken: finish the trip by descent
     elif mode == RETURN_COLOUR:
@@ -192,10 +200,7 @@ def cmarking_step(pi, pf, mem, act, params, seed, agent, tick):
     settle_mode(pi, mem)
     mode = mem[M_MODE]
     if mode == ERASE:
-        d = erase_step(pi, mem, act, seed, agent, tick)
-        if d >= 0:
-            act[A_MOVE] = d
-            mem[M_PREV] = opposite(d)
+        if follow_erasing(pi, mem, act, seed, agent, tick):
             return
         mem[M_MODE] = SEARCH
         mem[M_PREV] = -1

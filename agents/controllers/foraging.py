@@ -29,6 +29,15 @@ def settle_mode(pi, mem):
 
 
 @njit(cache=True, inline="always")
+def read_load_outcome(pi, mem):
+    """Marking agents and ants: carrying after a LOAD means going home."""
+    if mem[M_LOADING]:
+        mem[M_LOADING] = 0
+        mem[M_MODE] = RETURN if pi[CARRY] > 0 else SEARCH
+    settle_mode(pi, mem)
+
+
+@njit(cache=True, inline="always")
 def unload_if_home(pi, mem, act):
     """At the base a returning agent drops its load and searches again in the
     same tick.  It keeps the memory of the cell it came from, so, as the

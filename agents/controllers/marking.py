@@ -4,16 +4,13 @@ alone and carried home by descending the marks."""
 
 from numba import njit
 
-from agents.controllers.foraging import seek_resource, settle_mode, unload_if_home
+from agents.controllers.foraging import read_load_outcome, seek_resource, unload_if_home
 from agents.controllers.layout import (
     A_MARK,
     A_MOVE,
-    CARRY,
-    M_LOADING,
     M_MODE,
     M_PREV,
     RETURN,
-    SEARCH,
 )
 from agents.controllers.moves import descent_dir, explore_dir, opposite, reset_action, update_value
 
@@ -22,10 +19,7 @@ from agents.controllers.moves import descent_dir, explore_dir, opposite, reset_a
 def marking_step(pi, pf, mem, act, params, seed, agent, tick):
     reset_action(act)
     act[A_MARK] = update_value(pi)
-    if mem[M_LOADING]:
-        mem[M_LOADING] = 0
-        mem[M_MODE] = RETURN if pi[CARRY] > 0 else SEARCH
-    settle_mode(pi, mem)
+    read_load_outcome(pi, mem)
     if mem[M_MODE] == RETURN:
         if not unload_if_home(pi, mem, act):
             act[A_MOVE] = descent_dir(pi, seed, agent, tick, 1)
