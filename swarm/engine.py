@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 
 from agents.controllers import ANT, controller_kind, controller_params, step_controller
-from agents.controllers.layout import new_memory, new_perception
+from agents.controllers.layout import new_memory
 from swarm.scenario import Layout, Scenario, ScenarioError
 from world_server.grid import (
     C_DELIVERED,
@@ -100,8 +100,6 @@ class Engine:
         )
         self.tick = 0
         self.wall_seconds = 0.0
-        # Warm the compiled step on a scratch perception (and fail early).
-        self._pi, self._pf = new_perception()
 
     def step(self, n: int = 1, until: str = "foraged") -> int:
         """Run up to n ticks (fewer if `until` is reached); return ticks run."""
@@ -172,7 +170,3 @@ class Engine:
             "wall_seconds": round(self.wall_seconds, 4),
             "agent_steps_per_second": round(steps / self.wall_seconds) if self.wall_seconds else None,
         }
-
-
-def run_scenario(scenario: Scenario, until: str = "foraged", max_iterations: int = DEFAULT_MAX_ITERATIONS) -> dict:
-    return Engine(scenario).run(until, max_iterations).summary

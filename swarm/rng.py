@@ -38,9 +38,3 @@ def draw_below(seed, agent, tick, draw, n):
     """A uniform integer in [0, n) by multiply-shift of 32 random bits (bias < 2**-28
     for the n <= 16 that controllers ask for)."""
     return np.int64(((draw_u64(seed, agent, tick, draw) >> _S32) * np.uint64(n)) >> _S32)
-
-
-@njit(cache=True, inline="always")
-def draw_unit(seed, agent, tick, draw):
-    """A uniform float in [0, 1)."""
-    return np.float64(draw_u64(seed, agent, tick, draw) >> np.uint64(11)) * (1.0 / 9007199254740992.0)

@@ -234,8 +234,5 @@ class GridWorld:
     def in_transit(self) -> int:
         return int(self.payload.sum())
 
-    def marked_mask(self) -> np.ndarray:
-        return self.marks != MARK_NONE
-
     def apf_optimal(self) -> bool:
         return int(self.counters[C_OPTIMAL]) == self.reachable
