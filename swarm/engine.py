@@ -14,21 +14,17 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from agents.controllers import ANT, controller_kind, controller_params, step_controller
-from agents.controllers.layout import new_memory
+from agents.controllers import controller_kind, controller_params, step_controller
+from agents.controllers.layout import PERC_F_LEN, PERC_LEN, new_memory
 from swarm.scenario import Layout, Scenario, ScenarioError
 from world_server.grid import (
     C_DELIVERED,
     C_EXPLORED,
     C_OPTIMAL,
     C_REJECTED,
-    L_OBST,
-    W_DIFFUSION,
-    W_EVAPORATION,
     GridWorld,
-    apply_actions,
-    diffuse_evaporate,
     perceive,
+    resolve_tick,
 )
 
 UNTIL_FORAGED = 0
@@ -52,21 +48,18 @@ def is_done(until, counters, total, reachable):
 @njit(cache=True)
 def run_ticks(
     kind, layers, pher, pher_scratch, base_r, base_c, pos, payload, mem, acts,
-    cparams, wparams, counters, seed, tick0, n_ticks, until, total, reachable,
+    cparams, wparams, counters, pher_on, seed, tick0, n_ticks, until, total, reachable,
 ):  # fmt: skip
     """Run up to n_ticks ticks from tick0; stop early once `until` holds.
     Returns the number of ticks run."""
-    pi, pf = np.empty(24, np.int64), np.empty(5, np.float64)
+    pi, pf = np.empty(PERC_LEN, np.int64), np.empty(PERC_F_LEN, np.float64)
     n = pos.shape[0]
-    pher_on = kind == ANT
     for t in range(n_ticks):
         tick = tick0 + t
         for a in range(n):
             perceive(layers, pher, base_r, base_c, pos[a, 0], pos[a, 1], payload[a], pi, pf)
             step_controller(kind, pi, pf, mem[a], acts[a], cparams, seed, a, tick)
-        apply_actions(layers, pher, base_r, base_c, pos, payload, acts, tick, wparams, counters)
-        if pher_on:
-            diffuse_evaporate(pher, layers[L_OBST], wparams[W_DIFFUSION], wparams[W_EVAPORATION], pher_scratch)
+        resolve_tick(layers, pher, pher_scratch, base_r, base_c, pos, payload, acts, tick, wparams, counters, pher_on)
         if is_done(until, counters, total, reachable):
             return t + 1
     return n_ticks
@@ -93,11 +86,7 @@ class Engine:
         self.kind = controller_kind(scenario.controller)
         self.world = GridWorld(scenario, layout)
         self.mem = new_memory(scenario.agents)
-        self.cparams = controller_params(
-            scenario.controller,
-            cmarking={"climb_patience": scenario.cmarking.climb_patience},
-            ant={"threshold": scenario.ant.threshold, "detour": scenario.ant.detour},
-        )
+        self.cparams = controller_params(scenario)
         self.tick = 0
         self.wall_seconds = 0.0
 
@@ -107,7 +96,7 @@ class Engine:
         started = time.perf_counter()
         ran = run_ticks(
             self.kind, w.layers, w.pher, w.pher_scratch, w.base[0], w.base[1], w.pos, w.payload,
-            self.mem, w.acts, self.cparams, w.wparams, w.counters, np.int64(self.scenario.seed),
+            self.mem, w.acts, self.cparams, w.wparams, w.counters, w.pheromone_on, np.int64(self.scenario.seed),
             self.tick, n, UNTIL[until], w.total, w.reachable,
         )  # fmt: skip
         self.wall_seconds += time.perf_counter() - started

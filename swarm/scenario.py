@@ -371,10 +371,12 @@ def _layout_from_ascii(s: Scenario) -> Layout:
     base_r, base_c = (int(v[0]) for v in np.nonzero(grid == "B"))
     bfs = bfs_distances(obstacles, base_r, base_c)
     resources = np.where(grid == "R", s.quantity, 0).astype(np.int64)
-    for r, c in zip(*np.nonzero((grid == "R") & (bfs < 0)), strict=True):
+    unreachable = np.argwhere((grid == "R") & (bfs < 0))
+    if len(unreachable):
+        r, c = (int(v) for v in unreachable[0])
         raise ScenarioError(
             s.source,
-            _map_where(s, int(r)),
+            _map_where(s, r),
             f"column {c + 1}: resource R cannot be reached from the base; open a path or remove it",
         )
     return Layout(obstacles, resources, (base_r, base_c), bfs)

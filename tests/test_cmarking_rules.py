@@ -31,9 +31,10 @@ from agents.controllers.layout import (
     new_memory,
     new_perception,
 )  # fmt: skip
+from swarm.scenario import Scenario
 
 N, E, S, W = 0, 1, 2, 3
-PARAMS = controller_params("cmarking")
+PARAMS = controller_params(Scenario("rules", "test", controller="cmarking"))
 
 
 def _perception(marks, trails=(0, 0, 0, 0, 0), res=(0, 0, 0, 0, 0), obst=(0, 0, 0, 0, 0), carry=0):

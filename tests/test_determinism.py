@@ -8,7 +8,6 @@ from agents.controllers import controller_kind, step_controller
 from agents.controllers.layout import new_perception
 from swarm.engine import Engine
 from swarm.scenario import load_scenario
-from world_server.grid import apply_actions, diffuse_evaporate, perceive
 
 
 def _state(engine):
@@ -51,13 +50,12 @@ def test_stepping_agents_in_any_order_gives_the_same_run(controller):
     w = manual.world
     pi, pf = new_perception()
     kind = controller_kind(controller)
+    seed = np.int64(scenario.seed)
     for tick in range(120):
         for a in reversed(range(scenario.agents)):
-            perceive(w.layers, w.pher, w.base[0], w.base[1], w.pos[a, 0], w.pos[a, 1], w.payload[a], pi, pf)
-            step_controller(kind, pi, pf, manual.mem[a], w.acts[a], manual.cparams, np.int64(scenario.seed), a, tick)
-        apply_actions(w.layers, w.pher, w.base[0], w.base[1], w.pos, w.payload, w.acts, tick, w.wparams, w.counters)
-        if controller == "ant":
-            diffuse_evaporate(w.pher, w.layers[0], w.wparams[2], w.wparams[3], w.pher_scratch)
+            w.perceive(a, pi, pf)
+            step_controller(kind, pi, pf, manual.mem[a], w.acts[a], manual.cparams, seed, a, tick)
+        w.resolve(tick)
         reference.step(1)
         np.testing.assert_array_equal(reference.world.pos, w.pos, err_msg=f"tick {tick}")
         np.testing.assert_array_equal(reference.world.layers, w.layers, err_msg=f"tick {tick}")

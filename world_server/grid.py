@@ -184,6 +184,14 @@ def diffuse_evaporate(pher, obst, diffusion, evaporation, out):
     pher[:, :] = out
 
 
+@njit(cache=True, inline="always")
+def resolve_tick(layers, pher, pher_scratch, base_r, base_c, pos, payload, acts, tick, wparams, counters, pher_on):
+    """Steps 3 and 4 of the tick: apply every action, then let pheromone spread."""
+    apply_actions(layers, pher, base_r, base_c, pos, payload, acts, tick, wparams, counters)
+    if pher_on:
+        diffuse_evaporate(pher, layers[L_OBST], wparams[W_DIFFUSION], wparams[W_EVAPORATION], pher_scratch)
+
+
 class GridWorld:
     """The grid's state: layers, pheromone, agents' positions and payloads."""
 
@@ -213,6 +221,16 @@ class GridWorld:
         self.reachable = layout.reachable_cells
         a = scenario.ant
         self.wparams = np.array([scenario.q_max, a.deposit, a.diffusion, a.evaporation], dtype=np.float64)
+        self.pheromone_on = scenario.controller == "ant"  # only ants lay pheromone
+
+    def perceive(self, agent: int, pi: np.ndarray, pf: np.ndarray) -> None:
+        r, c = self.pos[agent]
+        perceive(self.layers, self.pher, self.base[0], self.base[1], r, c, self.payload[agent], pi, pf)
+
+    def resolve(self, tick: int) -> None:
+        """Apply the actions in `acts` for `tick` (agent-id order), then spread pheromone."""
+        resolve_tick(self.layers, self.pher, self.pher_scratch, self.base[0], self.base[1], self.pos, self.payload,
+                     self.acts, tick, self.wparams, self.counters, self.pheromone_on)  # fmt: skip
 
     @property
     def marks(self) -> np.ndarray:

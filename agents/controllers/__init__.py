@@ -9,14 +9,13 @@ import numpy as np
 from numba import njit
 
 from agents.controllers.ant import (
-    DEFAULT_DETOUR,
-    DEFAULT_THRESHOLD,
     P_DETOUR,
     P_THRESHOLD,
     ant_step,
 )
-from agents.controllers.cmarking import DEFAULT_CLIMB_PATIENCE, P_CLIMB_PATIENCE, cmarking_step
+from agents.controllers.cmarking import P_CLIMB_PATIENCE, cmarking_step
 from agents.controllers.marking import marking_step
+from swarm.scenario import Scenario
 
 MARKING = 0
 CMARKING = 1
@@ -42,12 +41,12 @@ def controller_kind(name: str) -> int:
         raise ValueError(f"unknown controller {name!r}: choose one of {', '.join(CONTROLLERS)}") from None
 
 
-def controller_params(name: str, cmarking: dict | None = None, ant: dict | None = None) -> np.ndarray:
-    """The float parameter vector of a controller, defaults filled in."""
+def controller_params(scenario: Scenario) -> np.ndarray:
+    """The float parameter vector of the scenario's controller."""
     params = np.zeros(N_PARAMS, dtype=np.float64)
-    if name == "cmarking":
-        params[P_CLIMB_PATIENCE] = (cmarking or {}).get("climb_patience", DEFAULT_CLIMB_PATIENCE)
-    elif name == "ant":
-        params[P_THRESHOLD] = (ant or {}).get("threshold", DEFAULT_THRESHOLD)
-        params[P_DETOUR] = (ant or {}).get("detour", DEFAULT_DETOUR)
+    if scenario.controller == "cmarking":
+        params[P_CLIMB_PATIENCE] = scenario.cmarking.climb_patience
+    elif scenario.controller == "ant":
+        params[P_THRESHOLD] = scenario.ant.threshold
+        params[P_DETOUR] = scenario.ant.detour
     return params

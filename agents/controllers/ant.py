@@ -38,8 +38,6 @@ from agents.controllers.moves import pick, random_free_dir, reset_action
 
 P_THRESHOLD = 0
 P_DETOUR = 1
-DEFAULT_THRESHOLD = 0.3
-DEFAULT_DETOUR = 8
 
 
 @njit(cache=True, inline="always")

@@ -62,7 +62,6 @@ from agents.controllers.moves import (
 )
 
 P_CLIMB_PATIENCE = 0
-DEFAULT_CLIMB_PATIENCE = 20
 
 
 @njit(cache=True, inline="always")
