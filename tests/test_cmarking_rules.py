@@ -22,6 +22,7 @@ from agents.controllers.layout import (
     OBST,
     RES,
     RETURN_COLOUR,
+    RETURN_MEND,
     RETURN_REMOVE,
     SEARCH,
     TRAIL,
@@ -112,3 +113,18 @@ def test_next_to_the_base_a_trail_end_is_not_a_dead_end():
     mem[M_CLIMBING], mem[M_PREV] = 1, N
     _step(*_perception([1, 2, 2, 0, 2], trails=(5, 5, 0, 0, 0)), mem)
     assert mem[M_MODE] == SEARCH
+
+
+def test_loading_on_a_trail_follows_it_home_and_mends_gaps():
+    # resource left on a coloured cell: go home along the trail (S, mark 3 < 4), colour nothing here
+    mem = new_memory()[0]
+    mem[M_LOADING] = 1
+    act = _step(*_perception([4, 5, 3, 3, 5], trails=(7, 0, 0, 7, 0), res=(1, 0, 0, 0, 0), carry=100), mem)
+    assert mem[M_MODE] == RETURN_MEND and mem[M_TRAIL] == 7
+    assert act[A_TRAIL_OP] == 0 and act[A_MOVE] == S  # E has the same mark but is not the trail
+    # on an uncoloured cell (a gap in the trail): colour it, then descend the marks
+    act = _step(*_perception([3, 2, 4, 4, 4]), mem)
+    assert act[A_TRAIL_OP] == TRAIL_PAINT and act[A_TRAIL_ID] == 7 and act[A_MOVE] == N
+    # a cell of another trail is left as it is
+    act = _step(*_perception([2, 1, 3, 3, 3], trails=(9, 0, 0, 0, 0)), mem)
+    assert act[A_TRAIL_OP] == 0 and act[A_MOVE] == N

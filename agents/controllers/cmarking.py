@@ -6,10 +6,12 @@ leaves open are fixed here and explained in docs/cmarking.md:
 
 * a trail colour is a trail id, ((tick + 1) << 20) | (agent + 1), unique per
   trail and increasing with its creation time;
-* LOADING on a resource that is not exhausted always returns colouring: a new
-  colour if the cell is uncoloured, else the cell's own colour (the paper's
-  "algorithm equivalent to RETURN TO BASE" moves the same way; repainting
-  mends trails cut when a crossing trail was removed);
+* LOADING on a coloured resource that is not exhausted returns home along the
+  trail (RETURN_MEND): it steps to the least-valued cell of the trail's colour
+  while that is lower than its own cell, otherwise descends the marks, and it
+  colours every *uncoloured* cell it crosses with the trail's colour.  This is
+  the paper's "algorithm equivalent to RETURN TO BASE", plus mending: a trail
+  cut where a crossing trail was removed is joined up again on the next trip;
 * an agent leaving the base after unloading does not climb back into the cell
   it came from (the paper's "different from the previous position");
 * a remover follows and erases only its own colour; where its trail is broken
@@ -46,6 +48,7 @@ from agents.controllers.layout import (
     RES,
     RETURN,
     RETURN_COLOUR,
+    RETURN_MEND,
     RETURN_REMOVE,
     SEARCH,
     TRAIL,
@@ -79,10 +82,11 @@ def begin_return(pi, mem, tick, agent):
     if pi[CARRY] == 0:
         mem[M_MODE] = SEARCH  # someone else emptied the cell first
     elif pi[RES] != 0:
-        mem[M_MODE] = RETURN_COLOUR
         if pi[TRAIL] != 0:
-            mem[M_TRAIL] = pi[TRAIL]  # on a trail: descend home repainting it
+            mem[M_MODE] = RETURN_MEND  # already on a trail: follow it home, mending gaps
+            mem[M_TRAIL] = pi[TRAIL]
         else:
+            mem[M_MODE] = RETURN_COLOUR
             mem[M_TRAIL] = new_trail_id(tick, agent)
     elif pi[TRAIL] != 0:
         mem[M_MODE] = RETURN_REMOVE
@@ -149,9 +153,16 @@ def returning_step(pi, mem, act, params, seed, agent, tick):
         if follow_erasing(pi, mem, act, seed, agent, tick):
             return
         mem[M_MODE] = RETURN  # trail broken: finish the trip by descent
-    elif mode == RETURN_COLOUR:
+    elif mode == RETURN_COLOUR or (mode == RETURN_MEND and pi[TRAIL] == 0):
         act[A_TRAIL_OP] = TRAIL_PAINT
         act[A_TRAIL_ID] = mem[M_TRAIL]
+    if mode == RETURN_MEND:
+        # Down the trail while it descends; every step lowers the mark, so the trip ends.
+        d = extreme_dir_among(pi, TRAIL, mem[M_TRAIL], -1, seed, agent, tick, 6, False)
+        if d >= 0 and pi[MARK + 1 + d] < act[A_MARK]:
+            act[A_MOVE] = d
+            mem[M_PREV] = opposite(d)
+            return
     act[A_MOVE] = descent_dir(pi, seed, agent, tick, 1)
     if act[A_MOVE] < N_DIRS:
         mem[M_PREV] = opposite(act[A_MOVE])

@@ -81,7 +81,8 @@ RETURN = 1  # plain descent to the base
 RETURN_COLOUR = 2
 RETURN_REMOVE = 3
 ERASE = 4  # wiping a trail fragment that leads nowhere (not carrying)
-MODE_NAMES = ("searching", "returning", "colouring", "removing", "erasing")
+RETURN_MEND = 5  # home along an existing trail, colouring its gaps
+MODE_NAMES = ("searching", "returning", "colouring", "removing", "erasing", "mending")
 
 
 def new_perception() -> tuple[np.ndarray, np.ndarray]:
