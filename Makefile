@@ -29,10 +29,10 @@ lint: install
 	$(BIN)/ruff format --check .
 
 experiments: install
-	$(BIN)/swarm experiment table1 --reps 100
-	$(BIN)/swarm experiment table2 --reps 1000
-	$(BIN)/swarm experiment table3 --reps 20
-	$(BIN)/swarm experiment ants --reps 10
+	$(BIN)/swarm experiment table1 --reps 1000
+	$(BIN)/swarm experiment table2 --reps 5000
+	$(BIN)/swarm experiment table3 --reps 50
+	$(BIN)/swarm experiment ants --reps 20
 
 bench: install
 	$(BIN)/swarm bench engine
