@@ -57,7 +57,7 @@ def run_ticks(
     for t in range(n_ticks):
         tick = tick0 + t
         for a in range(n):
-            perceive(layers, pher, base_r, base_c, pos[a, 0], pos[a, 1], payload[a], pi, pf)
+            perceive(layers, pher, pher_on, base_r, base_c, pos[a, 0], pos[a, 1], payload[a], pi, pf)
             step_controller(kind, pi, pf, mem[a], acts[a], cparams, seed, a, tick)
         resolve_tick(layers, pher, pher_scratch, base_r, base_c, pos, payload, acts, tick, wparams, counters, pher_on)
         if is_done(until, counters, total, reachable):

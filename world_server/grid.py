@@ -73,8 +73,9 @@ N_WPARAMS = 4
 
 
 @njit(cache=True, inline="always")
-def perceive(layers, pher, base_r, base_c, r, c, payload, pi, pf):
-    """Fill the perception of an agent at (r, c): its cell and 4 neighbours."""
+def perceive(layers, pher, pher_on, base_r, base_c, r, c, payload, pi, pf):
+    """Fill the perception of an agent at (r, c): its cell and 4 neighbours
+    (pheromone only when pher_on: no other controller smells it)."""
     h = layers.shape[1]
     w = layers.shape[2]
     for k in range(5):
@@ -94,7 +95,7 @@ def perceive(layers, pher, base_r, base_c, r, c, payload, pi, pf):
             pi[MARK + k] = layers[L_MARK, rr, cc]
             pi[TRAIL + k] = layers[L_TRAIL, rr, cc]
             pi[RES + k] = 1 if layers[L_RES, rr, cc] > 0 else 0
-            pf[PHER + k] = pher[rr, cc]
+            pf[PHER + k] = pher[rr, cc] if pher_on else 0.0
     pi[AT_BASE] = 1 if (r == base_r and c == base_c) else 0
     pi[COMPASS_DR] = (base_r > r) - (base_r < r)
     pi[COMPASS_DC] = (base_c > c) - (base_c < c)
@@ -225,7 +226,9 @@ class GridWorld:
 
     def perceive(self, agent: int, pi: np.ndarray, pf: np.ndarray) -> None:
         r, c = self.pos[agent]
-        perceive(self.layers, self.pher, self.base[0], self.base[1], r, c, self.payload[agent], pi, pf)
+        perceive(
+            self.layers, self.pher, self.pheromone_on, self.base[0], self.base[1], r, c, self.payload[agent], pi, pf
+        )
 
     def resolve(self, tick: int) -> None:
         """Apply the actions in `acts` for `tick` (agent-id order), then spread pheromone."""
