@@ -85,8 +85,56 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument("--quick", action="store_true", help="shorter measurement")
 
+    world = sub.add_parser(
+        "world",
+        help="serve a scenario's world over zenoh (the world process)",
+        description="Host (or join) a zenoh router and run the world in lock-step for agent processes.",
+    )
+    _scenario_args(world)
+    world.add_argument("--run-id", default="default", help="key space swarm/<run-id>/... (default: default)")
+    where = world.add_mutually_exclusive_group()
+    where.add_argument("--listen", default="tcp/127.0.0.1:7447", metavar="ENDPOINT",
+                       help="host a router listening here (default tcp/127.0.0.1:7447)")  # fmt: skip
+    where.add_argument("--connect", metavar="ENDPOINT", help="join an existing router instead")
+    world.add_argument("--deadline", type=float, default=2.0, metavar="S", help="per-tick deadline in seconds")
+    world.add_argument("--max-misses", type=_positive, default=3, metavar="K",
+                       help="an agent that misses K ticks in a row is lost (default 3)")  # fmt: skip
+    world.add_argument("--summary-file", metavar="FILE", help="also write the summary JSON here")
+
+    agent = sub.add_parser(
+        "agent",
+        help="run agent process(es) that join a world",
+        description="Join a world over zenoh and run one controller (or K with --count).",
+    )
+    agent.add_argument("--controller", choices=["cmarking", "marking", "ant"], default="cmarking")
+    agent.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
+    agent.add_argument("--run-id", default="default", help="the world's run id (default: default)")
+    agent.add_argument("--count", type=_positive, default=1, metavar="K", help="independent agents in this process")
+
+    up = sub.add_parser(
+        "up",
+        help="launch a world and N agent processes, and follow the run",
+        description="Start the world (with its embedded router) and N agent processes as separate OS "
+        "processes, show progress, and print the run summary.",
+    )
+    _scenario_args(up)
+    up.add_argument("--mode", choices=["lockstep"], default="lockstep", help="tick mode (lockstep)")
+    up.add_argument("--run-id", help="key space swarm/<run-id>/... (default: a fresh id)")
+    up.add_argument("--listen", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router's endpoint")
+    up.add_argument("--deadline", type=float, default=2.0, metavar="S", help="per-tick deadline in seconds")
+
     sub.add_parser("scenarios", help="list presets and bundled scenarios")
     return parser
+
+
+def _scenario_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scenario", metavar="SCENARIO", help=f"a TOML file, a preset ({PRESET_HELP}) or a bundled name")
+    p.add_argument("--agents", type=_positive, help="number of agents (default: the scenario's)")
+    p.add_argument("--controller", choices=["cmarking", "marking", "ant"], help="controller to run")
+    p.add_argument("--seed", type=_seed, help="seed of the map and of every random choice")
+    p.add_argument("--until", choices=["foraged", "converged", "both"], default="foraged", help="when the run ends")
+    p.add_argument("--max-iterations", type=_positive, default=1_000_000, metavar="M", help="stop after M ticks")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -100,9 +148,72 @@ def main(argv: list[str] | None = None) -> int:
     except ScenarioError as exc:
         print(f"swarm: error: {exc}", file=sys.stderr)
         return 2
+    except (ConnectionError, TimeoutError) as exc:
+        print(f"swarm: error: {exc}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("swarm: interrupted", file=sys.stderr)
         return 130
+
+
+def _print_summary(summary: dict, as_json: bool, until: str) -> int:
+    if as_json:
+        print(json.dumps(summary))
+    else:
+        state = "finished" if summary["finished"] else f"NOT finished ({until})"
+        print(
+            f"{summary['scenario']}: {summary['controller']} x{summary['agents']}, seed {summary['seed']}: "
+            f"{state} after {summary['iterations']} iterations\n"
+            f"  delivered {summary['delivered']}/{summary['total']}, explored "
+            f"{summary['explored_cells']}/{summary['reachable_cells']} cells, optimal marks "
+            f"{summary['optimal_cells']}/{summary['reachable_cells']} (APF optimal: {summary['apf_optimal']})"
+        )
+        if "rejected_messages" in summary:
+            print(
+                f"  {summary['ticks_per_second']} ticks/s, rejected messages {summary['rejected_messages']}, "
+                f"agents lost {summary['agents_lost']}"
+            )
+    return 0 if summary["finished"] else 1
+
+
+def _scenario(args):
+    return load_scenario(args.scenario).with_overrides(agents=args.agents, controller=args.controller, seed=args.seed)
+
+
+def cmd_world(args) -> int:
+    from world_server.server import serve
+
+    scenario = _scenario(args)
+    if args.until != "foraged" and scenario.controller == "ant":
+        raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
+    summary = serve(scenario, args.run_id, args.summary_file, listen=None if args.connect else args.listen,
+                    connect=args.connect, deadline=args.deadline, max_misses=args.max_misses, until=args.until,
+                    max_iterations=args.max_iterations)  # fmt: skip
+    return _print_summary(summary, args.json, args.until)
+
+
+def cmd_agent(args) -> int:
+    from agents.runtime import AgentRuntime
+
+    runtime = AgentRuntime(args.run_id, args.controller, args.connect, args.count)
+    try:
+        runtime.run()
+    finally:
+        runtime.close()
+    return 0
+
+
+def cmd_up(args) -> int:
+    from swarm.launcher import swarm_up
+    from world_server.server import new_run_id
+
+    scenario = _scenario(args)
+    if args.until != "foraged" and scenario.controller == "ant":
+        raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
+    summary = swarm_up(args.scenario, scenario.agents, scenario.controller, args.seed, args.run_id or new_run_id(),
+                       args.listen, args.until, args.max_iterations, args.deadline,
+                       progress=not args.json and sys.stderr.isatty())  # fmt: skip
+    return _print_summary(summary, args.json, args.until)
 
 
 def cmd_run(args) -> int:
@@ -113,18 +224,7 @@ def cmd_run(args) -> int:
     )
     engine = Engine(scenario)
     summary = engine.run(args.until, args.max_iterations, progress=not args.json and sys.stderr.isatty()).summary
-    if args.json:
-        print(json.dumps(summary))
-    else:
-        state = "finished" if summary["finished"] else f"NOT finished ({args.until})"
-        print(
-            f"{summary['scenario']}: {summary['controller']} x{summary['agents']}, seed {summary['seed']}: "
-            f"{state} after {summary['iterations']} iterations\n"
-            f"  delivered {summary['delivered']}/{summary['total']}, explored "
-            f"{summary['explored_cells']}/{summary['reachable_cells']} cells, optimal marks "
-            f"{summary['optimal_cells']}/{summary['reachable_cells']} (APF optimal: {summary['apf_optimal']})"
-        )
-    return 0 if summary["finished"] else 1
+    return _print_summary(summary, args.json, args.until)
 
 
 def cmd_experiment(args) -> int:
@@ -150,7 +250,8 @@ def cmd_scenarios(args) -> int:
     return 0
 
 
-COMMANDS = {"run": cmd_run, "experiment": cmd_experiment, "bench": cmd_bench, "scenarios": cmd_scenarios}
+COMMANDS = {"run": cmd_run, "experiment": cmd_experiment, "bench": cmd_bench, "scenarios": cmd_scenarios,
+            "world": cmd_world, "agent": cmd_agent, "up": cmd_up}  # fmt: skip
 
 
 if __name__ == "__main__":

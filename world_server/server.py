@@ -1,0 +1,364 @@
+"""The world process: the authoritative grid served over zenoh, ticked in lock-step.
+
+Every zenoh callback only enqueues; one thread (`run`) owns the world.  A tick:
+publish every active agent's observation, gather their actions and mark writes
+until all have answered or the deadline passes (a late agent does nothing that
+tick; after `max_misses` misses in a row it is lost and its slot is free for a
+new agent), then resolve the tick with the same `GridWorld.resolve` as the
+in-process engine.  Lost agents' bodies stay where they were, with their load,
+until a new agent takes the slot over (its controller then sees a payload and
+carries it home).
+"""
+
+from __future__ import annotations
+
+import json
+import queue
+import time
+import uuid
+from dataclasses import dataclass, field
+
+import numpy as np
+import zenoh
+
+from agents.controllers import controller_params
+from agents.controllers.layout import (
+    A_DEPOSIT,
+    A_LOAD,
+    A_MARK,
+    A_MOVE,
+    A_TRAIL_ID,
+    A_TRAIL_OP,
+    A_UNLOAD,
+    MARK_NONE,
+    STAY,
+    TRAIL_ERASE,
+    new_perception,
+)  # fmt: skip
+from swarm import protocol as proto
+from swarm.bus import open_client, open_router
+from swarm.engine import UNTIL, is_done
+from swarm.scenario import Scenario
+from world_server.grid import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, L_OBST, GridWorld, write_mark
+
+FREE, ACTIVE, LOST = 0, 1, 2
+
+
+@dataclass
+class Stats:
+    rejected: dict[str, int] = field(default_factory=dict)
+    agents_lost: int = 0
+    joins: int = 0
+    late_actions: int = 0
+
+    def reject(self, reason: str) -> None:
+        self.rejected[reason] = self.rejected.get(reason, 0) + 1
+
+    @property
+    def rejected_total(self) -> int:
+        return sum(self.rejected.values())
+
+
+class WorldServer:
+    def __init__(
+        self, scenario: Scenario, run_id: str, listen: str | None = None, connect: str | None = None,
+        deadline: float = 2.0, max_misses: int = 3, expect: int | None = None, start_timeout: float = 60.0,
+        until: str = "foraged", max_iterations: int = 1_000_000,
+    ):  # fmt: skip
+        self.scenario = scenario
+        self.keys = proto.Keys(run_id)
+        self.world = GridWorld(scenario)
+        self.cparams = controller_params(scenario)
+        self.deadline = deadline
+        self.max_misses = max_misses
+        self.expect = scenario.agents if expect is None else expect
+        self.start_timeout = start_timeout
+        self.until = until
+        self.max_iterations = max_iterations
+        self.slots = np.full(scenario.agents, FREE, dtype=np.int64)
+        self.misses = np.zeros(scenario.agents, dtype=np.int64)
+        self.acted = np.zeros(scenario.agents, dtype=bool)  # action received this tick
+        self.mark_due = np.zeros(scenario.agents, dtype=bool)  # its action announced a mark write
+        self.mark_got = np.zeros(scenario.agents, dtype=bool)  # that mark write arrived
+        self.nonces: dict[str, int] = {}
+        self.stats = Stats()
+        self.tick = 0
+        self.events: queue.Queue = queue.Queue()
+        self.started = 0.0
+        self.session = open_client(connect) if connect else open_router(listen or "tcp/127.0.0.1:7447")
+        put = self.events.put
+        k = self.keys
+        self._decls = [
+            self.session.declare_queryable(k.join, lambda q: put(("join", q))),
+            self.session.declare_queryable(k.info, lambda q: put(("info", q))),
+            self.session.declare_queryable(k.marks, lambda q: put(("marks?", q))),
+            self.session.declare_subscriber(k.acts, lambda s: put(("act", s))),
+            self.session.declare_subscriber(k.marks, lambda s: put(("mark", s))),
+            self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s))),
+        ]
+        self._pi, self._pf = new_perception()
+
+    # ---------------------------------------------------------------- messages
+
+    def _handle(self, kind: str, item) -> None:
+        if kind == "act":
+            self._on_act(item)
+        elif kind == "mark":
+            self._on_mark(item)
+        elif kind == "join":
+            self._on_join(item)
+        elif kind == "info":
+            self._reply(item, self.keys.info, proto.pack({"type": "info", **self.summary()}))
+        elif kind == "marks?":
+            self._on_marks_query(item)
+        elif kind == "alive":
+            self._on_alive(item)
+
+    def _reply(self, query, key: str, payload: bytes) -> None:
+        try:
+            query.reply(key, payload)
+        finally:
+            query.drop()
+
+    def _on_join(self, query) -> None:
+        raw = query.payload.to_bytes() if query.payload is not None else b""
+        request = proto.parse_join(raw)
+        if isinstance(request, proto.Rejected):
+            self.stats.reject(f"join: {request.reason}")
+            self._reply(query, self.keys.join, proto.refuse_reply(request.reason))
+            return
+        if request.get("controller") != self.scenario.controller:
+            reason = f"this run uses controller {self.scenario.controller!r}, not {request.get('controller')!r}"
+            self._reply(query, self.keys.join, proto.refuse_reply(reason))
+            return
+        nonce = request["nonce"]
+        agent = self.nonces.get(nonce)  # a retried join gets the same id
+        if agent is None:
+            free = np.flatnonzero(self.slots != ACTIVE)
+            if len(free) == 0:
+                self._reply(query, self.keys.join, proto.refuse_reply("the swarm is full"))
+                return
+            agent = int(free[0])
+            self.nonces[nonce] = agent
+            self.slots[agent] = ACTIVE
+            self.misses[agent] = 0
+            self.stats.joins += 1
+        info = {"run": self.keys.run, "seed": self.scenario.seed, "controller": self.scenario.controller,
+                "params": self.cparams.tolist(), "tick": self.tick}  # fmt: skip
+        self._reply(query, self.keys.join, proto.join_reply(agent, nonce, info))
+
+    def _on_alive(self, sample) -> None:
+        if sample.kind != zenoh.SampleKind.DELETE:
+            return
+        try:
+            agent = int(str(sample.key_expr).rsplit("/", 1)[1])
+        except ValueError:
+            return
+        if 0 <= agent < len(self.slots) and self.slots[agent] == ACTIVE:
+            self._lose(agent)
+
+    def _lose(self, agent: int) -> None:
+        self.slots[agent] = LOST
+        self.stats.agents_lost += 1
+        for nonce, a in list(self.nonces.items()):
+            if a == agent:
+                del self.nonces[nonce]
+
+    def _sender(self, sample) -> int | None:
+        try:
+            return int(str(sample.key_expr).rsplit("/", 1)[1])
+        except ValueError:
+            return None
+
+    def _on_act(self, sample) -> None:
+        msg = proto.parse_act(sample.payload.to_bytes())
+        if isinstance(msg, proto.Rejected):
+            self.stats.reject(f"act: {msg.reason}")
+            return
+        a = msg.agent
+        if self._sender(sample) != a:
+            self.stats.reject("act: names another agent's id")
+        elif not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
+            self.stats.reject("act: unknown agent")
+        elif msg.tick != self.tick:
+            self.stats.late_actions += 1
+            self.stats.reject("act: not for this tick")
+        elif self.acted[a]:
+            self.stats.reject("act: second action in one tick")
+        elif not _valid_action(msg.act):
+            self.stats.reject("act: out-of-range action")
+        else:
+            act = self.world.acts[a]
+            act[:] = msg.act
+            act[A_MARK] = MARK_NONE  # marks travel on the marks key space
+            self.acted[a] = True
+            self.mark_due[a] = msg.marked
+
+    def _on_mark(self, sample) -> None:
+        msg = proto.parse_mark(sample.payload.to_bytes())
+        if isinstance(msg, proto.Rejected):
+            self.stats.reject(f"mark: {msg.reason}")
+            return
+        a, w = msg.agent, self.world
+        cell = self._sender(sample)
+        width = w.layers.shape[2]
+        if not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
+            self.stats.reject("mark: unknown agent")
+        elif msg.tick != self.tick or self.mark_got[a] or (self.acted[a] and not self.mark_due[a]):
+            self.stats.reject("mark: not for this tick")
+        elif cell is None or cell != w.pos[a, 0] * width + w.pos[a, 1]:
+            self.stats.reject("mark: not the agent's cell")
+        elif msg.value < _update_bound(w.layers, int(w.pos[a, 0]), int(w.pos[a, 1])):
+            self.stats.reject("mark: lower than UPDATE-VALUE allows")
+        else:
+            write_mark(w.layers, int(w.pos[a, 0]), int(w.pos[a, 1]), np.int64(msg.value), w.counters)
+            self.mark_got[a] = True
+
+    def _on_marks_query(self, query) -> None:
+        marks = self.world.layers[L_MARK]
+        grid = np.where(marks == MARK_NONE, -1, marks)
+        payload = proto.pack({"type": "marks", "tick": self.tick, "height": int(grid.shape[0]),
+                              "width": int(grid.shape[1]), "marks": grid.ravel().tolist(),
+                              "trails": self.world.trails.ravel().tolist()})  # fmt: skip
+        self._reply(query, f"{self.keys.prefix}/marks/grid", payload)
+
+    def _drain(self, timeout: float) -> bool:
+        """Handle queued events; wait up to `timeout` for the first one."""
+        try:
+            kind, item = self.events.get(timeout=timeout)
+        except queue.Empty:
+            return False
+        self._handle(kind, item)
+        while True:
+            try:
+                kind, item = self.events.get_nowait()
+            except queue.Empty:
+                return True
+            self._handle(kind, item)
+
+    # ------------------------------------------------------------------ ticks
+
+    def wait_for_agents(self) -> None:
+        deadline = time.monotonic() + self.start_timeout
+        while int((self.slots == ACTIVE).sum()) < self.expect:
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"only {int((self.slots == ACTIVE).sum())} of {self.expect} agents joined")
+            self._drain(0.05)
+
+    def step(self) -> None:
+        w = self.world
+        tick = self.tick
+        active = np.flatnonzero(self.slots == ACTIVE)
+        self.acted[:] = False
+        self.mark_due[:] = False
+        self.mark_got[:] = False
+        w.acts[:, A_MOVE] = STAY
+        w.acts[:, A_MARK] = MARK_NONE
+        w.acts[:, A_TRAIL_OP:] = 0
+        width = w.layers.shape[2]
+        for a in active:
+            w.perceive(int(a), self._pi, self._pf)
+            cell = int(w.pos[a, 0] * width + w.pos[a, 1])
+            self.session.put(self.keys.obs(int(a)), proto.observation(tick, int(a), cell, self._pi, self._pf))
+        deadline = time.monotonic() + self.deadline
+        while not self.answered(active).all():
+            left = deadline - time.monotonic()
+            if left <= 0:
+                break
+            self._drain(left)
+        answered = self.answered(active)
+        for a, ok in zip(active, answered, strict=True):
+            if ok:
+                self.misses[a] = 0
+            elif self.slots[a] == ACTIVE:
+                self.misses[a] += 1
+                w.acts[a, A_MOVE] = STAY
+                w.acts[a, A_TRAIL_OP:] = 0
+                if self.misses[a] >= self.max_misses:
+                    self._lose(int(a))
+        w.resolve(tick)
+        self.tick += 1
+        self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress()}))
+
+    def answered(self, agents: np.ndarray) -> np.ndarray:
+        return self.acted[agents] & (~self.mark_due[agents] | self.mark_got[agents])
+
+    def done(self) -> bool:
+        w = self.world
+        return bool(is_done(UNTIL[self.until], w.counters, w.total, w.reachable))
+
+    def run(self) -> dict:
+        self.wait_for_agents()
+        self.started = time.monotonic()
+        while not self.done() and self.tick < self.max_iterations:
+            self.step()
+        self._drain(0.0)
+        return self.summary()
+
+    def progress(self) -> dict:
+        w = self.world
+        elapsed = time.monotonic() - self.started if self.started else 0.0
+        return {"tick": self.tick, "delivered": w.delivered, "total": w.total,
+                "agents_alive": int((self.slots == ACTIVE).sum()),
+                "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0}  # fmt: skip
+
+    def summary(self) -> dict:
+        w, s = self.world, self.scenario
+        elapsed = time.monotonic() - self.started if self.started else 0.0
+        return {
+            "scenario": s.name, "controller": s.controller, "agents": s.agents, "seed": s.seed,
+            "until": self.until, "iterations": self.tick, "finished": self.done(), "delivered": w.delivered,
+            "total": w.total, "in_transit": w.in_transit, "apf_optimal": w.apf_optimal(),
+            "optimal_cells": int(w.counters[C_OPTIMAL]), "explored_cells": int(w.counters[C_EXPLORED]),
+            "reachable_cells": w.reachable, "rejected_moves": int(w.counters[C_REJECTED]),
+            "grid": list(w.layout.shape), "run_id": self.keys.run, "mode": "lockstep",
+            "rejected_messages": self.stats.rejected_total, "rejected_by_reason": dict(self.stats.rejected),
+            "agents_lost": self.stats.agents_lost, "joins": self.stats.joins,
+            "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0,
+            "wall_seconds": round(elapsed, 3),
+        }  # fmt: skip
+
+    def stop_agents(self, reason: str) -> None:
+        for a in range(len(self.slots)):
+            self.session.put(self.keys.obs(a), proto.stop_message(reason))
+
+    def close(self) -> None:
+        for d in self._decls:
+            d.undeclare()
+        self.session.close()
+
+
+def _valid_action(act: np.ndarray) -> bool:
+    return bool(
+        0 <= act[A_MOVE] <= STAY and 0 <= act[A_TRAIL_OP] <= TRAIL_ERASE and act[A_TRAIL_ID] >= 0
+        and all(act[i] in (0, 1) for i in (A_LOAD, A_UNLOAD, A_DEPOSIT))
+    )  # fmt: skip
+
+
+def _update_bound(layers: np.ndarray, r: int, c: int) -> int:
+    """The lowest value UPDATE-VALUE can write on (r, c) now."""
+    marks, obst = layers[L_MARK], layers[L_OBST]
+    h, w = marks.shape
+    best = MARK_NONE
+    for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        nr, nc = r + dr, c + dc
+        if 0 <= nr < h and 0 <= nc < w and not obst[nr, nc]:
+            best = min(best, int(marks[nr, nc]))
+    return int(min(marks[r, c], best + 1 if best != MARK_NONE else MARK_NONE))
+
+
+def new_run_id() -> str:
+    return uuid.uuid4().hex[:8]
+
+
+def serve(scenario: Scenario, run_id: str, summary_file: str | None = None, **kw) -> dict:
+    server = WorldServer(scenario, run_id, **kw)
+    try:
+        summary = server.run()
+        server.stop_agents("finished" if summary["finished"] else "stopped")
+    finally:
+        server.close()
+    if summary_file:
+        with open(summary_file, "w") as f:
+            json.dump(summary, f)
+    return summary
