@@ -63,6 +63,7 @@ class AgentRuntime:
                     self.params = np.array(msg["params"], dtype=np.float64)
                     self.agents.append(agent)
                     put = self.inbox.put
+                    # Subscriber first: the world starts observing us when it sees the token.
                     self._decls.append(self.session.declare_subscriber(self.keys.obs(agent), put))
                     self._decls.append(self.session.liveliness().declare_token(self.keys.alive(agent)))
                     return

@@ -100,6 +100,8 @@ def build_parser() -> argparse.ArgumentParser:
     world.add_argument("--max-misses", type=_positive, default=3, metavar="K",
                        help="an agent that misses K ticks in a row is lost (default 3)")  # fmt: skip
     world.add_argument("--summary-file", metavar="FILE", help="also write the summary JSON here")
+    world.add_argument("--linger", type=float, default=0.0, metavar="S",
+                       help="keep serving swarm/<run-id>/marks/** for S seconds after the run")  # fmt: skip
 
     agent = sub.add_parser(
         "agent",
@@ -188,7 +190,7 @@ def cmd_world(args) -> int:
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
     summary = serve(scenario, args.run_id, args.summary_file, listen=None if args.connect else args.listen,
                     connect=args.connect, deadline=args.deadline, max_misses=args.max_misses, until=args.until,
-                    max_iterations=args.max_iterations)  # fmt: skip
+                    max_iterations=args.max_iterations, linger=args.linger)  # fmt: skip
     return _print_summary(summary, args.json, args.until)
 
 

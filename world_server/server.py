@@ -41,7 +41,9 @@ from swarm.engine import UNTIL, is_done
 from swarm.scenario import Scenario
 from world_server.grid import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, L_OBST, GridWorld, write_mark
 
-FREE, ACTIVE, LOST = 0, 1, 2
+# JOINING: welcomed, but its observation subscriber may not be routed yet; it is
+# ACTIVE once its liveliness token arrives (declared after the subscriber).
+FREE, JOINING, ACTIVE, LOST = 0, 1, 2, 3
 
 
 @dataclass
@@ -50,6 +52,7 @@ class Stats:
     agents_lost: int = 0
     joins: int = 0
     late_actions: int = 0
+    missed_ticks: int = 0
 
     def reject(self, reason: str) -> None:
         self.rejected[reason] = self.rejected.get(reason, 0) + 1
@@ -134,13 +137,13 @@ class WorldServer:
         nonce = request["nonce"]
         agent = self.nonces.get(nonce)  # a retried join gets the same id
         if agent is None:
-            free = np.flatnonzero(self.slots != ACTIVE)
+            free = np.flatnonzero((self.slots == FREE) | (self.slots == LOST))
             if len(free) == 0:
                 self._reply(query, self.keys.join, proto.refuse_reply("the swarm is full"))
                 return
             agent = int(free[0])
             self.nonces[nonce] = agent
-            self.slots[agent] = ACTIVE
+            self.slots[agent] = JOINING
             self.misses[agent] = 0
             self.stats.joins += 1
         info = {"run": self.keys.run, "seed": self.scenario.seed, "controller": self.scenario.controller,
@@ -148,13 +151,12 @@ class WorldServer:
         self._reply(query, self.keys.join, proto.join_reply(agent, nonce, info))
 
     def _on_alive(self, sample) -> None:
-        if sample.kind != zenoh.SampleKind.DELETE:
+        agent = self._sender(sample)
+        if agent is None or not 0 <= agent < len(self.slots):
             return
-        try:
-            agent = int(str(sample.key_expr).rsplit("/", 1)[1])
-        except ValueError:
-            return
-        if 0 <= agent < len(self.slots) and self.slots[agent] == ACTIVE:
+        if sample.kind == zenoh.SampleKind.PUT and self.slots[agent] == JOINING:
+            self.slots[agent] = ACTIVE
+        elif sample.kind == zenoh.SampleKind.DELETE and self.slots[agent] in (JOINING, ACTIVE):
             self._lose(agent)
 
     def _lose(self, agent: int) -> None:
@@ -272,6 +274,7 @@ class WorldServer:
                 self.misses[a] = 0
             elif self.slots[a] == ACTIVE:
                 self.misses[a] += 1
+                self.stats.missed_ticks += 1
                 w.acts[a, A_MOVE] = STAY
                 w.acts[a, A_TRAIL_OP:] = 0
                 if self.misses[a] >= self.max_misses:
@@ -295,6 +298,12 @@ class WorldServer:
         self._drain(0.0)
         return self.summary()
 
+    def linger(self, until) -> None:
+        """Keep serving the key space (marks, info) after the run until
+        `until()` is true: clients can still read the final marking environment."""
+        while not until():
+            self._drain(0.1)
+
     def progress(self) -> dict:
         w = self.world
         elapsed = time.monotonic() - self.started if self.started else 0.0
@@ -313,7 +322,7 @@ class WorldServer:
             "reachable_cells": w.reachable, "rejected_moves": int(w.counters[C_REJECTED]),
             "grid": list(w.layout.shape), "run_id": self.keys.run, "mode": "lockstep",
             "rejected_messages": self.stats.rejected_total, "rejected_by_reason": dict(self.stats.rejected),
-            "agents_lost": self.stats.agents_lost, "joins": self.stats.joins,
+            "agents_lost": self.stats.agents_lost, "joins": self.stats.joins, "missed_ticks": self.stats.missed_ticks,
             "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0,
             "wall_seconds": round(elapsed, 3),
         }  # fmt: skip
@@ -351,14 +360,16 @@ def new_run_id() -> str:
     return uuid.uuid4().hex[:8]
 
 
-def serve(scenario: Scenario, run_id: str, summary_file: str | None = None, **kw) -> dict:
+def serve(scenario: Scenario, run_id: str, summary_file: str | None = None, linger: float = 0.0, **kw) -> dict:
     server = WorldServer(scenario, run_id, **kw)
     try:
         summary = server.run()
         server.stop_agents("finished" if summary["finished"] else "stopped")
+        if summary_file:
+            with open(summary_file, "w") as f:
+                json.dump(summary, f)
+        end = time.monotonic() + linger
+        server.linger(lambda: time.monotonic() >= end)
     finally:
         server.close()
-    if summary_file:
-        with open(summary_file, "w") as f:
-            json.dump(summary, f)
     return summary

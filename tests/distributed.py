@@ -1,0 +1,72 @@
+"""Helpers for multi-process tests: a world server in a thread, real agent
+processes, free loopback ports, and cleanup of everything started."""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+import subprocess
+import sys
+import threading
+
+from world_server.server import WorldServer
+
+
+def free_endpoint() -> str:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return f"tcp/127.0.0.1:{s.getsockname()[1]}"
+
+
+def start_agents(endpoint: str, run_id: str, controller: str, n: int, count: int = 1) -> list[subprocess.Popen]:
+    cmd = [sys.executable, "-m", "swarm", "agent", "--connect", endpoint, "--run-id", run_id,
+           "--controller", controller, "--count", str(count)]  # fmt: skip
+    return [subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for _ in range(n)]
+
+
+def stop(procs: list[subprocess.Popen]) -> None:
+    for p in procs:
+        if p.poll() is None:
+            p.kill()
+    for p in procs:
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            p.wait(timeout=10)
+
+
+class ServerThread:
+    """A WorldServer running in a background thread of the test process."""
+
+    def __init__(self, scenario, run_id: str, endpoint: str, **kw):
+        self.server = WorldServer(scenario, run_id, listen=endpoint, **kw)
+        self.summary: dict | None = None
+        self.error: BaseException | None = None
+        self.finished = threading.Event()
+        self.closing = threading.Event()
+        self.thread = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self) -> None:
+        try:
+            self.summary = self.server.run()
+            self.server.stop_agents("finished")
+        except BaseException as exc:  # reported by join()
+            self.error = exc
+        self.finished.set()
+        if self.error is None:
+            self.server.linger(self.closing.is_set)
+
+    def start(self) -> ServerThread:
+        self.thread.start()
+        return self
+
+    def join(self, timeout: float) -> dict:
+        if not self.finished.wait(timeout):
+            raise TimeoutError("the world did not finish in time")
+        if self.error:
+            raise self.error
+        assert self.summary is not None
+        return self.summary
+
+    def close(self) -> None:
+        self.closing.set()
+        self.thread.join(10)
+        self.server.close()

@@ -1,0 +1,102 @@
+"""The distributed runtime: a real zenoh router, real agent processes.
+
+Lock-step runs must equal the in-process engine bit for bit, and bad traffic
+must be counted and rejected without touching the world."""
+
+import numpy as np
+import pytest
+
+from swarm import protocol as proto
+from swarm.bus import open_client
+from swarm.engine import Engine
+from swarm.scenario import load_scenario
+from tests.distributed import ServerThread, free_endpoint, start_agents, stop
+from world_server.grid import L_MARK
+
+
+def _run_distributed(scenario, run_id, count=1, attack=None):
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, run_id, endpoint, deadline=10.0).start()
+    n_procs = scenario.agents // count
+    procs = start_agents(endpoint, run_id, scenario.controller, n_procs, count)
+    try:
+        if attack is not None:
+            attack(endpoint, proto.Keys(run_id))
+        summary = world.join(timeout=240)
+        for p in procs:
+            p.wait(timeout=30)
+            assert p.returncode == 0, p.stderr.read().decode()[-2000:]
+        return summary, world.server.world
+    finally:
+        stop(procs)
+        world.close()
+
+
+@pytest.mark.parametrize(
+    ("ref", "controller", "agents", "seed"),
+    [("setup2", "cmarking", 3, 12), ("setup2", "marking", 2, 5), ("maze", "cmarking", 4, 2),
+     ("setup3-12", "cmarking", 6, 8)],
+)  # fmt: skip
+def test_lockstep_equals_the_in_process_engine(ref, controller, agents, seed):
+    scenario = load_scenario(ref).with_overrides(agents=agents, controller=controller, seed=seed)
+    engine = Engine(scenario)
+    expected = engine.run().summary
+    summary, world = _run_distributed(scenario, f"eq-{ref}-{seed}", count=2 if agents % 2 == 0 else 1)
+    for key in ("iterations", "delivered", "total", "finished", "explored_cells", "optimal_cells"):
+        assert summary[key] == expected[key], key
+    np.testing.assert_array_equal(world.layers, engine.world.layers)
+    np.testing.assert_array_equal(world.pos, engine.world.pos)
+    assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
+
+
+def test_bad_traffic_is_counted_and_changes_nothing():
+    scenario = load_scenario("setup2").with_overrides(agents=2, seed=21)
+    engine = Engine(scenario)
+    expected = engine.run().summary
+
+    def attack(endpoint, keys):
+        s = open_client(endpoint)
+        try:
+            s.put(keys.act(0), b"\x00\xffgarbage")  # not msgpack
+            s.put(keys.act(0), proto.pack({"type": "act", "tick": "soon"}))  # wrong schema
+            s.put(keys.act(1), proto.action(0, 0, np.zeros(7, np.int64), False))  # another agent's id
+            s.put(keys.act(0), proto.action(0, 0, np.array([9, 0, 0, 0, 0, 0, 0]), False))  # out of range
+            s.put(keys.act(0), proto.pack({"type": "act", "family": "grid", "tick": float("nan"), "agent": 0,
+                                           "act": [4] * 7, "marked": False}))  # fmt: skip
+            s.put(keys.act(0), proto.pack({"type": "act", "family": "grid", "tick": 0, "agent": 2**64 - 1,
+                                           "act": [4] * 7, "marked": False}))  # fmt: skip
+            s.put(keys.mark(0), proto.mark_write(0, 0, 0))  # a mark far below what UPDATE-VALUE allows
+            s.put(keys.act(0), proto.pack({"type": "act", "family": "bees", "tick": 0, "agent": 0,
+                                           "act": [4] * 7, "marked": False}))  # fmt: skip
+            for _ in range(300):  # a flood
+                s.put(keys.act(5), b"\x93\x01\x02")
+            replies = list(s.get(keys.marks, timeout=5.0))
+            assert replies and replies[0].ok is not None
+        finally:
+            s.close()
+
+    summary, world = _run_distributed(scenario, "attack", attack=attack)
+    assert summary["rejected_messages"] >= 300
+    assert summary["iterations"] == expected["iterations"]
+    np.testing.assert_array_equal(world.layers[L_MARK], engine.world.layers[L_MARK])
+
+
+def test_the_marks_key_space_can_be_read_by_any_client():
+    scenario = load_scenario("maze").with_overrides(agents=2, seed=3, controller="marking")
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "keyspace", endpoint, deadline=10.0).start()
+    procs = start_agents(endpoint, "keyspace", "marking", 2)
+    try:
+        world.join(timeout=240)
+        s = open_client(endpoint)
+        try:
+            reply = next(iter(s.get("swarm/keyspace/marks/**", timeout=5.0))).ok
+            msg = proto.unpack(reply.payload.to_bytes())
+        finally:
+            s.close()
+        marks = np.array(msg["marks"]).reshape(msg["height"], msg["width"])
+        truth = world.server.world.layers[L_MARK]
+        np.testing.assert_array_equal(marks, np.where(truth > 2**61, -1, truth))
+    finally:
+        stop(procs)
+        world.close()
