@@ -18,7 +18,7 @@ $(STAMP): pyproject.toml
 	@touch $(STAMP)
 
 demo: install
-	$(BIN)/swarm run setup1 --agents 20 --seed 1
+	$(BIN)/swarm up setup1 --agents 20 --seed 1
 
 test: install
 	$(BIN)/ruff check .

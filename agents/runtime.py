@@ -15,7 +15,7 @@ import uuid
 
 import numpy as np
 
-from agents.controllers import controller_kind, step_controller
+from agents.controllers import controller_kind, step_controller, warm_up
 from agents.controllers.layout import A_MARK, MARK, MARK_NONE, new_action, new_memory
 from swarm import protocol as proto
 from swarm.bus import DEFAULT_ENDPOINT, open_client
@@ -31,6 +31,7 @@ class AgentRuntime:
         self.keys = proto.Keys(run_id)
         self.controller = controller
         self.kind = controller_kind(controller)
+        warm_up()  # before joining: the world starts observing us as soon as we join
         self.idle_timeout = idle_timeout
         self.inbox: queue.Queue = queue.Queue()
         self.session = open_client(connect, timeout=join_timeout)

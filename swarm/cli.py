@@ -173,7 +173,7 @@ def _print_summary(summary: dict, as_json: bool, until: str) -> int:
         if "rejected_messages" in summary:
             print(
                 f"  {summary['ticks_per_second']} ticks/s, rejected messages {summary['rejected_messages']}, "
-                f"agents lost {summary['agents_lost']}"
+                f"agents lost {summary['agents_lost']}, missed ticks {summary['missed_ticks']}"
             )
     return 0 if summary["finished"] else 1
 

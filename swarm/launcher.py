@@ -18,20 +18,9 @@ import tempfile
 import time
 from pathlib import Path
 
+from agents.controllers import warm_up
 from swarm import protocol as proto
 from swarm.bus import open_client
-
-
-def _warm_kernels() -> None:
-    """Compile (or load) the controller kernel once here, so N agents starting
-    together read it from the cache instead of compiling N times."""
-    import numpy as np
-
-    from agents.controllers import step_controller
-    from agents.controllers.layout import new_action, new_memory, new_perception
-
-    pi, pf = new_perception()
-    step_controller(0, pi, pf, new_memory(1)[0], new_action(), np.zeros(4), np.int64(0), 0, 0)
 
 
 def _terminate(procs: list[subprocess.Popen], grace: float = 5.0) -> None:
@@ -51,7 +40,7 @@ def swarm_up(
     scenario_ref: str, agents: int, controller: str, seed: int | None, run_id: str, listen: str,
     until: str = "foraged", max_iterations: int = 1_000_000, deadline: float = 2.0, progress: bool = True,
 ) -> dict:  # fmt: skip
-    _warm_kernels()
+    warm_up()  # once here, so N agents starting together find it in the cache
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
         summary_file = Path(tmp) / "summary.json"

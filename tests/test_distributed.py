@@ -100,3 +100,50 @@ def test_the_marks_key_space_can_be_read_by_any_client():
     finally:
         stop(procs)
         world.close()
+
+
+def test_kill_9_an_agent_then_a_fresh_one_joins_and_the_run_finishes():
+    import os
+    import signal
+    import time
+
+    scenario = load_scenario("open").with_overrides(agents=3, seed=7)
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "faults", endpoint, deadline=5.0).start()
+    procs = start_agents(endpoint, "faults", "cmarking", 3)
+    server = world.server
+    try:
+        deadline = time.monotonic() + 120
+        while server.tick < 100:
+            assert time.monotonic() < deadline, "the run did not start"
+            time.sleep(0.01)
+        os.kill(procs[0].pid, signal.SIGKILL)
+        while server.stats.agents_lost == 0:
+            assert time.monotonic() < deadline, "the killed agent was never declared lost"
+            time.sleep(0.01)
+        lost_at = server.tick
+        procs += start_agents(endpoint, "faults", "cmarking", 1)
+        summary = world.join(timeout=240)
+        assert summary["finished"] and summary["delivered"] == summary["total"]
+        assert summary["agents_lost"] == 1 and summary["joins"] == 4
+        assert summary["iterations"] > lost_at
+        assert procs[-1].wait(timeout=30) == 0  # the newcomer worked until the world said stop
+        assert procs[1].wait(timeout=30) == 0 and procs[2].wait(timeout=30) == 0
+    finally:
+        stop(procs)
+        world.close()
+
+
+def test_lost_agents_cargo_is_dropped_where_it_stood():
+    scenario = load_scenario("setup2").with_overrides(agents=2, seed=1)
+    from world_server.grid import L_RES, GridWorld
+
+    w = GridWorld(scenario)
+    w.pos[0] = (3, 4)
+    w.payload[0] = 100
+    before = int(w.layers[L_RES, 3, 4])
+    w.drop_load(0)
+    assert w.payload[0] == 0 and w.layers[L_RES, 3, 4] == before + 100
+    w.payload[1] = 60  # on the base: delivered
+    w.drop_load(1)
+    assert w.delivered == 60

@@ -235,6 +235,21 @@ class GridWorld:
         resolve_tick(self.layers, self.pher, self.pher_scratch, self.base[0], self.base[1], self.pos, self.payload,
                      self.acts, tick, self.wparams, self.counters, self.pheromone_on)  # fmt: skip
 
+    def drop_load(self, agent: int) -> None:
+        """A lost robot's cargo falls on its cell and becomes resource there
+        (on the base it counts as delivered), so the run can still finish."""
+        r, c = (int(v) for v in self.pos[agent])
+        if (r, c) == self.base:
+            self.counters[C_DELIVERED] += self.payload[agent]
+        else:
+            self.layers[L_RES, r, c] += self.payload[agent]
+        self.payload[agent] = 0
+
+    def new_body(self, agent: int) -> None:
+        """A fresh body at the base, empty-handed, for an agent taking over a slot."""
+        self.pos[agent] = self.base
+        self.payload[agent] = 0
+
     @property
     def marks(self) -> np.ndarray:
         return self.layers[L_MARK]

@@ -3,11 +3,12 @@
 Every zenoh callback only enqueues; one thread (`run`) owns the world.  A tick:
 publish every active agent's observation, gather their actions and mark writes
 until all have answered or the deadline passes (a late agent does nothing that
-tick; after `max_misses` misses in a row it is lost and its slot is free for a
-new agent), then resolve the tick with the same `GridWorld.resolve` as the
-in-process engine.  Lost agents' bodies stay where they were, with their load,
-until a new agent takes the slot over (its controller then sees a payload and
-carries it home).
+tick; after `max_misses` misses in a row, or when its liveliness token goes,
+it is lost and its slot is free for a new agent), then resolve the tick with
+the same `GridWorld.resolve` as the in-process engine.  A lost agent's body
+leaves the grid, its cargo dropped on its cell as resource (on the base: delivered), so the
+others can still finish the run; a new agent taking the slot over starts with
+a fresh body at the base.
 """
 
 from __future__ import annotations
@@ -142,6 +143,8 @@ class WorldServer:
                 self._reply(query, self.keys.join, proto.refuse_reply("the swarm is full"))
                 return
             agent = int(free[0])
+            if self.slots[agent] == LOST:
+                self.world.new_body(agent)
             self.nonces[nonce] = agent
             self.slots[agent] = JOINING
             self.misses[agent] = 0
@@ -162,6 +165,7 @@ class WorldServer:
     def _lose(self, agent: int) -> None:
         self.slots[agent] = LOST
         self.stats.agents_lost += 1
+        self.world.drop_load(agent)
         for nonce, a in list(self.nonces.items()):
             if a == agent:
                 del self.nonces[nonce]

@@ -34,6 +34,15 @@ def step_controller(kind, pi, pf, mem, act, params, seed, agent, tick):
         ant_step(pi, pf, mem, act, params, seed, agent, tick)
 
 
+def warm_up() -> None:
+    """Compile, or load from the cache, the step kernel now: an agent's first
+    observation must not wait for it (lock-step deadlines are short)."""
+    from agents.controllers.layout import new_action, new_memory, new_perception
+
+    pi, pf = new_perception()
+    step_controller(MARKING, pi, pf, new_memory(1)[0], new_action(), np.zeros(N_PARAMS), np.int64(0), 0, 0)
+
+
 def controller_kind(name: str) -> int:
     try:
         return CONTROLLERS[name]
