@@ -27,10 +27,11 @@ class JoinRefused(RuntimeError):
 
 class AgentRuntime:
     def __init__(self, run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
-                 join_timeout: float = 60.0, idle_timeout: float = 120.0):  # fmt: skip
+                 join_timeout: float = 60.0, idle_timeout: float = 120.0, null: bool = False):  # fmt: skip
         self.keys = proto.Keys(run_id)
         self.controller = controller
         self.kind = controller_kind(controller)
+        self.null = null  # benchmark floor: answer STAY without running the controller
         warm_up()  # before joining: the world starts observing us as soon as we join
         self.idle_timeout = idle_timeout
         self.inbox: queue.Queue = queue.Queue()
@@ -86,6 +87,10 @@ class AgentRuntime:
                 continue
             if isinstance(msg, proto.Rejected) or msg.agent not in self.slot_of:
                 continue
+            if self.null:
+                self.session.put(self.keys.act(msg.agent), self._null_act(msg))
+                answered += 1
+                continue
             mem = self.mem[self.slot_of[msg.agent]]
             step_controller(self.kind, msg.pi, msg.pf, mem, self.act, self.params, np.int64(self.seed),
                             msg.agent, msg.tick)  # fmt: skip
@@ -96,6 +101,11 @@ class AgentRuntime:
             self.session.put(self.keys.act(msg.agent), proto.action(msg.tick, msg.agent, self.act, marked))
             answered += 1
         return answered
+
+    def _null_act(self, msg: proto.Obs) -> bytes:
+        self.act[:] = 0
+        self.act[0] = 4  # STAY
+        return proto.action(msg.tick, msg.agent, self.act, False)
 
     def close(self) -> None:
         for d in self._decls:

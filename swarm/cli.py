@@ -81,7 +81,8 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
 
     bench = sub.add_parser("bench", help="measure throughput", description="Measure throughput.")
-    bench.add_argument("target", choices=["engine"], help="engine: the in-process engine")
+    bench.add_argument("target", choices=["engine", "distributed"],
+                       help="engine: the in-process engine; distributed: world + agent processes")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument("--quick", action="store_true", help="shorter measurement")
 
@@ -100,6 +101,9 @@ def build_parser() -> argparse.ArgumentParser:
     world.add_argument("--max-misses", type=_positive, default=3, metavar="K",
                        help="an agent that misses K ticks in a row is lost (default 3)")  # fmt: skip
     world.add_argument("--summary-file", metavar="FILE", help="also write the summary JSON here")
+    world.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
+    world.add_argument("--start-timeout", type=float, default=600.0, metavar="S",
+                       help="give up if the agents have not all joined after S seconds (default 600)")  # fmt: skip
     world.add_argument("--linger", type=float, default=0.0, metavar="S",
                        help="keep serving swarm/<run-id>/marks/** for S seconds after the run")  # fmt: skip
 
@@ -112,6 +116,7 @@ def build_parser() -> argparse.ArgumentParser:
     agent.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
     agent.add_argument("--run-id", default="default", help="the world's run id (default: default)")
     agent.add_argument("--count", type=_positive, default=1, metavar="K", help="independent agents in this process")
+    agent.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
 
     up = sub.add_parser(
         "up",
@@ -190,14 +195,15 @@ def cmd_world(args) -> int:
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
     summary = serve(scenario, args.run_id, args.summary_file, listen=None if args.connect else args.listen,
                     connect=args.connect, deadline=args.deadline, max_misses=args.max_misses, until=args.until,
-                    max_iterations=args.max_iterations, linger=args.linger)  # fmt: skip
+                    max_iterations=args.max_iterations, linger=args.linger,
+                    start_timeout=args.start_timeout, null=args.null)  # fmt: skip
     return _print_summary(summary, args.json, args.until)
 
 
 def cmd_agent(args) -> int:
     from agents.runtime import AgentRuntime
 
-    runtime = AgentRuntime(args.run_id, args.controller, args.connect, args.count)
+    runtime = AgentRuntime(args.run_id, args.controller, args.connect, args.count, null=args.null)
     try:
         runtime.run()
     finally:
@@ -239,6 +245,13 @@ def cmd_experiment(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    if args.target == "distributed":
+        from swarm.bench_distributed import bench_distributed, format_distributed_bench
+
+        result = bench_distributed(sizes=(10, 50) if args.quick else (10, 50, 100, 200),
+                                   packed=200 if args.quick else 1000)  # fmt: skip
+        print(json.dumps(result) if args.json else format_distributed_bench(result))
+        return 0
     from swarm.bench import bench_engine, format_engine_bench
 
     result = bench_engine(quick=args.quick)

@@ -39,17 +39,27 @@ def _terminate(procs: list[subprocess.Popen], grace: float = 5.0) -> None:
 def swarm_up(
     scenario_ref: str, agents: int, controller: str, seed: int | None, run_id: str, listen: str,
     until: str = "foraged", max_iterations: int = 1_000_000, deadline: float = 2.0, progress: bool = True,
+    per_process: int = 1, null: bool = False,
 ) -> dict:  # fmt: skip
+    """Run the swarm as processes; `per_process` agents share one agent process
+    (`swarm agent --count`), `null` runs the benchmark floor (messaging only)."""
+    if agents % per_process:
+        raise ValueError(f"{agents} agents do not split into processes of {per_process}")
     warm_up()  # once here, so N agents starting together find it in the cache
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
         summary_file = Path(tmp) / "summary.json"
         world_cmd = [*python, "world", scenario_ref, "--agents", str(agents), "--controller", controller,
                      "--run-id", run_id, "--listen", listen, "--until", until, "--max-iterations",
-                     str(max_iterations), "--deadline", str(deadline), "--summary-file", str(summary_file)]  # fmt: skip
+                     str(max_iterations), "--deadline", str(deadline), "--summary-file", str(summary_file),
+                     "--start-timeout", str(60 + 3 * agents)]  # fmt: skip
         if seed is not None:
             world_cmd += ["--seed", str(seed)]
-        agent_cmd = [*python, "agent", "--controller", controller, "--connect", listen, "--run-id", run_id]
+        agent_cmd = [*python, "agent", "--controller", controller, "--connect", listen, "--run-id", run_id,
+                     "--count", str(per_process)]  # fmt: skip
+        if null:
+            world_cmd.append("--null")
+            agent_cmd.append("--null")
         quiet = {"stdout": subprocess.DEVNULL, "start_new_session": True}
         procs: list[subprocess.Popen] = []
         session = None
@@ -57,14 +67,14 @@ def swarm_up(
             world = subprocess.Popen(world_cmd, **quiet)
             procs.append(world)
             session = open_client(listen, timeout=60.0)
-            procs += [subprocess.Popen(agent_cmd, **quiet) for _ in range(agents)]
-            _follow(session, proto.Keys(run_id), world, procs, agents, progress)
+            procs += [subprocess.Popen(agent_cmd, **quiet) for _ in range(agents // per_process)]
+            rss = _follow(session, proto.Keys(run_id), world, procs, agents, progress)
             world.wait()
-            if world.returncode != 0 or not summary_file.exists():
-                raise RuntimeError(
-                    f"the world process failed (exit {world.returncode}); run `swarm world` alone to see why"
-                )
+            if not summary_file.exists():  # exit 1 with a summary is an unfinished run, not a failure
+                raise RuntimeError(f"the world process failed (exit {world.returncode}); its errors are above")
             summary = json.loads(summary_file.read_text())
+            if rss:
+                summary["agent_process_rss_mb"] = round(max(rss.values()) / 1024, 1)
             for p in procs[1:]:  # agents leave on the world's stop message
                 with contextlib.suppress(subprocess.TimeoutExpired):
                     p.wait(timeout=10)
@@ -75,11 +85,24 @@ def swarm_up(
             _terminate(procs)
 
 
-def _follow(session, keys: proto.Keys, world: subprocess.Popen, procs, agents: int, progress: bool) -> None:
+def _rss_kb(pid: int) -> int:
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            for line in f:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1])
+    except OSError:
+        pass
+    return 0
+
+
+def _follow(session, keys: proto.Keys, world: subprocess.Popen, procs, agents: int, progress: bool) -> dict:
+    """Show progress until the world exits; return each agent process's peak RSS (kB)."""
     import queue
 
     from tqdm import tqdm
 
+    rss: dict[int, int] = {}
     states: queue.Queue = queue.Queue()
     sub = session.declare_subscriber(keys.state, states.put)
     bar = tqdm(desc="delivered", unit="unit", disable=not progress, leave=False)
@@ -93,6 +116,9 @@ def _follow(session, keys: proto.Keys, world: subprocess.Popen, procs, agents: i
                 continue
             if isinstance(msg, proto.Rejected):
                 continue
+            if msg.get("tick", 0) % 50 == 1:
+                for p in procs[1:]:
+                    rss[p.pid] = max(rss.get(p.pid, 0), _rss_kb(p.pid))
             bar.total = msg.get("total")
             bar.n = msg.get("delivered", 0)
             bar.set_postfix(tick=msg.get("tick"), alive=f"{msg.get('agents_alive')}/{agents}",
@@ -101,6 +127,7 @@ def _follow(session, keys: proto.Keys, world: subprocess.Popen, procs, agents: i
     finally:
         bar.close()
         sub.undeclare()
+    return rss
 
 
 def default_listen() -> str:

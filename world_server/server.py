@@ -67,11 +67,12 @@ class WorldServer:
     def __init__(
         self, scenario: Scenario, run_id: str, listen: str | None = None, connect: str | None = None,
         deadline: float = 2.0, max_misses: int = 3, expect: int | None = None, start_timeout: float = 60.0,
-        until: str = "foraged", max_iterations: int = 1_000_000,
+        until: str = "foraged", max_iterations: int = 1_000_000, null: bool = False,
     ):  # fmt: skip
         self.scenario = scenario
         self.keys = proto.Keys(run_id)
         self.world = GridWorld(scenario)
+        self.world.warm_up()
         self.cparams = controller_params(scenario)
         self.deadline = deadline
         self.max_misses = max_misses
@@ -79,6 +80,11 @@ class WorldServer:
         self.start_timeout = start_timeout
         self.until = until
         self.max_iterations = max_iterations
+        self.null = null  # benchmark floor: messaging only, no perception and no world rules
+        self.tick_seconds: list[float] = []
+        self.bytes_out = 0
+        self.bytes_in = 0
+        self.agent_steps = 0  # actions received in time, over the run
         self.slots = np.full(scenario.agents, FREE, dtype=np.int64)
         self.misses = np.zeros(scenario.agents, dtype=np.int64)
         self.acted = np.zeros(scenario.agents, dtype=bool)  # action received this tick
@@ -177,7 +183,9 @@ class WorldServer:
             return None
 
     def _on_act(self, sample) -> None:
-        msg = proto.parse_act(sample.payload.to_bytes())
+        raw = sample.payload.to_bytes()
+        self.bytes_in += len(raw)
+        msg = proto.parse_act(raw)
         if isinstance(msg, proto.Rejected):
             self.stats.reject(f"act: {msg.reason}")
             return
@@ -201,7 +209,9 @@ class WorldServer:
             self.mark_due[a] = msg.marked
 
     def _on_mark(self, sample) -> None:
-        msg = proto.parse_mark(sample.payload.to_bytes())
+        raw = sample.payload.to_bytes()
+        self.bytes_in += len(raw)
+        msg = proto.parse_mark(raw)
         if isinstance(msg, proto.Rejected):
             self.stats.reject(f"mark: {msg.reason}")
             return
@@ -252,6 +262,7 @@ class WorldServer:
             self._drain(0.05)
 
     def step(self) -> None:
+        started = time.perf_counter()
         w = self.world
         tick = self.tick
         active = np.flatnonzero(self.slots == ACTIVE)
@@ -263,9 +274,12 @@ class WorldServer:
         w.acts[:, A_TRAIL_OP:] = 0
         width = w.layers.shape[2]
         for a in active:
-            w.perceive(int(a), self._pi, self._pf)
+            if not self.null:
+                w.perceive(int(a), self._pi, self._pf)
             cell = int(w.pos[a, 0] * width + w.pos[a, 1])
-            self.session.put(self.keys.obs(int(a)), proto.observation(tick, int(a), cell, self._pi, self._pf))
+            payload = proto.observation(tick, int(a), cell, self._pi, self._pf)
+            self.bytes_out += len(payload)
+            self.session.put(self.keys.obs(int(a)), payload)
         deadline = time.monotonic() + self.deadline
         while not self.answered(active).all():
             left = deadline - time.monotonic()
@@ -273,6 +287,7 @@ class WorldServer:
                 break
             self._drain(left)
         answered = self.answered(active)
+        self.agent_steps += int(answered.sum())
         for a, ok in zip(active, answered, strict=True):
             if ok:
                 self.misses[a] = 0
@@ -283,8 +298,10 @@ class WorldServer:
                 w.acts[a, A_TRAIL_OP:] = 0
                 if self.misses[a] >= self.max_misses:
                     self._lose(int(a))
-        w.resolve(tick)
+        if not self.null:
+            w.resolve(tick)
         self.tick += 1
+        self.tick_seconds.append(time.perf_counter() - started)
         self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress()}))
 
     def answered(self, agents: np.ndarray) -> np.ndarray:
@@ -328,8 +345,15 @@ class WorldServer:
             "rejected_messages": self.stats.rejected_total, "rejected_by_reason": dict(self.stats.rejected),
             "agents_lost": self.stats.agents_lost, "joins": self.stats.joins, "missed_ticks": self.stats.missed_ticks,
             "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0,
-            "wall_seconds": round(elapsed, 3),
+            "wall_seconds": round(elapsed, 3), **self._latency(),
         }  # fmt: skip
+
+    def _latency(self) -> dict:
+        ticks = np.array(self.tick_seconds) * 1000 if self.tick_seconds else np.zeros(1)
+        return {"tick_ms_p50": round(float(np.percentile(ticks, 50)), 3),
+                "tick_ms_p99": round(float(np.percentile(ticks, 99)), 3), "tick_ms_max": round(float(ticks.max()), 3),
+                "payload_bytes_out": self.bytes_out, "payload_bytes_in": self.bytes_in,
+                "agent_steps": self.agent_steps}  # fmt: skip
 
     def stop_agents(self, reason: str) -> None:
         for a in range(len(self.slots)):
