@@ -102,6 +102,14 @@ def build_parser() -> argparse.ArgumentParser:
                        help="an agent that misses K ticks in a row is lost (default 3)")  # fmt: skip
     world.add_argument("--summary-file", metavar="FILE", help="also write the summary JSON here")
     world.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
+    world.add_argument(
+        "--state-dir",
+        default="runs",
+        metavar="DIR",
+        help="persist the world to DIR/<run-id>.state.npz and resume from it on restart (default runs)",
+    )
+    world.add_argument("--persist-every", type=int, default=50, metavar="K",
+                       help="persist every K ticks (default 50; 0: only at the end)")  # fmt: skip
     world.add_argument("--start-timeout", type=float, default=600.0, metavar="S",
                        help="give up if the agents have not all joined after S seconds (default 600)")  # fmt: skip
     world.add_argument("--linger", type=float, default=0.0, metavar="S",
@@ -196,7 +204,8 @@ def cmd_world(args) -> int:
     summary = serve(scenario, args.run_id, args.summary_file, listen=None if args.connect else args.listen,
                     connect=args.connect, deadline=args.deadline, max_misses=args.max_misses, until=args.until,
                     max_iterations=args.max_iterations, linger=args.linger,
-                    start_timeout=args.start_timeout, null=args.null)  # fmt: skip
+                    start_timeout=args.start_timeout, null=args.null,
+                    state_dir=args.state_dir, persist_every=args.persist_every)  # fmt: skip
     return _print_summary(summary, args.json, args.until)
 
 

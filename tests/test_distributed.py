@@ -147,3 +147,45 @@ def test_lost_agents_cargo_is_dropped_where_it_stood():
     w.payload[1] = 60  # on the base: delivered
     w.drop_load(1)
     assert w.delivered == 60
+
+
+def test_kill_9_the_world_and_restart_it_resumes_from_disk(tmp_path):
+    import json
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from world_server import persist
+
+    endpoint = free_endpoint()
+    state = persist.state_path(tmp_path, "resume")
+    summary_file = tmp_path / "summary.json"
+    world_cmd = [sys.executable, "-m", "swarm", "world", "setup1", "--agents", "3", "--seed", "4", "--run-id",
+                 "resume", "--listen", endpoint, "--state-dir", str(tmp_path), "--persist-every", "20",
+                 "--deadline", "5", "--summary-file", str(summary_file)]  # fmt: skip
+    world = subprocess.Popen(world_cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    procs = [world, *start_agents(endpoint, "resume", "cmarking", 3)]
+    try:
+        deadline = time.monotonic() + 120
+        while True:
+            saved = persist.load(state) if state.exists() else None
+            if saved and saved["tick"] >= 100:
+                break
+            assert time.monotonic() < deadline and world.poll() is None, "the world never persisted"
+            time.sleep(0.05)
+        os.kill(world.pid, signal.SIGKILL)
+        world.wait()
+        before = persist.load(state)
+        assert before["tick"] >= 100 and before["tick"] % 20 == 0
+        world = subprocess.Popen(world_cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        procs.append(world)
+        assert world.wait(timeout=300) == 0, world.stderr.read().decode()[-3000:]
+        summary = json.loads(summary_file.read_text())
+        assert summary["finished"] and summary["delivered"] == summary["total"]
+        assert summary["iterations"] > before["tick"]
+        assert summary["agents_lost"] == 0  # the same three agents came back
+        assert summary["explored_cells"] >= int(before["counters"][1])
+    finally:
+        stop(procs)

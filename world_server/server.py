@@ -40,6 +40,7 @@ from swarm import protocol as proto
 from swarm.bus import open_client, open_router
 from swarm.engine import UNTIL, is_done
 from swarm.scenario import Scenario
+from world_server import persist
 from world_server.grid import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, L_OBST, GridWorld, write_mark
 
 # JOINING: welcomed, but its observation subscriber may not be routed yet; it is
@@ -68,6 +69,7 @@ class WorldServer:
         self, scenario: Scenario, run_id: str, listen: str | None = None, connect: str | None = None,
         deadline: float = 2.0, max_misses: int = 3, expect: int | None = None, start_timeout: float = 60.0,
         until: str = "foraged", max_iterations: int = 1_000_000, null: bool = False,
+        state_dir: str | None = None, persist_every: int = 50, resume_timeout: float = 30.0,
     ):  # fmt: skip
         self.scenario = scenario
         self.keys = proto.Keys(run_id)
@@ -95,6 +97,10 @@ class WorldServer:
         self.tick = 0
         self.events: queue.Queue = queue.Queue()
         self.started = 0.0
+        self.persist_every = persist_every
+        self.resume_timeout = resume_timeout
+        self.state_file = persist.state_path(state_dir, run_id) if state_dir else None
+        self.resumed = self._resume()
         self.session = open_client(connect) if connect else open_router(listen or "tcp/127.0.0.1:7447")
         put = self.events.put
         k = self.keys
@@ -107,6 +113,34 @@ class WorldServer:
             self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s))),
         ]
         self._pi, self._pf = new_perception()
+
+    # ------------------------------------------------------------ persistence
+
+    def _resume(self) -> bool:
+        """Continue a run persisted under this run id, if there is one."""
+        state = persist.load(self.state_file) if self.state_file else None
+        if state is None:
+            return False
+        if state["scenario"] != self.scenario.describe():
+            raise ValueError(f"{self.state_file} holds run {self.keys.run!r} of another scenario; "
+                             "use another --run-id or remove the file")  # fmt: skip
+        w = self.world
+        for key in persist.ARRAYS:
+            getattr(w, key)[...] = state[key]
+        self.tick = int(state["tick"])
+        slots = state["slots"]
+        # Agents that were in the run come back when their liveliness token reappears.
+        self.slots[:] = np.where((slots == ACTIVE) | (slots == JOINING), JOINING, slots)
+        self.stats.joins = int(state["stats"].get("joins", 0))
+        self.stats.agents_lost = int(state["stats"].get("agents_lost", 0))
+        self.stats.rejected = dict(state["stats"].get("rejected", {}))
+        return True
+
+    def save_state(self) -> None:
+        if self.state_file is None:
+            return
+        stats = {"joins": self.stats.joins, "agents_lost": self.stats.agents_lost, "rejected": self.stats.rejected}
+        persist.save(self.state_file, self.world, self.tick, self.slots, stats, self.scenario.describe())
 
     # ---------------------------------------------------------------- messages
 
@@ -255,6 +289,13 @@ class WorldServer:
     # ------------------------------------------------------------------ ticks
 
     def wait_for_agents(self) -> None:
+        if self.resumed:
+            deadline = time.monotonic() + self.resume_timeout
+            while (self.slots == JOINING).any() and time.monotonic() < deadline:
+                self._drain(0.05)
+            for agent in np.flatnonzero(self.slots == JOINING):
+                self._lose(int(agent))  # did not come back
+            return
         deadline = time.monotonic() + self.start_timeout
         while int((self.slots == ACTIVE).sum()) < self.expect:
             if time.monotonic() > deadline:
@@ -301,6 +342,8 @@ class WorldServer:
         if not self.null:
             w.resolve(tick)
         self.tick += 1
+        if self.persist_every and self.tick % self.persist_every == 0:
+            self.save_state()
         self.tick_seconds.append(time.perf_counter() - started)
         self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress()}))
 
@@ -312,11 +355,13 @@ class WorldServer:
         return bool(is_done(UNTIL[self.until], w.counters, w.total, w.reachable))
 
     def run(self) -> dict:
-        self.wait_for_agents()
+        if not (self.resumed and self.done()):  # a finished run resumed has nothing left to do
+            self.wait_for_agents()
         self.started = time.monotonic()
         while not self.done() and self.tick < self.max_iterations:
             self.step()
         self._drain(0.0)
+        self.save_state()
         return self.summary()
 
     def linger(self, until) -> None:
