@@ -66,9 +66,11 @@ def swarm_up(
         try:
             world = subprocess.Popen(world_cmd, **quiet)
             procs.append(world)
-            session = open_client(listen, timeout=60.0)
-            procs += [subprocess.Popen(agent_cmd, **quiet) for _ in range(agents // per_process)]
-            rss = _follow(session, proto.Keys(run_id), world, procs, agents, progress)
+            session = _connect(listen, world)
+            rss = {}
+            if session is not None:  # None: the world is already done (e.g. it resumed a finished run)
+                procs += [subprocess.Popen(agent_cmd, **quiet) for _ in range(agents // per_process)]
+                rss = _follow(session, proto.Keys(run_id), world, procs, agents, progress)
             world.wait()
             if not summary_file.exists():  # exit 1 with a summary is an unfinished run, not a failure
                 raise RuntimeError(f"the world process failed (exit {world.returncode}); its errors are above")
@@ -83,6 +85,18 @@ def swarm_up(
             if session is not None:
                 session.close()
             _terminate(procs)
+
+
+def _connect(listen: str, world: subprocess.Popen, timeout: float = 60.0):
+    """A client session to the world's router, or None if the world exits first."""
+    deadline = time.monotonic() + timeout
+    while world.poll() is None:
+        try:
+            return open_client(listen, timeout=2.0)
+        except ConnectionError:
+            if time.monotonic() > deadline:
+                raise
+    return None
 
 
 def _rss_kb(pid: int) -> int:

@@ -189,3 +189,54 @@ def test_kill_9_the_world_and_restart_it_resumes_from_disk(tmp_path):
         assert summary["explored_cells"] >= int(before["counters"][1])
     finally:
         stop(procs)
+
+
+def _children_alive(run_id: str) -> list[str]:
+    """World and agent processes of a run (full command lines: ps -ww)."""
+    import subprocess
+
+    out = subprocess.run(["ps", "-ww", "-eo", "args"], capture_output=True, text=True).stdout
+    return [line for line in out.splitlines()
+            if f"--run-id {run_id}" in line and (" world " in line or " agent " in line)]  # fmt: skip
+
+
+def test_swarm_up_equals_swarm_run_and_leaves_no_process(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    args = ["setup2", "--agents", "3", "--seed", "9"]
+    up = subprocess.run([sys.executable, "-m", "swarm", "up", *args, "--run-id", "upeq", "--listen", free_endpoint(),
+                         "--json"], capture_output=True, text=True, timeout=300, cwd=tmp_path)  # fmt: skip
+    assert up.returncode == 0, up.stderr[-3000:]
+    ran = subprocess.run([sys.executable, "-m", "swarm", "run", *args, "--json"], capture_output=True, text=True,
+                         timeout=300)  # fmt: skip
+    a, b = json.loads(up.stdout), json.loads(ran.stdout)
+    for key in ("iterations", "delivered", "total", "finished", "apf_optimal", "explored_cells", "reachable_cells"):
+        assert a[key] == b[key], key
+    assert {"rejected_messages", "agents_lost", "ticks_per_second"} <= set(a)
+    assert _children_alive("upeq") == []
+
+
+def test_ctrl_c_stops_swarm_up_and_every_child(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    up = subprocess.Popen([sys.executable, "-m", "swarm", "up", "setup1", "--agents", "4", "--seed", "1",
+                           "--run-id", "ctrlc", "--listen", free_endpoint()], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True, cwd=tmp_path)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        while len(_children_alive("ctrlc")) < 5:  # the world and 4 agents
+            assert time.monotonic() < deadline and up.poll() is None, up.stderr.read()[-2000:]
+            time.sleep(0.1)
+        time.sleep(1.0)
+        up.send_signal(signal.SIGINT)
+        assert up.wait(timeout=30) == 130
+        time.sleep(0.5)
+        assert _children_alive("ctrlc") == []
+    finally:
+        if up.poll() is None:
+            up.kill()
