@@ -78,29 +78,36 @@ class AgentRuntime:
         answered = 0
         while len(stopped) < len(self.agents):
             try:
-                sample = self.inbox.get(timeout=self.idle_timeout)
+                batch = [self.inbox.get(timeout=self.idle_timeout)]
             except queue.Empty:
                 raise TimeoutError(f"no observation for {self.idle_timeout:.0f} s; is the world gone?") from None
-            msg = proto.parse_obs(sample.payload.to_bytes())
-            if isinstance(msg, dict):  # stop
-                stopped.add(int(str(sample.key_expr).rsplit("/", 1)[1]))
-                continue
-            if isinstance(msg, proto.Rejected) or msg.agent not in self.slot_of:
-                continue
-            if self.null:
-                self.session.put(self.keys.act(msg.agent), self._null_act(msg))
-                answered += 1
-                continue
-            mem = self.mem[self.slot_of[msg.agent]]
-            step_controller(self.kind, msg.pi, msg.pf, mem, self.act, self.params, np.int64(self.seed),
-                            msg.agent, msg.tick)  # fmt: skip
-            value = int(self.act[A_MARK])
-            marked = bool(value != MARK_NONE and value < msg.pi[MARK])  # a write that changes nothing is not sent
-            if marked:
-                self.session.put(self.keys.mark(msg.cell), proto.mark_write(msg.tick, msg.agent, value))
-            self.session.put(self.keys.act(msg.agent), proto.action(msg.tick, msg.agent, self.act, marked))
-            answered += 1
+            while not self.inbox.empty():  # behind (real time): answer only the newest per agent
+                batch.append(self.inbox.get_nowait())
+            latest: dict[int, proto.Obs] = {}
+            for sample in batch:
+                msg = proto.parse_obs(sample.payload.to_bytes())
+                if isinstance(msg, dict):  # stop
+                    stopped.add(int(str(sample.key_expr).rsplit("/", 1)[1]))
+                elif not isinstance(msg, proto.Rejected) and msg.agent in self.slot_of:
+                    latest[msg.agent] = msg
+            for msg in latest.values():
+                if msg.agent not in stopped:
+                    self._answer(msg)
+                    answered += 1
         return answered
+
+    def _answer(self, msg: proto.Obs) -> None:
+        if self.null:
+            self.session.put(self.keys.act(msg.agent), self._null_act(msg))
+            return
+        mem = self.mem[self.slot_of[msg.agent]]
+        step_controller(self.kind, msg.pi, msg.pf, mem, self.act, self.params, np.int64(self.seed), msg.agent,
+                        msg.tick)  # fmt: skip
+        value = int(self.act[A_MARK])
+        marked = bool(value != MARK_NONE and value < msg.pi[MARK])  # a write that changes nothing is not sent
+        if marked:
+            self.session.put(self.keys.mark(msg.cell), proto.mark_write(msg.tick, msg.agent, value))
+        self.session.put(self.keys.act(msg.agent), proto.action(msg.tick, msg.agent, self.act, marked))
 
     def _null_act(self, msg: proto.Obs) -> bytes:
         self.act[:] = 0

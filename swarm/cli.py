@@ -98,6 +98,13 @@ def build_parser() -> argparse.ArgumentParser:
                        help="host a router listening here (default tcp/127.0.0.1:7447)")  # fmt: skip
     where.add_argument("--connect", metavar="ENDPOINT", help="join an existing router instead")
     world.add_argument("--deadline", type=float, default=2.0, metavar="S", help="per-tick deadline in seconds")
+    world.add_argument(
+        "--mode",
+        choices=["lockstep", "realtime"],
+        default="lockstep",
+        help="lockstep: barrier per tick (equals swarm run); realtime: fixed rate, latest action wins",
+    )
+    world.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="ticks per second in realtime mode")
     world.add_argument("--max-misses", type=_positive, default=3, metavar="K",
                        help="an agent that misses K ticks in a row is lost (default 3)")  # fmt: skip
     world.add_argument("--summary-file", metavar="FILE", help="also write the summary JSON here")
@@ -133,7 +140,13 @@ def build_parser() -> argparse.ArgumentParser:
         "processes, show progress, and print the run summary.",
     )
     _scenario_args(up)
-    up.add_argument("--mode", choices=["lockstep"], default="lockstep", help="tick mode (lockstep)")
+    up.add_argument(
+        "--mode",
+        choices=["lockstep", "realtime"],
+        default="lockstep",
+        help="lockstep: barrier per tick (equals swarm run); realtime: fixed rate, latest action wins",
+    )
+    up.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="ticks per second in realtime mode")
     up.add_argument("--run-id", help="key space swarm/<run-id>/... (default: a fresh id)")
     up.add_argument("--listen", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router's endpoint")
     up.add_argument("--deadline", type=float, default=2.0, metavar="S", help="per-tick deadline in seconds")
@@ -205,7 +218,8 @@ def cmd_world(args) -> int:
                     connect=args.connect, deadline=args.deadline, max_misses=args.max_misses, until=args.until,
                     max_iterations=args.max_iterations, linger=args.linger,
                     start_timeout=args.start_timeout, null=args.null,
-                    state_dir=args.state_dir, persist_every=args.persist_every)  # fmt: skip
+                    state_dir=args.state_dir, persist_every=args.persist_every, mode=args.mode,
+                    rate=args.rate)  # fmt: skip
     return _print_summary(summary, args.json, args.until)
 
 
@@ -229,7 +243,7 @@ def cmd_up(args) -> int:
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
     summary = swarm_up(args.scenario, scenario.agents, scenario.controller, args.seed, args.run_id or new_run_id(),
                        args.listen, args.until, args.max_iterations, args.deadline,
-                       progress=not args.json and sys.stderr.isatty())  # fmt: skip
+                       progress=not args.json and sys.stderr.isatty(), mode=args.mode, rate=args.rate)  # fmt: skip
     return _print_summary(summary, args.json, args.until)
 
 

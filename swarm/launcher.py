@@ -39,7 +39,7 @@ def _terminate(procs: list[subprocess.Popen], grace: float = 5.0) -> None:
 def swarm_up(
     scenario_ref: str, agents: int, controller: str, seed: int | None, run_id: str, listen: str,
     until: str = "foraged", max_iterations: int = 1_000_000, deadline: float = 2.0, progress: bool = True,
-    per_process: int = 1, null: bool = False,
+    per_process: int = 1, null: bool = False, mode: str = "lockstep", rate: float = 20.0,
 ) -> dict:  # fmt: skip
     """Run the swarm as processes; `per_process` agents share one agent process
     (`swarm agent --count`), `null` runs the benchmark floor (messaging only)."""
@@ -52,7 +52,7 @@ def swarm_up(
         world_cmd = [*python, "world", scenario_ref, "--agents", str(agents), "--controller", controller,
                      "--run-id", run_id, "--listen", listen, "--until", until, "--max-iterations",
                      str(max_iterations), "--deadline", str(deadline), "--summary-file", str(summary_file),
-                     "--start-timeout", str(60 + 3 * agents)]  # fmt: skip
+                     "--start-timeout", str(60 + 3 * agents), "--mode", mode, "--rate", str(rate)]  # fmt: skip
         if seed is not None:
             world_cmd += ["--seed", str(seed)]
         agent_cmd = [*python, "agent", "--controller", controller, "--connect", listen, "--run-id", run_id,

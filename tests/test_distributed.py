@@ -240,3 +240,18 @@ def test_ctrl_c_stops_swarm_up_and_every_child(tmp_path):
     finally:
         if up.poll() is None:
             up.kill()
+
+
+def test_realtime_mode_ticks_at_its_rate_and_finishes():
+    scenario = load_scenario("setup2").with_overrides(agents=3, seed=9)
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "realtime", endpoint, mode="realtime", rate=50.0).start()
+    procs = start_agents(endpoint, "realtime", "cmarking", 3)
+    try:
+        summary = world.join(timeout=240)
+        assert summary["mode"] == "realtime" and summary["finished"]
+        assert summary["delivered"] == summary["total"]
+        assert 35 <= summary["ticks_per_second"] <= 52  # the world's clock, not the agents', sets the pace
+    finally:
+        stop(procs)
+        world.close()

@@ -70,7 +70,14 @@ class WorldServer:
         deadline: float = 2.0, max_misses: int = 3, expect: int | None = None, start_timeout: float = 60.0,
         until: str = "foraged", max_iterations: int = 1_000_000, null: bool = False,
         state_dir: str | None = None, persist_every: int = 50, resume_timeout: float = 30.0,
+        mode: str = "lockstep", rate: float = 20.0,
     ):  # fmt: skip
+        if mode not in ("lockstep", "realtime"):
+            raise ValueError(f"unknown mode {mode!r}: lockstep or realtime")
+        if not rate > 0:
+            raise ValueError("the real-time rate must be positive")
+        self.mode = mode
+        self.period = 1.0 / rate
         self.scenario = scenario
         self.keys = proto.Keys(run_id)
         self.world = GridWorld(scenario)
@@ -228,10 +235,10 @@ class WorldServer:
             self.stats.reject("act: names another agent's id")
         elif not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
             self.stats.reject("act: unknown agent")
-        elif msg.tick != self.tick:
+        elif not self._current(msg.tick):
             self.stats.late_actions += 1
             self.stats.reject("act: not for this tick")
-        elif self.acted[a]:
+        elif self.acted[a] and self.mode == "lockstep":  # in real time the latest action wins
             self.stats.reject("act: second action in one tick")
         elif not _valid_action(msg.act):
             self.stats.reject("act: out-of-range action")
@@ -254,7 +261,9 @@ class WorldServer:
         width = w.layers.shape[2]
         if not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
             self.stats.reject("mark: unknown agent")
-        elif msg.tick != self.tick or self.mark_got[a] or (self.acted[a] and not self.mark_due[a]):
+        elif not self._current(msg.tick) or (
+            self.mode == "lockstep" and (self.mark_got[a] or (self.acted[a] and not self.mark_due[a]))
+        ):
             self.stats.reject("mark: not for this tick")
         elif cell is None or cell != w.pos[a, 0] * width + w.pos[a, 1]:
             self.stats.reject("mark: not the agent's cell")
@@ -263,6 +272,13 @@ class WorldServer:
         else:
             write_mark(w.layers, int(w.pos[a, 0]), int(w.pos[a, 1]), np.int64(msg.value), w.counters)
             self.mark_got[a] = True
+
+    def _current(self, tick: int) -> bool:
+        """Lock-step: only this tick.  Real time: this tick or the two before
+        (an agent may answer a slightly old observation)."""
+        if self.mode == "lockstep":
+            return tick == self.tick
+        return self.tick - 2 <= tick <= self.tick
 
     def _on_marks_query(self, query) -> None:
         marks = self.world.layers[L_MARK]
@@ -321,12 +337,17 @@ class WorldServer:
             payload = proto.observation(tick, int(a), cell, self._pi, self._pf)
             self.bytes_out += len(payload)
             self.session.put(self.keys.obs(int(a)), payload)
-        deadline = time.monotonic() + self.deadline
-        while not self.answered(active).all():
-            left = deadline - time.monotonic()
-            if left <= 0:
-                break
-            self._drain(left)
+        if self.mode == "lockstep":  # a barrier: until all have answered or the deadline
+            deadline = time.monotonic() + self.deadline
+            while not self.answered(active).all():
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    break
+                self._drain(left)
+        else:  # real time: the tick lasts one period, whoever has answered
+            deadline = started + self.period
+            while (left := deadline - time.monotonic()) > 0:
+                self._drain(left)
         answered = self.answered(active)
         self.agent_steps += int(answered.sum())
         for a, ok in zip(active, answered, strict=True):
@@ -348,6 +369,8 @@ class WorldServer:
         self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress()}))
 
     def answered(self, agents: np.ndarray) -> np.ndarray:
+        if self.mode == "realtime":
+            return self.acted[agents]
         return self.acted[agents] & (~self.mark_due[agents] | self.mark_got[agents])
 
     def done(self) -> bool:
@@ -386,7 +409,7 @@ class WorldServer:
             "total": w.total, "in_transit": w.in_transit, "apf_optimal": w.apf_optimal(),
             "optimal_cells": int(w.counters[C_OPTIMAL]), "explored_cells": int(w.counters[C_EXPLORED]),
             "reachable_cells": w.reachable, "rejected_moves": int(w.counters[C_REJECTED]),
-            "grid": list(w.layout.shape), "run_id": self.keys.run, "mode": "lockstep",
+            "grid": list(w.layout.shape), "run_id": self.keys.run, "mode": self.mode,
             "rejected_messages": self.stats.rejected_total, "rejected_by_reason": dict(self.stats.rejected),
             "agents_lost": self.stats.agents_lost, "joins": self.stats.joins, "missed_ticks": self.stats.missed_ticks,
             "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0,
