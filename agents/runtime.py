@@ -36,10 +36,12 @@ class AgentRuntime:
         self.idle_timeout = idle_timeout
         self.inbox: queue.Queue = queue.Queue()
         self.session = open_client(connect, timeout=join_timeout)
+        self.group = uuid.uuid4().hex  # this process: its agents' messages travel together
+        # Subscribed before joining: the world starts observing an agent as soon as it sees its token.
+        self._decls = [self.session.declare_subscriber(self.keys.obs(self.group), self.inbox.put)]
         self.agents: list[int] = []
         self.mem = new_memory(count)
         self.act = new_action()
-        self._decls = []
         self.seed = 0
         self.params = np.zeros(1)
         for _ in range(count):
@@ -50,8 +52,8 @@ class AgentRuntime:
         nonce = uuid.uuid4().hex
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            for reply in self.session.get(self.keys.join, payload=proto.join_request(nonce, controller=self.controller),
-                                          timeout=2.0):  # fmt: skip
+            request = proto.join_request(nonce, self.group, controller=self.controller)
+            for reply in self.session.get(self.keys.join, payload=request, timeout=2.0):
                 if not reply.ok:
                     continue
                 msg = proto.unpack(reply.ok.payload.to_bytes())
@@ -64,55 +66,60 @@ class AgentRuntime:
                     self.seed = int(msg["seed"])
                     self.params = np.array(msg["params"], dtype=np.float64)
                     self.agents.append(agent)
-                    put = self.inbox.put
-                    # Subscriber first: the world starts observing us when it sees the token.
-                    self._decls.append(self.session.declare_subscriber(self.keys.obs(agent), put))
                     self._decls.append(self.session.liveliness().declare_token(self.keys.alive(agent)))
                     return
             time.sleep(0.2)
         raise TimeoutError(f"no world answered on {self.keys.join} within {timeout:.0f} s")
 
     def run(self) -> int:
-        """Answer observations until the world says stop; returns ticks answered."""
-        stopped: set[int] = set()
+        """Answer observations until the world says stop; returns agent-steps answered."""
         answered = 0
-        while len(stopped) < len(self.agents):
+        while True:
             try:
                 batch = [self.inbox.get(timeout=self.idle_timeout)]
             except queue.Empty:
                 raise TimeoutError(f"no observation for {self.idle_timeout:.0f} s; is the world gone?") from None
-            while not self.inbox.empty():  # behind (real time): answer only the newest per agent
+            while not self.inbox.empty():  # behind (real time): answer only the newest
                 batch.append(self.inbox.get_nowait())
-            latest: dict[int, proto.Obs] = {}
+            latest = None
             for sample in batch:
                 msg = proto.parse_obs(sample.payload.to_bytes())
                 if isinstance(msg, dict):  # stop
-                    stopped.add(int(str(sample.key_expr).rsplit("/", 1)[1]))
-                elif not isinstance(msg, proto.Rejected) and msg.agent in self.slot_of:
-                    latest[msg.agent] = msg
-            for msg in latest.values():
-                if msg.agent not in stopped:
-                    self._answer(msg)
-                    answered += 1
-        return answered
+                    return answered
+                if not isinstance(msg, proto.Rejected):
+                    latest = msg
+            if latest is not None:
+                answered += self._answer(latest)
 
-    def _answer(self, msg: proto.Obs) -> None:
-        if self.null:
-            self.session.put(self.keys.act(msg.agent), self._null_act(msg))
-            return
-        mem = self.mem[self.slot_of[msg.agent]]
-        step_controller(self.kind, msg.pi, msg.pf, mem, self.act, self.params, np.int64(self.seed), msg.agent,
-                        msg.tick)  # fmt: skip
-        value = int(self.act[A_MARK])
-        marked = bool(value != MARK_NONE and value < msg.pi[MARK])  # a write that changes nothing is not sent
-        if marked:
-            self.session.put(self.keys.mark(msg.cell), proto.mark_write(msg.tick, msg.agent, value))
-        self.session.put(self.keys.act(msg.agent), proto.action(msg.tick, msg.agent, self.act, marked))
-
-    def _null_act(self, msg: proto.Obs) -> bytes:
-        self.act[:] = 0
-        self.act[0] = 4  # STAY
-        return proto.action(msg.tick, msg.agent, self.act, False)
+    def _answer(self, obs: proto.Obs) -> int:
+        """Step every agent of ours in the batch; one mark message, one action message."""
+        acts = np.zeros((len(obs.agents), self.act.shape[0]), dtype=np.int64)
+        agents, marked, mark_agents, mark_cells, mark_values = [], [], [], [], []
+        seed = np.int64(self.seed)
+        for i, agent in enumerate(obs.agents.tolist()):
+            slot = self.slot_of.get(agent)
+            if slot is None:
+                continue
+            act = acts[len(agents)]
+            if self.null:
+                act[0] = 4  # STAY
+            else:
+                step_controller(self.kind, obs.pi[i], obs.pf[i], self.mem[slot], act, self.params, seed, agent,
+                                obs.tick)  # fmt: skip
+            value = int(act[A_MARK])
+            lowers = value != MARK_NONE and value < obs.pi[i, MARK]  # a write that changes nothing is not sent
+            if lowers:
+                mark_agents.append(agent)
+                mark_cells.append(int(obs.cells[i]))
+                mark_values.append(value)
+            agents.append(agent)
+            marked.append(lowers)
+        if mark_agents:
+            self.session.put(
+                self.keys.mark(self.group), proto.mark_writes(obs.tick, mark_agents, mark_cells, mark_values)
+            )
+        self.session.put(self.keys.act(self.group), proto.actions(obs.tick, agents, acts[: len(agents)], marked))
+        return len(agents)
 
     def close(self) -> None:
         for d in self._decls:

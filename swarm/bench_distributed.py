@@ -15,6 +15,7 @@ import time
 from swarm.engine import Engine
 from swarm.launcher import swarm_up
 from swarm.scenario import load_scenario
+from world_server.server import new_run_id
 
 SIZES = (10, 50, 100, 200)
 
@@ -27,7 +28,8 @@ def _engine_tps(agents: int, ticks: int) -> float:
 
 
 def _one(agents: int, ticks: int, per_process: int, null: bool, port: int) -> dict:
-    s = swarm_up("setup1", agents, "cmarking", 1, f"bench{port}", f"tcp/127.0.0.1:{port}", "foraged", ticks,
+    run_id = f"bench{new_run_id()}"  # fresh: never resume an earlier bench's saved state
+    s = swarm_up("setup1", agents, "cmarking", 1, run_id, f"tcp/127.0.0.1:{port}", "foraged", ticks,
                  deadline=10.0, progress=False, per_process=per_process, null=null)  # fmt: skip
     steps = max(1, s["agent_steps"])
     return {"agents": agents, "per_process": per_process, "null": null, "ticks": s["iterations"],

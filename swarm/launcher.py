@@ -45,6 +45,21 @@ def swarm_up(
     (`swarm agent --count`), `null` runs the benchmark floor (messaging only)."""
     if agents % per_process:
         raise ValueError(f"{agents} agents do not split into processes of {per_process}")
+    # SIGTERM (docker stop, timeout, kill) must clean up like Ctrl-C does: raise so `finally` runs.
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        return _swarm_up(scenario_ref, agents, controller, seed, run_id, listen, until, max_iterations, deadline,
+                         progress, per_process, null, mode, rate)  # fmt: skip
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _raise_interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def _swarm_up(scenario_ref, agents, controller, seed, run_id, listen, until, max_iterations, deadline, progress,
+              per_process, null, mode, rate) -> dict:  # fmt: skip
     warm_up()  # once here, so N agents starting together find it in the cache
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
@@ -77,9 +92,10 @@ def swarm_up(
             summary = json.loads(summary_file.read_text())
             if rss:
                 summary["agent_process_rss_mb"] = round(max(rss.values()) / 1024, 1)
-            for p in procs[1:]:  # agents leave on the world's stop message
+            grace = time.monotonic() + 10  # agents leave on the world's stop message; the rest are ended below
+            for p in procs[1:]:
                 with contextlib.suppress(subprocess.TimeoutExpired):
-                    p.wait(timeout=10)
+                    p.wait(timeout=max(0.0, grace - time.monotonic()))
             return summary
         finally:
             if session is not None:

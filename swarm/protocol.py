@@ -4,17 +4,19 @@ Key expressions, all under one prefix per run, `swarm/<run>/`:
 
     info              queryable: the run's scenario summary and state
     join              queryable: an agent asks to join, the world answers its id
-    obs/<id>          world -> agent: perception for one tick
-    act/<id>          agent -> world: the action for that tick
-    marks/<cell>      agent -> world: a mark write on the agent's cell (merged by min);
+    obs/<group>       world -> agent process: perceptions of its agents for one tick
+    act/<group>       agent process -> world: their actions for that tick
+    marks/<group>     agent process -> world: their mark writes (merged by min);
                       `get swarm/<run>/marks/**` returns the marking environment
     alive/<id>        liveliness token of an agent
     state             world -> anyone: per-tick summary
 
-`cell` is an opaque integer handed to the agent runtime in each observation
-(the controller never sees it).  Every message carries `v` (protocol version)
-and agent messages carry `family` ("grid" now; the continuous controllers to
-come send wheel commands under another family without changing this layout).
+A group is one agent process (`swarm agent --count K` runs K agents): one
+message per process and tick each way, arrays as binary blocks.  `cells` are
+opaque integers handed to the agent runtime (the controller never sees them).
+Every message carries `v` (protocol version) and agent messages carry
+`family` ("grid" now; the continuous controllers to come send wheel commands
+under another family without changing this layout).
 Decoding never raises on bad input: it returns a `Rejected` reason, counted
 by the world.
 """
@@ -23,7 +25,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import msgpack
 import numpy as np
@@ -52,14 +53,14 @@ class Keys:
         self.marks = f"{self.prefix}/marks/**"
         self.alive_all = f"{self.prefix}/alive/*"
 
-    def obs(self, agent: int) -> str:
-        return f"{self.prefix}/obs/{agent}"
+    def obs(self, group: str) -> str:
+        return f"{self.prefix}/obs/{group}"
 
-    def act(self, agent: int) -> str:
-        return f"{self.prefix}/act/{agent}"
+    def act(self, group: str) -> str:
+        return f"{self.prefix}/act/{group}"
 
-    def mark(self, cell: int) -> str:
-        return f"{self.prefix}/marks/{cell}"
+    def mark(self, group: str) -> str:
+        return f"{self.prefix}/marks/{group}"
 
     def alive(self, agent: int) -> str:
         return f"{self.prefix}/alive/{agent}"
@@ -111,8 +112,10 @@ def _ints(message: dict, key: str, length: int) -> np.ndarray | Rejected:
 # ------------------------------------------------------------------- messages
 
 
-def join_request(nonce: str, family: str = FAMILY_GRID, controller: str = "cmarking") -> bytes:
-    return pack({"type": "join", "nonce": nonce, "family": family, "controller": controller})
+def join_request(nonce: str, group: str, family: str = FAMILY_GRID, controller: str = "cmarking") -> bytes:
+    """`group`: the agent process (letters and digits); observations and
+    actions of all agents of one process travel together."""
+    return pack({"type": "join", "nonce": nonce, "group": group, "family": family, "controller": controller})
 
 
 def join_reply(agent: int, nonce: str, info: dict) -> bytes:
@@ -123,20 +126,25 @@ def refuse_reply(reason: str) -> bytes:
     return pack({"type": "refused", "reason": reason})
 
 
-def observation(tick: int, agent: int, cell: int, pi: np.ndarray, pf: np.ndarray) -> bytes:
-    return pack({"type": "obs", "tick": tick, "agent": agent, "cell": cell,
-                 "pi": pi.tolist(), "pf": pf.tolist()})  # fmt: skip
+def observations(tick: int, agents: np.ndarray, cells: np.ndarray, pi: np.ndarray, pf: np.ndarray) -> bytes:
+    """One message for every agent of one agent process: pi (K x PERC_LEN int64)
+    and pf (K x PERC_F_LEN float64) travel as little-endian binary blocks."""
+    return pack({"type": "obs", "tick": tick, "agents": agents.tolist(), "cells": cells.tolist(),
+                 "pi": pi.astype("<i8").tobytes(), "pf": pf.astype("<f8").tobytes()})  # fmt: skip
 
 
-def action(tick: int, agent: int, act: np.ndarray, marked: bool) -> bytes:
-    """`marked`: a mark write for this tick was put on the marks key space (zenoh
-    does not order puts on different keys, so the world waits for both)."""
-    return pack({"type": "act", "family": FAMILY_GRID, "tick": tick, "agent": agent, "act": act.tolist(),
-                 "marked": bool(marked)})  # fmt: skip
+def actions(tick: int, agents: list[int], acts: np.ndarray, marked: list[bool]) -> bytes:
+    """The actions of one agent process for one tick.  `marked[i]`: agent i put a
+    mark write for this tick on the marks key space (zenoh does not order puts
+    on different keys, so the world waits for both)."""
+    return pack({"type": "act", "family": FAMILY_GRID, "tick": tick, "agents": list(agents),
+                 "acts": acts.astype("<i8").tobytes(), "marked": [bool(m) for m in marked]})  # fmt: skip
 
 
-def mark_write(tick: int, agent: int, value: int) -> bytes:
-    return pack({"type": "mark", "family": FAMILY_GRID, "tick": tick, "agent": agent, "value": value})
+def mark_writes(tick: int, agents: list[int], cells: list[int], values: list[int]) -> bytes:
+    """UPDATE-VALUE writes of one agent process for one tick, merged by min."""
+    return pack({"type": "mark", "family": FAMILY_GRID, "tick": tick, "agents": list(agents), "cells": list(cells),
+                 "values": list(values)})  # fmt: skip
 
 
 def stop_message(reason: str) -> bytes:
@@ -146,29 +154,53 @@ def stop_message(reason: str) -> bytes:
 @dataclass(frozen=True)
 class Obs:
     tick: int
-    agent: int
-    cell: int
-    pi: np.ndarray
-    pf: np.ndarray
+    agents: np.ndarray  # (K,)
+    cells: np.ndarray  # (K,)
+    pi: np.ndarray  # (K, PERC_LEN)
+    pf: np.ndarray  # (K, PERC_F_LEN)
 
 
 @dataclass(frozen=True)
-class Act:
+class Acts:
     tick: int
-    agent: int
-    act: np.ndarray
-    marked: bool
+    agents: np.ndarray  # (K,)
+    acts: np.ndarray  # (K, ACT_LEN)
+    marked: np.ndarray  # (K,) bool
 
 
 @dataclass(frozen=True)
-class MarkWrite:
+class Marks:
     tick: int
-    agent: int
-    value: int
+    agents: np.ndarray
+    cells: np.ndarray
+    values: np.ndarray
+
+
+def _int_list(m: dict, key: str, high: int = INT64_MAX) -> np.ndarray | Rejected:
+    values = m.get(key)
+    if not isinstance(values, list) or len(values) > 100_000:
+        return Rejected(f"{key}: expected a list of integers")
+    if not all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= high for v in values):
+        return Rejected(f"{key}: expected integers in range")
+    return np.array(values, dtype=np.int64)
+
+
+def _block(m: dict, key: str, rows: int, cols: int, dtype: str) -> np.ndarray | Rejected:
+    raw = m.get(key)
+    if not isinstance(raw, bytes) or len(raw) != rows * cols * 8:
+        return Rejected(f"{key}: expected {rows}x{cols} binary values")
+    block = np.frombuffer(raw, dtype=dtype).reshape(rows, cols)
+    if dtype == "<f8" and not np.isfinite(block).all():
+        return Rejected(f"{key}: not finite")
+    return block.astype(np.int64 if dtype == "<i8" else np.float64)
+
+
+def _first_rejection(*values):
+    return next((v for v in values if isinstance(v, Rejected)), None)
 
 
 def parse_obs(data: bytes) -> Obs | Rejected | dict:
-    """An observation, or the raw dict of a `stop` message."""
+    """A batch of observations, or the raw dict of a `stop` message."""
     m = unpack(data)
     if isinstance(m, Rejected):
         return m
@@ -176,20 +208,18 @@ def parse_obs(data: bytes) -> Obs | Rejected | dict:
         return m
     if m.get("type") != "obs":
         return Rejected("not an observation")
-    pi = _ints(m, "pi", PERC_LEN)
-    pf = m.get("pf")
-    if isinstance(pi, Rejected):
-        return pi
-    if not isinstance(pf, list) or len(pf) != PERC_F_LEN or not all(isinstance(x, float) for x in pf):
-        return Rejected("pf: expected floats")
-    fields = [_int(m, k) for k in ("tick", "agent", "cell")]
-    for f in fields:
-        if isinstance(f, Rejected):
-            return f
-    return Obs(fields[0], fields[1], fields[2], pi, np.array(pf, dtype=np.float64))
+    tick, agents, cells = _int(m, "tick"), _int_list(m, "agents"), _int_list(m, "cells")
+    if bad := _first_rejection(tick, agents, cells):
+        return bad
+    if len(cells) != len(agents):
+        return Rejected("cells: one per agent")
+    pi, pf = _block(m, "pi", len(agents), PERC_LEN, "<i8"), _block(m, "pf", len(agents), PERC_F_LEN, "<f8")
+    if bad := _first_rejection(pi, pf):
+        return bad
+    return Obs(tick, agents, cells, pi, pf)
 
 
-def parse_act(data: bytes) -> Act | Rejected:
+def parse_acts(data: bytes) -> Acts | Rejected:
     m = unpack(data)
     if isinstance(m, Rejected):
         return m
@@ -197,27 +227,31 @@ def parse_act(data: bytes) -> Act | Rejected:
         return Rejected("not an action")
     if m.get("family") not in FAMILIES:
         return Rejected("unknown controller family")
-    tick, agent = _int(m, "tick"), _int(m, "agent")
-    act = _ints(m, "act", ACT_LEN)
-    for f in (tick, agent, act):
-        if isinstance(f, Rejected):
-            return f
-    if not isinstance(m.get("marked"), bool):
-        return Rejected("marked: expected true or false")
-    return Act(tick, agent, act, m["marked"])
+    tick, agents = _int(m, "tick"), _int_list(m, "agents")
+    if bad := _first_rejection(tick, agents):
+        return bad
+    acts = _block(m, "acts", len(agents), ACT_LEN, "<i8")
+    if isinstance(acts, Rejected):
+        return acts
+    marked = m.get("marked")
+    if not isinstance(marked, list) or len(marked) != len(agents) or not all(isinstance(x, bool) for x in marked):
+        return Rejected("marked: expected one true or false per agent")
+    return Acts(tick, agents, acts, np.array(marked, dtype=bool))
 
 
-def parse_mark(data: bytes) -> MarkWrite | Rejected:
+def parse_marks(data: bytes) -> Marks | Rejected:
     m = unpack(data)
     if isinstance(m, Rejected):
         return m
     if m.get("type") != "mark" or m.get("family") not in FAMILIES:
         return Rejected("not a mark write")
-    tick, agent, value = _int(m, "tick"), _int(m, "agent"), _int(m, "value", 0, 2**62)
-    for f in (tick, agent, value):
-        if isinstance(f, Rejected):
-            return f
-    return MarkWrite(tick, agent, value)
+    tick = _int(m, "tick")
+    agents, cells, values = _int_list(m, "agents"), _int_list(m, "cells"), _int_list(m, "values", 2**62)
+    if bad := _first_rejection(tick, agents, cells, values):
+        return bad
+    if not len(agents) == len(cells) == len(values):
+        return Rejected("agents, cells, values: one each per write")
+    return Marks(tick, agents, cells, values)
 
 
 def parse_join(data: bytes) -> dict | Rejected:
@@ -226,10 +260,9 @@ def parse_join(data: bytes) -> dict | Rejected:
         return m
     if m.get("type") != "join" or not isinstance(m.get("nonce"), str) or len(m["nonce"]) > 128:
         return Rejected("not a join request")
+    group = m.get("group")
+    if not isinstance(group, str) or not 0 < len(group) <= 64 or not group.isalnum():
+        return Rejected("group: expected 1 to 64 letters and digits")
     if m.get("family") not in FAMILIES:
         return Rejected("unknown controller family")
     return m
-
-
-def describe(value: Any) -> str:
-    return value.reason if isinstance(value, Rejected) else "ok"

@@ -56,24 +56,64 @@ def test_bad_traffic_is_counted_and_changes_nothing():
 
     def attack(endpoint, keys):
         s = open_client(endpoint)
+        stay = np.array([[4, 0, 0, 0, 0, 0, 0]], dtype=np.int64)
         try:
-            s.put(keys.act(0), b"\x00\xffgarbage")  # not msgpack
-            s.put(keys.act(0), proto.pack({"type": "act", "tick": "soon"}))  # wrong schema
-            s.put(keys.act(1), proto.action(0, 0, np.zeros(7, np.int64), False))  # another agent's id
-            s.put(keys.act(0), proto.action(0, 0, np.array([9, 0, 0, 0, 0, 0, 0]), False))  # out of range
-            s.put(keys.act(0), proto.pack({"type": "act", "family": "grid", "tick": float("nan"), "agent": 0,
-                                           "act": [4] * 7, "marked": False}))  # fmt: skip
-            s.put(keys.act(0), proto.pack({"type": "act", "family": "grid", "tick": 0, "agent": 2**64 - 1,
-                                           "act": [4] * 7, "marked": False}))  # fmt: skip
-            s.put(keys.mark(0), proto.mark_write(0, 0, 0))  # a mark far below what UPDATE-VALUE allows
-            s.put(keys.act(0), proto.pack({"type": "act", "family": "bees", "tick": 0, "agent": 0,
-                                           "act": [4] * 7, "marked": False}))  # fmt: skip
+            s.put(keys.act("intruder"), b"\x00\xffgarbage")  # not msgpack
+            s.put(keys.act("intruder"), proto.pack({"type": "act", "tick": "soon"}))  # wrong schema
+            s.put(keys.act("intruder"), proto.actions(0, [0], stay, [False]))  # another process's agent
+            s.put(keys.act("intruder"), proto.actions(0, [99], stay, [False]))  # unknown agent
+            s.put(
+                keys.act("intruder"),
+                proto.pack(
+                    {
+                        "type": "act",
+                        "family": "grid",
+                        "tick": float("nan"),
+                        "agents": [0],
+                        "acts": stay.tobytes(),
+                        "marked": [False],
+                    }
+                ),
+            )
+            s.put(
+                keys.act("intruder"),
+                proto.pack(
+                    {
+                        "type": "act",
+                        "family": "grid",
+                        "tick": 0,
+                        "agents": [2**64 - 1],
+                        "acts": stay.tobytes(),
+                        "marked": [False],
+                    }
+                ),
+            )
+            s.put(
+                keys.act("intruder"),
+                proto.pack(
+                    {"type": "act", "family": "grid", "tick": 0, "agents": [0], "acts": b"short", "marked": [False]}
+                ),
+            )
+            s.put(
+                keys.act("intruder"),
+                proto.pack(
+                    {
+                        "type": "act",
+                        "family": "bees",
+                        "tick": 0,
+                        "agents": [0],
+                        "acts": stay.tobytes(),
+                        "marked": [False],
+                    }
+                ),
+            )
+            s.put(keys.mark("intruder"), proto.mark_writes(0, [0], [0], [0]))  # a forged mark
             for _ in range(300):  # a flood
-                s.put(keys.act(5), b"\x93\x01\x02")
+                s.put(keys.act("flood"), b"\x93\x01\x02")
             replies = list(s.get(keys.marks, timeout=5.0))
             assert replies and replies[0].ok is not None
         finally:
-            s.close()
+            s.close()  # fmt: skip
 
     summary, world = _run_distributed(scenario, "attack", attack=attack)
     assert summary["rejected_messages"] >= 300
@@ -218,25 +258,26 @@ def test_swarm_up_equals_swarm_run_and_leaves_no_process(tmp_path):
     assert _children_alive("upeq") == []
 
 
-def test_ctrl_c_stops_swarm_up_and_every_child(tmp_path):
+@pytest.mark.parametrize("signum", ["SIGINT", "SIGTERM"])
+def test_ctrl_c_stops_swarm_up_and_every_child(tmp_path, signum):
     import signal
     import subprocess
     import sys
     import time
 
     up = subprocess.Popen([sys.executable, "-m", "swarm", "up", "setup1", "--agents", "4", "--seed", "1",
-                           "--run-id", "ctrlc", "--listen", free_endpoint()], stdout=subprocess.PIPE,
+                           "--run-id", f"ctrlc{signum}", "--listen", free_endpoint()], stdout=subprocess.PIPE,
                           stderr=subprocess.PIPE, text=True, cwd=tmp_path)  # fmt: skip
     try:
         deadline = time.monotonic() + 120
-        while len(_children_alive("ctrlc")) < 5:  # the world and 4 agents
+        while len(_children_alive(f"ctrlc{signum}")) < 5:  # the world and 4 agents
             assert time.monotonic() < deadline and up.poll() is None, up.stderr.read()[-2000:]
             time.sleep(0.1)
         time.sleep(1.0)
-        up.send_signal(signal.SIGINT)
+        up.send_signal(getattr(signal, signum))
         assert up.wait(timeout=30) == 130
         time.sleep(0.5)
-        assert _children_alive("ctrlc") == []
+        assert _children_alive(f"ctrlc{signum}") == []
     finally:
         if up.poll() is None:
             up.kill()

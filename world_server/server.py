@@ -32,9 +32,10 @@ from agents.controllers.layout import (
     A_TRAIL_OP,
     A_UNLOAD,
     MARK_NONE,
+    PERC_F_LEN,
+    PERC_LEN,
     STAY,
     TRAIL_ERASE,
-    new_perception,
 )  # fmt: skip
 from swarm import protocol as proto
 from swarm.bus import open_client, open_router
@@ -100,6 +101,7 @@ class WorldServer:
         self.mark_due = np.zeros(scenario.agents, dtype=bool)  # its action announced a mark write
         self.mark_got = np.zeros(scenario.agents, dtype=bool)  # that mark write arrived
         self.nonces: dict[str, int] = {}
+        self.group_of: dict[int, str] = {}  # agent -> its agent process (message group)
         self.stats = Stats()
         self.tick = 0
         self.events: queue.Queue = queue.Queue()
@@ -119,7 +121,6 @@ class WorldServer:
             self.session.declare_subscriber(k.marks, lambda s: put(("mark", s))),
             self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s))),
         ]
-        self._pi, self._pf = new_perception()
 
     # ------------------------------------------------------------ persistence
 
@@ -141,12 +142,14 @@ class WorldServer:
         self.stats.joins = int(state["stats"].get("joins", 0))
         self.stats.agents_lost = int(state["stats"].get("agents_lost", 0))
         self.stats.rejected = dict(state["stats"].get("rejected", {}))
+        self.group_of = {int(a): g for a, g in state["stats"].get("groups", {}).items()}
         return True
 
     def save_state(self) -> None:
         if self.state_file is None:
             return
-        stats = {"joins": self.stats.joins, "agents_lost": self.stats.agents_lost, "rejected": self.stats.rejected}
+        stats = {"joins": self.stats.joins, "agents_lost": self.stats.agents_lost, "rejected": self.stats.rejected,
+                 "groups": {str(a): g for a, g in self.group_of.items()}}  # fmt: skip
         persist.save(self.state_file, self.world, self.tick, self.slots, stats, self.scenario.describe())
 
     # ---------------------------------------------------------------- messages
@@ -193,6 +196,7 @@ class WorldServer:
             if self.slots[agent] == LOST:
                 self.world.new_body(agent)
             self.nonces[nonce] = agent
+            self.group_of[agent] = request["group"]
             self.slots[agent] = JOINING
             self.misses[agent] = 0
             self.stats.joins += 1
@@ -226,52 +230,56 @@ class WorldServer:
     def _on_act(self, sample) -> None:
         raw = sample.payload.to_bytes()
         self.bytes_in += len(raw)
-        msg = proto.parse_act(raw)
+        msg = proto.parse_acts(raw)
         if isinstance(msg, proto.Rejected):
             self.stats.reject(f"act: {msg.reason}")
             return
-        a = msg.agent
-        if self._sender(sample) != a:
-            self.stats.reject("act: names another agent's id")
-        elif not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
-            self.stats.reject("act: unknown agent")
-        elif not self._current(msg.tick):
-            self.stats.late_actions += 1
-            self.stats.reject("act: not for this tick")
-        elif self.acted[a] and self.mode == "lockstep":  # in real time the latest action wins
-            self.stats.reject("act: second action in one tick")
-        elif not _valid_action(msg.act):
-            self.stats.reject("act: out-of-range action")
-        else:
-            act = self.world.acts[a]
-            act[:] = msg.act
-            act[A_MARK] = MARK_NONE  # marks travel on the marks key space
-            self.acted[a] = True
-            self.mark_due[a] = msg.marked
+        group = str(sample.key_expr).rsplit("/", 1)[1]
+        for a, act, marked in zip(msg.agents.tolist(), msg.acts, msg.marked.tolist(), strict=True):
+            if not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
+                self.stats.reject("act: unknown agent")
+            elif self.group_of.get(a) != group:
+                self.stats.reject("act: names an agent of another process")
+            elif not self._current(msg.tick):
+                self.stats.late_actions += 1
+                self.stats.reject("act: not for this tick")
+            elif self.acted[a] and self.mode == "lockstep":  # in real time the latest action wins
+                self.stats.reject("act: second action in one tick")
+            elif not _valid_action(act):
+                self.stats.reject("act: out-of-range action")
+            else:
+                row = self.world.acts[a]
+                row[:] = act
+                row[A_MARK] = MARK_NONE  # marks travel on the marks key space
+                self.acted[a] = True
+                self.mark_due[a] = marked
 
     def _on_mark(self, sample) -> None:
         raw = sample.payload.to_bytes()
         self.bytes_in += len(raw)
-        msg = proto.parse_mark(raw)
+        msg = proto.parse_marks(raw)
         if isinstance(msg, proto.Rejected):
             self.stats.reject(f"mark: {msg.reason}")
             return
-        a, w = msg.agent, self.world
-        cell = self._sender(sample)
+        group = str(sample.key_expr).rsplit("/", 1)[1]
+        w = self.world
         width = w.layers.shape[2]
-        if not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
-            self.stats.reject("mark: unknown agent")
-        elif not self._current(msg.tick) or (
-            self.mode == "lockstep" and (self.mark_got[a] or (self.acted[a] and not self.mark_due[a]))
-        ):
-            self.stats.reject("mark: not for this tick")
-        elif cell is None or cell != w.pos[a, 0] * width + w.pos[a, 1]:
-            self.stats.reject("mark: not the agent's cell")
-        elif msg.value < _update_bound(w.layers, int(w.pos[a, 0]), int(w.pos[a, 1])):
-            self.stats.reject("mark: lower than UPDATE-VALUE allows")
-        else:
-            write_mark(w.layers, int(w.pos[a, 0]), int(w.pos[a, 1]), np.int64(msg.value), w.counters)
-            self.mark_got[a] = True
+        for a, cell, value in zip(msg.agents.tolist(), msg.cells.tolist(), msg.values.tolist(), strict=True):
+            if not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
+                self.stats.reject("mark: unknown agent")
+            elif self.group_of.get(a) != group:
+                self.stats.reject("mark: names an agent of another process")
+            elif not self._current(msg.tick) or (
+                self.mode == "lockstep" and (self.mark_got[a] or (self.acted[a] and not self.mark_due[a]))
+            ):
+                self.stats.reject("mark: not for this tick")
+            elif cell != w.pos[a, 0] * width + w.pos[a, 1]:
+                self.stats.reject("mark: not the agent's cell")
+            elif value < _update_bound(w.layers, int(w.pos[a, 0]), int(w.pos[a, 1])):
+                self.stats.reject("mark: lower than UPDATE-VALUE allows")
+            else:
+                write_mark(w.layers, int(w.pos[a, 0]), int(w.pos[a, 1]), np.int64(value), w.counters)
+                self.mark_got[a] = True
 
     def _current(self, tick: int) -> bool:
         """Lock-step: only this tick.  Real time: this tick or the two before
@@ -329,14 +337,16 @@ class WorldServer:
         w.acts[:, A_MOVE] = STAY
         w.acts[:, A_MARK] = MARK_NONE
         w.acts[:, A_TRAIL_OP:] = 0
-        width = w.layers.shape[2]
-        for a in active:
+        for group, agents in self._groups(active).items():
+            pi = np.zeros((len(agents), PERC_LEN), dtype=np.int64)
+            pf = np.zeros((len(agents), PERC_F_LEN), dtype=np.float64)
             if not self.null:
-                w.perceive(int(a), self._pi, self._pf)
-            cell = int(w.pos[a, 0] * width + w.pos[a, 1])
-            payload = proto.observation(tick, int(a), cell, self._pi, self._pf)
+                for i, a in enumerate(agents):
+                    w.perceive(int(a), pi[i], pf[i])
+            cells = w.pos[agents, 0] * w.layers.shape[2] + w.pos[agents, 1]
+            payload = proto.observations(tick, agents, cells, pi, pf)
             self.bytes_out += len(payload)
-            self.session.put(self.keys.obs(int(a)), payload)
+            self.session.put(self.keys.obs(group), payload)
         if self.mode == "lockstep":  # a barrier: until all have answered or the deadline
             deadline = time.monotonic() + self.deadline
             while not self.answered(active).all():
@@ -367,6 +377,12 @@ class WorldServer:
             self.save_state()
         self.tick_seconds.append(time.perf_counter() - started)
         self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress()}))
+
+    def _groups(self, agents: np.ndarray) -> dict[str, np.ndarray]:
+        groups: dict[str, list[int]] = {}
+        for a in agents.tolist():
+            groups.setdefault(self.group_of[a], []).append(a)
+        return {g: np.array(members, dtype=np.int64) for g, members in groups.items()}
 
     def answered(self, agents: np.ndarray) -> np.ndarray:
         if self.mode == "realtime":
@@ -424,8 +440,8 @@ class WorldServer:
                 "agent_steps": self.agent_steps}  # fmt: skip
 
     def stop_agents(self, reason: str) -> None:
-        for a in range(len(self.slots)):
-            self.session.put(self.keys.obs(a), proto.stop_message(reason))
+        for group in set(self.group_of.values()):
+            self.session.put(self.keys.obs(group), proto.stop_message(reason))
 
     def close(self) -> None:
         for d in self._decls:
