@@ -97,14 +97,7 @@ def build_parser() -> argparse.ArgumentParser:
     where.add_argument("--listen", default="tcp/127.0.0.1:7447", metavar="ENDPOINT",
                        help="host a router listening here (default tcp/127.0.0.1:7447)")  # fmt: skip
     where.add_argument("--connect", metavar="ENDPOINT", help="join an existing router instead")
-    world.add_argument("--deadline", type=float, default=2.0, metavar="S", help="per-tick deadline in seconds")
-    world.add_argument(
-        "--mode",
-        choices=["lockstep", "realtime"],
-        default="lockstep",
-        help="lockstep: barrier per tick (equals swarm run); realtime: fixed rate, latest action wins",
-    )
-    world.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="ticks per second in realtime mode")
+    _tick_args(world)
     world.add_argument("--max-misses", type=_positive, default=3, metavar="K",
                        help="an agent that misses K ticks in a row is lost (default 3)")  # fmt: skip
     world.add_argument("--summary-file", metavar="FILE", help="also write the summary JSON here")
@@ -140,19 +133,23 @@ def build_parser() -> argparse.ArgumentParser:
         "processes, show progress, and print the run summary.",
     )
     _scenario_args(up)
-    up.add_argument(
+    _tick_args(up)
+    up.add_argument("--run-id", help="key space swarm/<run-id>/... (default: a fresh id)")
+    up.add_argument("--listen", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router's endpoint")
+
+    sub.add_parser("scenarios", help="list presets and bundled scenarios")
+    return parser
+
+
+def _tick_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
         "--mode",
         choices=["lockstep", "realtime"],
         default="lockstep",
         help="lockstep: barrier per tick (equals swarm run); realtime: fixed rate, latest action wins",
     )
-    up.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="ticks per second in realtime mode")
-    up.add_argument("--run-id", help="key space swarm/<run-id>/... (default: a fresh id)")
-    up.add_argument("--listen", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router's endpoint")
-    up.add_argument("--deadline", type=float, default=2.0, metavar="S", help="per-tick deadline in seconds")
-
-    sub.add_parser("scenarios", help="list presets and bundled scenarios")
-    return parser
+    p.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="ticks per second in realtime mode")
+    p.add_argument("--deadline", type=float, default=2.0, metavar="S", help="lock-step: per-tick deadline in seconds")
 
 
 def _scenario_args(p: argparse.ArgumentParser) -> None:

@@ -227,14 +227,21 @@ class WorldServer:
         except ValueError:
             return None
 
-    def _on_act(self, sample) -> None:
+    def _receive(self, sample, parse, what: str):
+        """(message, sending group), or None after counting a rejection."""
         raw = sample.payload.to_bytes()
         self.bytes_in += len(raw)
-        msg = proto.parse_acts(raw)
+        msg = parse(raw)
         if isinstance(msg, proto.Rejected):
-            self.stats.reject(f"act: {msg.reason}")
+            self.stats.reject(f"{what}: {msg.reason}")
+            return None
+        return msg, str(sample.key_expr).rsplit("/", 1)[1]
+
+    def _on_act(self, sample) -> None:
+        received = self._receive(sample, proto.parse_acts, "act")
+        if received is None:
             return
-        group = str(sample.key_expr).rsplit("/", 1)[1]
+        msg, group = received
         for a, act, marked in zip(msg.agents.tolist(), msg.acts, msg.marked.tolist(), strict=True):
             if not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
                 self.stats.reject("act: unknown agent")
@@ -255,13 +262,10 @@ class WorldServer:
                 self.mark_due[a] = marked
 
     def _on_mark(self, sample) -> None:
-        raw = sample.payload.to_bytes()
-        self.bytes_in += len(raw)
-        msg = proto.parse_marks(raw)
-        if isinstance(msg, proto.Rejected):
-            self.stats.reject(f"mark: {msg.reason}")
+        received = self._receive(sample, proto.parse_marks, "mark")
+        if received is None:
             return
-        group = str(sample.key_expr).rsplit("/", 1)[1]
+        msg, group = received
         w = self.world
         width = w.layers.shape[2]
         for a, cell, value in zip(msg.agents.tolist(), msg.cells.tolist(), msg.values.tolist(), strict=True):
