@@ -21,6 +21,8 @@ from pathlib import Path
 from agents.controllers import warm_up
 from swarm import protocol as proto
 from swarm.bus import open_client
+from swarm.scenario import load_scenario
+from world_server.grid import GridWorld
 
 
 def _terminate(procs: list[subprocess.Popen], grace: float = 5.0) -> None:
@@ -60,7 +62,8 @@ def _raise_interrupt(signum, frame):
 
 def _swarm_up(scenario_ref, agents, controller, seed, run_id, listen, until, max_iterations, deadline, progress,
               per_process, null, mode, rate) -> dict:  # fmt: skip
-    warm_up()  # once here, so N agents starting together find it in the cache
+    warm_up()  # once here, so N agents starting together find the kernels in the cache,
+    GridWorld(load_scenario(scenario_ref).with_overrides(agents=1)).warm_up()  # and so does the world
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
         summary_file = Path(tmp) / "summary.json"
@@ -103,7 +106,7 @@ def _swarm_up(scenario_ref, agents, controller, seed, run_id, listen, until, max
             _terminate(procs)
 
 
-def _connect(listen: str, world: subprocess.Popen, timeout: float = 60.0):
+def _connect(listen: str, world: subprocess.Popen, timeout: float = 300.0):
     """A client session to the world's router, or None if the world exits first."""
     deadline = time.monotonic() + timeout
     while world.poll() is None:
