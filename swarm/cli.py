@@ -54,6 +54,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--agents", type=_positive, help="number of agents (default: the scenario's)")
     run.add_argument("--controller", choices=["cmarking", "marking", "ant"], help="controller to run")
     run.add_argument("--seed", type=_seed, help="seed of the map and of every random choice")
+    _physics_args(run)
+    run.add_argument("--record", metavar="FILE", help="write a rerun recording of the run to FILE (.rrd)")
+    run.add_argument("--viewer", nargs="?", const="spawn", metavar="URL",
+                     help="also stream to a live rerun viewer: spawn one here, or give its gRPC URL "
+                     "(rerun+http://HOST:9876/proxy); needs --record")  # fmt: skip
     run.add_argument(
         "--until",
         choices=["foraged", "converged", "both"],
@@ -152,11 +157,33 @@ def _tick_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--deadline", type=float, default=2.0, metavar="S", help="lock-step: per-tick deadline in seconds")
 
 
+def _viewer_url(viewer: str | None) -> str | None:
+    """`--viewer` alone spawns a native viewer here and streams to it."""
+    if viewer != "spawn":
+        return viewer
+    import rerun as rr
+
+    try:
+        rr.spawn(port=9876, connect=False)
+    except Exception as exc:  # no binary, no display: say so, keep recording to the file
+        print(f"swarm: could not start a rerun viewer here ({exc}); recording to the file only", file=sys.stderr)
+        return None
+    return "rerun+http://127.0.0.1:9876/proxy"
+
+
+def _physics_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--physics", choices=["ideal", "physical"],
+                   help="robot bodies: ideal = instant cell-to-cell moves, the paper's (default); physical = pymunk "
+                   "discs that drive between cell centres, collide and queue")  # fmt: skip
+    p.add_argument("--body-diameter", type=float, metavar="D", help="physical bodies' diameter in cells (default 0.4)")
+
+
 def _scenario_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", metavar="SCENARIO", help=f"a TOML file, a preset ({PRESET_HELP}) or a bundled name")
     p.add_argument("--agents", type=_positive, help="number of agents (default: the scenario's)")
     p.add_argument("--controller", choices=["cmarking", "marking", "ant"], help="controller to run")
     p.add_argument("--seed", type=_seed, help="seed of the map and of every random choice")
+    _physics_args(p)
     p.add_argument("--until", choices=["foraged", "converged", "both"], default="foraged", help="when the run ends")
     p.add_argument("--max-iterations", type=_positive, default=1_000_000, metavar="M", help="stop after M ticks")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
@@ -202,7 +229,13 @@ def _print_summary(summary: dict, as_json: bool, until: str) -> int:
 
 
 def _scenario(args):
-    return load_scenario(args.scenario).with_overrides(agents=args.agents, controller=args.controller, seed=args.seed)
+    return load_scenario(args.scenario).with_overrides(
+        agents=args.agents,
+        controller=args.controller,
+        seed=args.seed,
+        physics=args.physics,
+        body_diameter=args.body_diameter,
+    )
 
 
 def cmd_world(args) -> int:
@@ -240,18 +273,32 @@ def cmd_up(args) -> int:
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
     summary = swarm_up(args.scenario, scenario.agents, scenario.controller, args.seed, args.run_id or new_run_id(),
                        args.listen, args.until, args.max_iterations, args.deadline,
-                       progress=not args.json and sys.stderr.isatty(), mode=args.mode, rate=args.rate)  # fmt: skip
+                       progress=not args.json and sys.stderr.isatty(), mode=args.mode, rate=args.rate,
+                       physics=scenario.physics)  # fmt: skip
     return _print_summary(summary, args.json, args.until)
 
 
 def cmd_run(args) -> int:
     from swarm.engine import Engine
 
-    scenario = load_scenario(args.scenario).with_overrides(
-        agents=args.agents, controller=args.controller, seed=args.seed
-    )
+    scenario = _scenario(args)
     engine = Engine(scenario)
-    summary = engine.run(args.until, args.max_iterations, progress=not args.json and sys.stderr.isatty()).summary
+    recorder = None
+    if args.record:
+        from swarm.recording import Recorder, run_meta
+
+        meta = run_meta(scenario, engine.world, Path(args.record).stem, args.until, "in-process")
+        recorder = Recorder(args.record, engine.world, meta, viewer=_viewer_url(args.viewer))
+    summary = None
+    try:
+        summary = engine.run(args.until, args.max_iterations, progress=not args.json and sys.stderr.isatty(),
+                             recorder=recorder).summary  # fmt: skip
+    finally:
+        if recorder is not None:
+            recorder.close(summary)
+    if recorder is not None:
+        print(f"recording: {args.record}  (open it: swarm replay {args.record}; numbers and plots: "
+              f"swarm report {args.record})", file=sys.stderr)  # fmt: skip
     return _print_summary(summary, args.json, args.until)
 
 

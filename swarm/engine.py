@@ -46,6 +46,14 @@ def is_done(until, counters, total, reachable):
 
 
 @njit(cache=True)
+def decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, mem, acts, cparams, seed, tick, pi, pf):
+    """Steps 1-2 of the tick: every agent perceives the start-of-tick world and chooses."""
+    for a in range(pos.shape[0]):
+        perceive(layers, pher, pher_on, base_r, base_c, pos[a, 0], pos[a, 1], payload[a], pi, pf)
+        step_controller(kind, pi, pf, mem[a], acts[a], cparams, seed, a, tick)
+
+
+@njit(cache=True)
 def run_ticks(
     kind, layers, pher, pher_scratch, base_r, base_c, pos, payload, mem, acts,
     cparams, wparams, counters, pher_on, seed, tick0, n_ticks, until, total, reachable,
@@ -53,12 +61,9 @@ def run_ticks(
     """Run up to n_ticks ticks from tick0; stop early once `until` holds.
     Returns the number of ticks run."""
     pi, pf = np.empty(PERC_LEN, np.int64), np.empty(PERC_F_LEN, np.float64)
-    n = pos.shape[0]
     for t in range(n_ticks):
         tick = tick0 + t
-        for a in range(n):
-            perceive(layers, pher, pher_on, base_r, base_c, pos[a, 0], pos[a, 1], payload[a], pi, pf)
-            step_controller(kind, pi, pf, mem[a], acts[a], cparams, seed, a, tick)
+        decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, mem, acts, cparams, seed, tick, pi, pf)
         resolve_tick(layers, pher, pher_scratch, base_r, base_c, pos, payload, acts, tick, wparams, counters, pher_on)
         if is_done(until, counters, total, reachable):
             return t + 1
@@ -94,14 +99,30 @@ class Engine:
         """Run up to n ticks (fewer if `until` is reached); return ticks run."""
         w = self.world
         started = time.perf_counter()
-        ran = run_ticks(
-            self.kind, w.layers, w.pher, w.pher_scratch, w.base[0], w.base[1], w.pos, w.payload,
-            self.mem, w.acts, self.cparams, w.wparams, w.counters, w.pheromone_on, np.int64(self.scenario.seed),
-            self.tick, n, UNTIL[until], w.total, w.reachable,
-        )  # fmt: skip
+        if w.bodies.physical:
+            ran = self._step_physical(n, until)
+        else:
+            ran = run_ticks(
+                self.kind, w.layers, w.pher, w.pher_scratch, w.base[0], w.base[1], w.pos, w.payload,
+                self.mem, w.acts, self.cparams, w.wparams, w.counters, w.pheromone_on, np.int64(self.scenario.seed),
+                self.tick, n, UNTIL[until], w.total, w.reachable,
+            )  # fmt: skip
         self.wall_seconds += time.perf_counter() - started
         self.tick += int(ran)
         return int(ran)
+
+    def _step_physical(self, n: int, until: str) -> int:
+        """Tick by tick: the bodies' simulation (pymunk) sits between deciding and the grid rules."""
+        w = self.world
+        pi, pf = np.empty(PERC_LEN, np.int64), np.empty(PERC_F_LEN, np.float64)
+        seed = np.int64(self.scenario.seed)
+        for t in range(n):
+            decide_all(self.kind, w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload,
+                       self.mem, w.acts, self.cparams, seed, self.tick + t, pi, pf)  # fmt: skip
+            w.resolve(self.tick + t)
+            if self.done(until):
+                return t + 1
+        return n
 
     def done(self, until: str = "foraged") -> bool:
         w = self.world
@@ -113,7 +134,11 @@ class Engine:
         max_iterations: int = DEFAULT_MAX_ITERATIONS,
         progress: bool = False,
         chunk: int = 5000,
+        recorder=None,
     ) -> RunResult:
+        """Run to `until` (or max_iterations).  With a `recorder`
+        (swarm.recording.Recorder) the engine goes one tick at a time and the
+        recorder captures each."""
         if until not in UNTIL:
             raise ValueError(f"unknown --until {until!r}: choose foraged, converged or both")
         if until != "foraged" and self.scenario.controller == "ant":
@@ -123,10 +148,17 @@ class Engine:
             from tqdm import tqdm
 
             bar = tqdm(total=self.world.total, unit="unit", desc="delivered", leave=False)
+        shown = 0.0
         try:
             while not self.done(until) and self.tick < max_iterations:
-                self.step(min(chunk, max_iterations - self.tick), until)
-                if bar is not None:
+                if recorder is None:
+                    self.step(min(chunk, max_iterations - self.tick), until)
+                else:
+                    started = time.perf_counter()
+                    self.step(1, until)
+                    recorder.capture(self.tick - 1, tick_ms=(time.perf_counter() - started) * 1000)
+                if bar is not None and time.monotonic() - shown > 0.1:
+                    shown = time.monotonic()
                     bar.n = self.world.delivered
                     bar.set_postfix(tick=self.tick, explored=int(self.world.counters[C_EXPLORED]))
                     bar.refresh()
@@ -158,4 +190,5 @@ class Engine:
             "grid": list(w.layout.shape),
             "wall_seconds": round(self.wall_seconds, 4),
             "agent_steps_per_second": round(steps / self.wall_seconds) if self.wall_seconds else None,
+            **w.bodies.summary(s.agents),
         }

@@ -21,7 +21,7 @@ from pathlib import Path
 from agents.controllers import warm_up
 from swarm import protocol as proto
 from swarm.bus import open_client
-from swarm.scenario import load_scenario
+from swarm.scenario import PhysicsParams, load_scenario
 from world_server.grid import GridWorld
 
 
@@ -42,6 +42,7 @@ def swarm_up(
     scenario_ref: str, agents: int, controller: str, seed: int | None, run_id: str, listen: str,
     until: str = "foraged", max_iterations: int = 1_000_000, deadline: float = 2.0, progress: bool = True,
     per_process: int = 1, null: bool = False, mode: str = "lockstep", rate: float = 20.0,
+    physics: PhysicsParams | None = None,
 ) -> dict:  # fmt: skip
     """Run the swarm as processes; `per_process` agents share one agent process
     (`swarm agent --count`), `null` runs the benchmark floor (messaging only)."""
@@ -51,7 +52,7 @@ def swarm_up(
     previous = signal.signal(signal.SIGTERM, _raise_interrupt)
     try:
         return _swarm_up(scenario_ref, agents, controller, seed, run_id, listen, until, max_iterations, deadline,
-                         progress, per_process, null, mode, rate)  # fmt: skip
+                         progress, per_process, null, mode, rate, physics or PhysicsParams())  # fmt: skip
     finally:
         signal.signal(signal.SIGTERM, previous)
 
@@ -61,7 +62,7 @@ def _raise_interrupt(signum, frame):
 
 
 def _swarm_up(scenario_ref, agents, controller, seed, run_id, listen, until, max_iterations, deadline, progress,
-              per_process, null, mode, rate) -> dict:  # fmt: skip
+              per_process, null, mode, rate, physics) -> dict:  # fmt: skip
     warm_up()  # once here, so N agents starting together find the kernels in the cache,
     GridWorld(load_scenario(scenario_ref).with_overrides(agents=1)).warm_up()  # and so does the world
     python = [sys.executable, "-m", "swarm"]
@@ -73,6 +74,7 @@ def _swarm_up(scenario_ref, agents, controller, seed, run_id, listen, until, max
                      "--start-timeout", str(60 + 3 * agents), "--mode", mode, "--rate", str(rate)]  # fmt: skip
         if seed is not None:
             world_cmd += ["--seed", str(seed)]
+        world_cmd += ["--physics", physics.mode, "--body-diameter", repr(physics.diameter)]
         agent_cmd = [*python, "agent", "--controller", controller, "--connect", listen, "--run-id", run_id,
                      "--count", str(per_process)]  # fmt: skip
         if null:

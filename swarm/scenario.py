@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import re
 import tomllib
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -60,6 +60,21 @@ class CMarkingParams:
     climb_patience: int = 20
 
 
+PHYSICS_MODES = ("ideal", "physical")
+
+
+@dataclass(frozen=True)
+class PhysicsParams:
+    """Robot bodies (world_server/bodies.py).  Lengths in cells, times in seconds."""
+
+    mode: str = "ideal"  # ideal: instant cell-to-cell moves (the paper); physical: pymunk discs
+    diameter: float = 0.4  # body diameter (two fit side by side in a corridor)
+    speed: float = 2.0  # top speed, cells per second
+    timeout: float = 2.0  # longest simulated time one tick may take
+    dt: float = 0.05  # physics step
+    arrive: float = 0.2  # a body has reached a cell when its centre is this close to the cell's centre
+
+
 @dataclass(frozen=True)
 class Layout:
     """A concrete world: obstacles, resource quantities, base, BFS distances."""
@@ -91,18 +106,31 @@ class Scenario:
     generator: Generator | None = None
     ant: AntParams = field(default_factory=AntParams)
     cmarking: CMarkingParams = field(default_factory=CMarkingParams)
+    physics: PhysicsParams = field(default_factory=PhysicsParams)
     map_first_line: int = 0  # file line of the first map row, for messages
 
     def with_overrides(
-        self, agents: int | None = None, controller: str | None = None, seed: int | None = None
+        self,
+        agents: int | None = None,
+        controller: str | None = None,
+        seed: int | None = None,
+        physics: str | None = None,
+        body_diameter: float | None = None,
     ) -> Scenario:
+        body = self.physics
+        if physics is not None:
+            body = replace(body, mode=physics)
+        if body_diameter is not None:
+            body = replace(body, diameter=body_diameter)
         new = replace(
             self,
             agents=self.agents if agents is None else agents,
             controller=self.controller if controller is None else controller,
             seed=self.seed if seed is None else seed,
+            physics=body,
         )
         _check_run_fields(new, "command line")
+        _check_physics(new.physics, "command line")
         return new
 
     def layout(self) -> Layout:
@@ -130,6 +158,7 @@ class Scenario:
             }
         else:
             d["map"] = "\n".join(self.ascii_map or ())
+        d["physics"] = asdict(self.physics)
         return d
 
 
@@ -188,7 +217,7 @@ def load_scenario(ref: str) -> Scenario:
 # --------------------------------------------------------------------- parsing
 
 _TOP_KEYS = {"name", "seed", "agents", "controller", "q_max", "quantity", "map", "generator"}
-_TOP_KEYS |= {"ant", "cmarking"}
+_TOP_KEYS |= {"ant", "cmarking", "physics"}
 
 
 def parse_scenario_text(text: str, source: str = "<string>") -> Scenario:
@@ -244,6 +273,14 @@ def parse_scenario_text(text: str, source: str = "<string>") -> Scenario:
         section = _section(data, "cmarking", source)
         _no_unknown(section, set(CMarkingParams.__dataclass_fields__), source, "[cmarking]")
         kw["cmarking"] = CMarkingParams(**{k: _typed(section, k, int, source, f"cmarking.{k}") for k in section})
+    if "physics" in data:
+        section = _section(data, "physics", source)
+        _no_unknown(section, set(PhysicsParams.__dataclass_fields__), source, "[physics]")
+        kw["physics"] = PhysicsParams(**{
+            k: _typed(section, k, str, source, "physics.mode") if k == "mode"
+            else float(_typed(section, k, (int, float), source, f"physics.{k}"))
+            for k in section
+        })  # fmt: skip
     scenario = Scenario(**kw)
     check_scenario(scenario)
     return scenario
@@ -302,6 +339,26 @@ def _check_run_fields(s: Scenario, source: str) -> None:
         raise ScenarioError(source, "seed", f"expected 0 to 2**63-1, got {s.seed}")
 
 
+def _check_physics(p: PhysicsParams, src: str) -> None:
+    if p.mode not in PHYSICS_MODES:
+        raise ScenarioError(src, "physics.mode", f"unknown {p.mode!r}; expected one of {', '.join(PHYSICS_MODES)}")
+    values = (p.diameter, p.speed, p.timeout, p.dt, p.arrive)
+    if not all(np.isfinite(v) for v in values):
+        raise ScenarioError(src, "physics", "expected finite numbers")
+    if not 0.05 <= p.diameter < 1.0:
+        raise ScenarioError(src, "physics.diameter", f"expected 0.05 to <1 cell (a body must fit a corridor), "
+                            f"got {p.diameter}")  # fmt: skip
+    if not 0 < p.speed <= 100:
+        raise ScenarioError(src, "physics.speed", f"expected 0 to 100 cells per second, got {p.speed}")
+    if not 0 < p.dt <= 0.5:
+        raise ScenarioError(src, "physics.dt", f"expected a step of 0 to 0.5 s, got {p.dt}")
+    if not (p.timeout * p.speed >= 1.0 and p.timeout / p.dt <= 10_000):
+        raise ScenarioError(src, "physics.timeout", f"expected at least the time to cross one cell "
+                            f"({1 / p.speed:g} s) and at most 10000 steps of dt, got {p.timeout}")  # fmt: skip
+    if not 0 < p.arrive < 0.5:
+        raise ScenarioError(src, "physics.arrive", f"expected 0 to <0.5 cell, got {p.arrive}")
+
+
 def check_scenario(s: Scenario) -> None:
     src = s.source
     _check_run_fields(s, src)
@@ -320,6 +377,7 @@ def check_scenario(s: Scenario) -> None:
         raise ScenarioError(src, "ant.threshold", f"expected an amount >= 0, got {a.threshold}")
     if not 0 <= a.detour <= 10_000:
         raise ScenarioError(src, "ant.detour", f"expected 0 to 10000 steps, got {a.detour}")
+    _check_physics(s.physics, src)
     if s.cmarking.climb_patience < 1:
         raise ScenarioError(src, "cmarking.climb_patience", "expected a step count >= 1")
     if s.generator is not None:

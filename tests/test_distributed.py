@@ -33,12 +33,12 @@ def _run_distributed(scenario, run_id, count=1, attack=None):
 
 
 @pytest.mark.parametrize(
-    ("ref", "controller", "agents", "seed"),
-    [("setup2", "cmarking", 3, 12), ("setup2", "marking", 2, 5), ("maze", "cmarking", 4, 2),
-     ("setup3-12", "cmarking", 6, 8)],
+    ("ref", "controller", "agents", "seed", "physics"),
+    [("setup2", "cmarking", 3, 12, "ideal"), ("setup2", "marking", 2, 5, "ideal"), ("maze", "cmarking", 4, 2, "ideal"),
+     ("setup3-12", "cmarking", 6, 8, "ideal"), ("maze", "cmarking", 6, 3, "physical")],
 )  # fmt: skip
-def test_lockstep_equals_the_in_process_engine(ref, controller, agents, seed):
-    scenario = load_scenario(ref).with_overrides(agents=agents, controller=controller, seed=seed)
+def test_lockstep_equals_the_in_process_engine(ref, controller, agents, seed, physics):
+    scenario = load_scenario(ref).with_overrides(agents=agents, controller=controller, seed=seed, physics=physics)
     engine = Engine(scenario)
     expected = engine.run().summary
     summary, world = _run_distributed(scenario, f"eq-{ref}-{seed}", count=2 if agents % 2 == 0 else 1)
@@ -46,7 +46,9 @@ def test_lockstep_equals_the_in_process_engine(ref, controller, agents, seed):
         assert summary[key] == expected[key], key
     np.testing.assert_array_equal(world.layers, engine.world.layers)
     np.testing.assert_array_equal(world.pos, engine.world.pos)
+    np.testing.assert_array_equal(world.body_xy, engine.world.body_xy)
     assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
+    assert summary.get("blocked_moves") == expected.get("blocked_moves")
 
 
 def test_bad_traffic_is_counted_and_changes_nothing():
@@ -240,22 +242,26 @@ def _children_alive(run_id: str) -> list[str]:
             if f"--run-id {run_id}" in line and (" world " in line or " agent " in line)]  # fmt: skip
 
 
-def test_swarm_up_equals_swarm_run_and_leaves_no_process(tmp_path):
+@pytest.mark.parametrize("physics", ["ideal", "physical"])
+def test_swarm_up_equals_swarm_run_and_leaves_no_process(tmp_path, physics):
     import json
     import subprocess
     import sys
 
-    args = ["setup2", "--agents", "3", "--seed", "9"]
-    up = subprocess.run([sys.executable, "-m", "swarm", "up", *args, "--run-id", "upeq", "--listen", free_endpoint(),
-                         "--json"], capture_output=True, text=True, timeout=300, cwd=tmp_path)  # fmt: skip
+    args = ["setup2", "--agents", "3", "--seed", "9", "--physics", physics]
+    up = subprocess.run([sys.executable, "-m", "swarm", "up", *args, "--run-id", f"upeq{physics}",
+                         "--listen", free_endpoint(), "--json"],
+                        capture_output=True, text=True, timeout=300, cwd=tmp_path)  # fmt: skip
     assert up.returncode == 0, up.stderr[-3000:]
     ran = subprocess.run([sys.executable, "-m", "swarm", "run", *args, "--json"], capture_output=True, text=True,
                          timeout=300)  # fmt: skip
     a, b = json.loads(up.stdout), json.loads(ran.stdout)
-    for key in ("iterations", "delivered", "total", "finished", "apf_optimal", "explored_cells", "reachable_cells"):
+    for key in ("iterations", "delivered", "total", "finished", "apf_optimal", "explored_cells", "reachable_cells",
+                "physics"):  # fmt: skip
         assert a[key] == b[key], key
+    assert a["physics"] == physics
     assert {"rejected_messages", "agents_lost", "ticks_per_second"} <= set(a)
-    assert _children_alive("upeq") == []
+    assert _children_alive(f"upeq{physics}") == []
 
 
 @pytest.mark.parametrize("signum", ["SIGINT", "SIGTERM"])

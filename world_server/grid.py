@@ -46,7 +46,8 @@ from agents.controllers.layout import (
     TRAIL_PAINT,
     new_perception,
 )
-from swarm.scenario import Layout, Scenario
+from swarm.scenario import Layout, PhysicsParams, Scenario
+from world_server.bodies import Bodies
 
 # Integer layers of the grid, stacked in one (N_LAYERS, H, W) array.
 L_OBST = 0
@@ -224,6 +225,7 @@ class GridWorld:
         a = scenario.ant
         self.wparams = np.array([scenario.q_max, a.deposit, a.diffusion, a.evaporation], dtype=np.float64)
         self.pheromone_on = scenario.controller == "ant"  # only ants lay pheromone
+        self.bodies = Bodies(scenario.physics, layout.obstacles, n, layout.base)
 
     def perceive(self, agent: int, pi: np.ndarray, pf: np.ndarray) -> None:
         r, c = self.pos[agent]
@@ -232,7 +234,9 @@ class GridWorld:
         )
 
     def resolve(self, tick: int) -> None:
-        """Apply the actions in `acts` for `tick` (agent-id order), then spread pheromone."""
+        """Move the bodies (physical: only arrived moves count), apply the
+        actions in `acts` for `tick` (agent-id order), then spread pheromone."""
+        self.bodies.move(self.pos, self.acts)
         resolve_tick(self.layers, self.pher, self.pher_scratch, self.base[0], self.base[1], self.pos, self.payload,
                      self.acts, tick, self.wparams, self.counters, self.pheromone_on)  # fmt: skip
 
@@ -241,6 +245,7 @@ class GridWorld:
         tick of a served run is not charged for it."""
         scratch = GridWorld.__new__(GridWorld)
         scratch.__dict__ = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()}
+        scratch.bodies = Bodies(PhysicsParams(), self.layout.obstacles, 0, self.base)  # ideal: no simulation
         pi, pf = new_perception()
         if len(scratch.pos):
             scratch.perceive(0, pi, pf)
@@ -260,6 +265,16 @@ class GridWorld:
         """A fresh body at the base, empty-handed, for an agent taking over a slot."""
         self.pos[agent] = self.base
         self.payload[agent] = 0
+        self.bodies.reset(agent)
+
+    def remove_body(self, agent: int) -> None:
+        """A lost robot's body leaves the plane (it no longer blocks anyone)."""
+        self.bodies.remove(agent)
+
+    @property
+    def body_xy(self) -> np.ndarray:
+        """Every body's (x, y) in cells (cell centres under ideal physics)."""
+        return self.bodies.positions(self.pos)
 
     @property
     def marks(self) -> np.ndarray:

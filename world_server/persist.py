@@ -25,7 +25,7 @@ def save(path: Path, world, tick: int, slots: np.ndarray, stats: dict, scenario:
     meta = json.dumps({"tick": tick, "stats": stats, "scenario": scenario})
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "wb") as f:
-        np.savez(f, slots=slots, meta=np.array(meta), **{k: getattr(world, k) for k in ARRAYS})
+        np.savez(f, slots=slots, meta=np.array(meta), body_xy=world.body_xy, **{k: getattr(world, k) for k in ARRAYS})
         f.flush()
         os.fsync(f.fileno())
     os.replace(tmp, path)
@@ -35,6 +35,6 @@ def load(path: Path) -> dict | None:
     if not path.exists():
         return None
     with np.load(path, allow_pickle=False) as data:
-        state = {k: data[k].copy() for k in (*ARRAYS, "slots")}
+        state = {k: data[k].copy() for k in (*ARRAYS, "slots", "body_xy")}
         state.update(json.loads(str(data["meta"])))
     return state

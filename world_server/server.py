@@ -27,11 +27,13 @@ from agents.controllers.layout import (
     A_DEPOSIT,
     A_LOAD,
     A_MARK,
+    A_MODE,
     A_MOVE,
     A_TRAIL_ID,
     A_TRAIL_OP,
     A_UNLOAD,
     MARK_NONE,
+    N_MODES,
     PERC_F_LEN,
     PERC_LEN,
     STAY,
@@ -135,6 +137,7 @@ class WorldServer:
         w = self.world
         for key in persist.ARRAYS:
             getattr(w, key)[...] = state[key]
+        w.bodies.place(state["body_xy"])
         self.tick = int(state["tick"])
         slots = state["slots"]
         # Agents that were in the run come back when their liveliness token reappears.
@@ -216,7 +219,9 @@ class WorldServer:
     def _lose(self, agent: int) -> None:
         self.slots[agent] = LOST
         self.stats.agents_lost += 1
-        self.world.drop_load(agent)
+        if not self.done():  # after the run, agents leaving do not change the final world
+            self.world.drop_load(agent)
+            self.world.remove_body(agent)
         for nonce, a in list(self.nonces.items()):
             if a == agent:
                 del self.nonces[nonce]
@@ -340,7 +345,7 @@ class WorldServer:
         self.mark_got[:] = False
         w.acts[:, A_MOVE] = STAY
         w.acts[:, A_MARK] = MARK_NONE
-        w.acts[:, A_TRAIL_OP:] = 0
+        w.acts[:, A_TRAIL_OP:A_MODE] = 0  # the mode stays as last reported
         for group, agents in self._groups(active).items():
             pi = np.zeros((len(agents), PERC_LEN), dtype=np.int64)
             pf = np.zeros((len(agents), PERC_F_LEN), dtype=np.float64)
@@ -371,7 +376,7 @@ class WorldServer:
                 self.misses[a] += 1
                 self.stats.missed_ticks += 1
                 w.acts[a, A_MOVE] = STAY
-                w.acts[a, A_TRAIL_OP:] = 0
+                w.acts[a, A_TRAIL_OP:A_MODE] = 0
                 if self.misses[a] >= self.max_misses:
                     self._lose(int(a))
         if not self.null:
@@ -433,7 +438,7 @@ class WorldServer:
             "rejected_messages": self.stats.rejected_total, "rejected_by_reason": dict(self.stats.rejected),
             "agents_lost": self.stats.agents_lost, "joins": self.stats.joins, "missed_ticks": self.stats.missed_ticks,
             "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0,
-            "wall_seconds": round(elapsed, 3), **self._latency(),
+            "wall_seconds": round(elapsed, 3), **w.bodies.summary(s.agents), **self._latency(),
         }  # fmt: skip
 
     def _latency(self) -> dict:
@@ -456,7 +461,7 @@ class WorldServer:
 def _valid_action(act: np.ndarray) -> bool:
     return bool(
         0 <= act[A_MOVE] <= STAY and 0 <= act[A_TRAIL_OP] <= TRAIL_ERASE and act[A_TRAIL_ID] >= 0
-        and all(act[i] in (0, 1) for i in (A_LOAD, A_UNLOAD, A_DEPOSIT))
+        and all(act[i] in (0, 1) for i in (A_LOAD, A_UNLOAD, A_DEPOSIT)) and 0 <= act[A_MODE] < N_MODES
     )  # fmt: skip
 
 

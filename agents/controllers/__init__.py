@@ -14,6 +14,7 @@ from agents.controllers.ant import (
     ant_step,
 )
 from agents.controllers.cmarking import P_CLIMB_PATIENCE, cmarking_step
+from agents.controllers.layout import A_MODE, M_MODE
 from agents.controllers.marking import marking_step
 from swarm.scenario import Scenario
 
@@ -32,6 +33,7 @@ def step_controller(kind, pi, pf, mem, act, params, seed, agent, tick):
         marking_step(pi, pf, mem, act, params, seed, agent, tick)
     else:
         ant_step(pi, pf, mem, act, params, seed, agent, tick)
+    act[A_MODE] = mem[M_MODE]  # reported for the recording
 
 
 def warm_up() -> None:

@@ -25,6 +25,8 @@ Action (one per tick; the world applies it, see world_server.grid):
     A_LOAD      1: pick up resource from the current cell
     A_UNLOAD    1: drop the payload (only counts at the base)
     A_DEPOSIT   1: drop pheromone on the current cell (ants only)
+    A_MODE      the controller's mode after this step (MODE_NAMES), for the
+                record only: the world never acts on it
 """
 
 import numpy as np
@@ -58,7 +60,8 @@ A_TRAIL_ID = 3
 A_LOAD = 4
 A_UNLOAD = 5
 A_DEPOSIT = 6
-ACT_LEN = 7
+A_MODE = 7
+ACT_LEN = 8
 
 TRAIL_KEEP = 0
 TRAIL_PAINT = 1
@@ -83,6 +86,7 @@ RETURN_REMOVE = 3
 ERASE = 4  # wiping a trail fragment that leads nowhere (not carrying)
 RETURN_MEND = 5  # home along an existing trail, colouring its gaps
 MODE_NAMES = ("searching", "returning", "colouring", "removing", "erasing", "mending")
+N_MODES = len(MODE_NAMES)
 
 
 def new_perception() -> tuple[np.ndarray, np.ndarray]:
