@@ -55,10 +55,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--controller", choices=["cmarking", "marking", "ant"], help="controller to run")
     run.add_argument("--seed", type=_seed, help="seed of the map and of every random choice")
     _physics_args(run)
-    run.add_argument("--record", metavar="FILE", help="write a rerun recording of the run to FILE (.rrd)")
-    run.add_argument("--viewer", nargs="?", const="spawn", metavar="URL",
-                     help="also stream to a live rerun viewer: spawn one here, or give its gRPC URL "
-                     "(rerun+http://HOST:9876/proxy); needs --record")  # fmt: skip
+    _record_args(run, "write a rerun recording of the run to FILE (.rrd)")
     run.add_argument(
         "--until",
         choices=["foraged", "converged", "both"],
@@ -119,6 +116,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="give up if the agents have not all joined after S seconds (default 600)")  # fmt: skip
     world.add_argument("--linger", type=float, default=0.0, metavar="S",
                        help="keep serving swarm/<run-id>/marks/** for S seconds after the run")  # fmt: skip
+    _record_args(world, "write a rerun recording of the run to FILE (.rrd)")
 
     agent = sub.add_parser(
         "agent",
@@ -141,6 +139,30 @@ def build_parser() -> argparse.ArgumentParser:
     _tick_args(up)
     up.add_argument("--run-id", help="key space swarm/<run-id>/... (default: a fresh id)")
     up.add_argument("--listen", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router's endpoint")
+    _record_args(up, "where the recording goes (default runs/<run-id>.rrd)")
+    up.add_argument("--no-record", action="store_true", help="do not record the run")
+
+    replay = sub.add_parser(
+        "replay",
+        help="open a recording in the rerun viewer",
+        description="Open a recording in the native rerun viewer, or serve the web viewer (--web) and print "
+        "the URL to open.",
+    )
+    replay.add_argument("file", metavar="FILE", help="a .rrd written by swarm up or swarm run --record")
+    replay.add_argument("--web", action="store_true", help="serve the web viewer instead of opening a window")
+    replay.add_argument("--port", type=int, default=9090, help="web viewer HTTP port (default 9090)")
+    replay.add_argument("--grpc-port", type=int, default=9876, help="port of the data stream (default 9876)")
+    replay.add_argument("--bind", default="127.0.0.1", help="address to serve on (0.0.0.0 for other machines)")
+
+    rep = sub.add_parser(
+        "report",
+        help="summary and plots from a recording",
+        description="Read a recording back and print the run summary; write plots (delivered, share of "
+        "optimal cells, agents per state vs tick) and summary.json.",
+    )
+    rep.add_argument("file", metavar="FILE", help="a .rrd written by swarm up or swarm run --record")
+    rep.add_argument("--out", metavar="DIR", help="where the plots go (default: FILE without .rrd)")
+    rep.add_argument("--json", action="store_true", help="print one JSON object instead of text")
 
     sub.add_parser("scenarios", help="list presets and bundled scenarios")
     return parser
@@ -155,6 +177,13 @@ def _tick_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="ticks per second in realtime mode")
     p.add_argument("--deadline", type=float, default=2.0, metavar="S", help="lock-step: per-tick deadline in seconds")
+
+
+def _record_args(p: argparse.ArgumentParser, record_help: str) -> None:
+    p.add_argument("--record", metavar="FILE", help=record_help)
+    p.add_argument("--viewer", nargs="?", const="spawn", metavar="URL",
+                   help="also stream to a live rerun viewer: spawn one here, or give its gRPC URL "
+                   "(rerun+http://HOST:9876/proxy)")  # fmt: skip
 
 
 def _viewer_url(viewer: str | None) -> str | None:
@@ -203,6 +232,7 @@ def main(argv: list[str] | None = None) -> int:
     except (ConnectionError, TimeoutError) as exc:
         print(f"swarm: error: {exc}", file=sys.stderr)
         return 2
+
     except KeyboardInterrupt:
         print("swarm: interrupted", file=sys.stderr)
         return 130
@@ -220,7 +250,7 @@ def _print_summary(summary: dict, as_json: bool, until: str) -> int:
             f"{summary['explored_cells']}/{summary['reachable_cells']} cells, optimal marks "
             f"{summary['optimal_cells']}/{summary['reachable_cells']} (APF optimal: {summary['apf_optimal']})"
         )
-        if "rejected_messages" in summary:
+        if "agents_lost" in summary:
             print(
                 f"  {summary['ticks_per_second']} ticks/s, rejected messages {summary['rejected_messages']}, "
                 f"agents lost {summary['agents_lost']}, missed ticks {summary['missed_ticks']}"
@@ -249,7 +279,7 @@ def cmd_world(args) -> int:
                     max_iterations=args.max_iterations, linger=args.linger,
                     start_timeout=args.start_timeout, null=args.null,
                     state_dir=args.state_dir, persist_every=args.persist_every, mode=args.mode,
-                    rate=args.rate)  # fmt: skip
+                    rate=args.rate, record=args.record, viewer=_viewer_url(args.viewer))  # fmt: skip
     return _print_summary(summary, args.json, args.until)
 
 
@@ -271,10 +301,14 @@ def cmd_up(args) -> int:
     scenario = _scenario(args)
     if args.until != "foraged" and scenario.controller == "ant":
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
-    summary = swarm_up(args.scenario, scenario.agents, scenario.controller, args.seed, args.run_id or new_run_id(),
+    run_id = args.run_id or new_run_id()
+    record = None if args.no_record else (args.record or f"runs/{run_id}.rrd")
+    summary = swarm_up(args.scenario, scenario.agents, scenario.controller, args.seed, run_id,
                        args.listen, args.until, args.max_iterations, args.deadline,
                        progress=not args.json and sys.stderr.isatty(), mode=args.mode, rate=args.rate,
-                       physics=scenario.physics)  # fmt: skip
+                       physics=scenario.physics, record=record, viewer=args.viewer)  # fmt: skip
+    if summary.get("recording"):
+        _point_at_recording(summary["recording"])
     return _print_summary(summary, args.json, args.until)
 
 
@@ -297,9 +331,43 @@ def cmd_run(args) -> int:
         if recorder is not None:
             recorder.close(summary)
     if recorder is not None:
-        print(f"recording: {args.record}  (open it: swarm replay {args.record}; numbers and plots: "
-              f"swarm report {args.record})", file=sys.stderr)  # fmt: skip
+        _point_at_recording(args.record)
     return _print_summary(summary, args.json, args.until)
+
+
+def _point_at_recording(path: str) -> None:
+    print(f"recording: {path}\n  open it:           swarm replay {path}   (or --web)\n"
+          f"  summary and plots: swarm report {path}", file=sys.stderr)  # fmt: skip
+
+
+def cmd_replay(args) -> int:
+    from swarm.review import RecordingError, replay
+
+    try:
+        return replay(args.file, web=args.web, web_port=args.port, grpc_port=args.grpc_port, bind=args.bind)
+    except RecordingError as exc:
+        print(f"swarm: error: {exc}", file=sys.stderr)
+        return 2
+
+
+def cmd_report(args) -> int:
+    from swarm.review import RecordingError, report
+
+    try:
+        result = report(args.file, args.out)
+    except RecordingError as exc:
+        print(f"swarm: error: {exc}", file=sys.stderr)
+        return 2
+    if args.json:
+        print(json.dumps(result["summary"]))
+    else:
+        summary = result["summary"]
+        _print_summary(summary, False, summary["until"])
+        if "rejected_messages" in summary:
+            print(f"  {summary['mode']}: tick latency p50 {summary['tick_ms_p50']} ms, "
+                  f"p99 {summary['tick_ms_p99']} ms, rejected messages {summary['rejected_messages']}")  # fmt: skip
+        print(f"wrote {', '.join(result['plots'])} and {result['out']}/summary.json")
+    return 0
 
 
 def cmd_experiment(args) -> int:
@@ -333,7 +401,8 @@ def cmd_scenarios(args) -> int:
 
 
 COMMANDS = {"run": cmd_run, "experiment": cmd_experiment, "bench": cmd_bench, "scenarios": cmd_scenarios,
-            "world": cmd_world, "agent": cmd_agent, "up": cmd_up}  # fmt: skip
+            "world": cmd_world, "agent": cmd_agent, "up": cmd_up, "replay": cmd_replay,
+            "report": cmd_report}  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -15,13 +15,16 @@ import numpy as np
 from numba import njit
 
 from agents.controllers import controller_kind, controller_params, step_controller
-from agents.controllers.layout import PERC_F_LEN, PERC_LEN, new_memory
+from agents.controllers.layout import A_MODE, PERC_F_LEN, PERC_LEN, new_memory
 from swarm.scenario import Layout, Scenario, ScenarioError
 from world_server.grid import (
     C_DELIVERED,
     C_EXPLORED,
     C_OPTIMAL,
     C_REJECTED,
+    L_MARK,
+    L_RES,
+    L_TRAIL,
     GridWorld,
     perceive,
     resolve_tick,
@@ -32,6 +35,7 @@ UNTIL_CONVERGED = 1
 UNTIL_BOTH = 2
 UNTIL = {"foraged": UNTIL_FORAGED, "converged": UNTIL_CONVERGED, "both": UNTIL_BOTH}
 DEFAULT_MAX_ITERATIONS = 1_000_000
+RECORDED_LAYERS = (L_MARK, L_TRAIL, L_RES)  # the grid layers a recording holds per tick
 
 
 @njit(cache=True)
@@ -54,20 +58,56 @@ def decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, mem, a
 
 
 @njit(cache=True)
+def record_tick(t, layers, pos, payload, acts, counters, rec_pos, rec_mode, rec_payload, rec_counters, rec_last,
+                rec_layers, rec_changed):  # fmt: skip
+    """Copy tick t of a block into the recording buffers; a recorded layer is
+    copied only when it differs from the last copy (most ticks change little)."""
+    rec_pos[t] = pos
+    rec_mode[t] = acts[:, A_MODE]
+    rec_payload[t] = payload
+    rec_counters[t] = counters
+    for k in range(len(RECORDED_LAYERS)):
+        layer = layers[RECORDED_LAYERS[k]]
+        last = rec_last[k]
+        changed = False
+        for r in range(layer.shape[0]):
+            for c in range(layer.shape[1]):
+                if layer[r, c] != last[r, c]:
+                    changed = True
+                    break
+            if changed:
+                break
+        rec_changed[t, k] = changed
+        if changed:
+            last[:, :] = layer
+            rec_layers[t, k] = layer
+
+
+@njit(cache=True)
 def run_ticks(
     kind, layers, pher, pher_scratch, base_r, base_c, pos, payload, mem, acts,
     cparams, wparams, counters, pher_on, seed, tick0, n_ticks, until, total, reachable,
+    record, rec_pos, rec_mode, rec_payload, rec_counters, rec_last, rec_layers, rec_changed,
 ):  # fmt: skip
     """Run up to n_ticks ticks from tick0; stop early once `until` holds.
-    Returns the number of ticks run."""
+    Returns the number of ticks run.  With `record`, tick t of the call is
+    copied into the rec_* buffers (see swarm.recording.EngineTap)."""
     pi, pf = np.empty(PERC_LEN, np.int64), np.empty(PERC_F_LEN, np.float64)
     for t in range(n_ticks):
         tick = tick0 + t
         decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, mem, acts, cparams, seed, tick, pi, pf)
         resolve_tick(layers, pher, pher_scratch, base_r, base_c, pos, payload, acts, tick, wparams, counters, pher_on)
+        if record:
+            record_tick(t, layers, pos, payload, acts, counters, rec_pos, rec_mode, rec_payload, rec_counters,
+                        rec_last, rec_layers, rec_changed)  # fmt: skip
         if is_done(until, counters, total, reachable):
             return t + 1
     return n_ticks
+
+
+_NO_RECORDING = (np.zeros((0, 0, 2), np.int64), np.zeros((0, 0), np.int64), np.zeros((0, 0), np.int64),
+                 np.zeros((0, 0), np.int64), np.zeros((0, 0, 0), np.int64), np.zeros((0, 0, 0, 0), np.int64),
+                 np.zeros((0, 0), np.bool_))  # fmt: skip
 
 
 @dataclass
@@ -95,31 +135,39 @@ class Engine:
         self.tick = 0
         self.wall_seconds = 0.0
 
-    def step(self, n: int = 1, until: str = "foraged") -> int:
-        """Run up to n ticks (fewer if `until` is reached); return ticks run."""
+    def step(self, n: int = 1, until: str = "foraged", tap=None) -> int:
+        """Run up to n ticks (fewer if `until` is reached); return ticks run.
+        A `tap` (swarm.recording.EngineTap) receives every tick's record."""
         w = self.world
         started = time.perf_counter()
         if w.bodies.physical:
-            ran = self._step_physical(n, until)
+            ran = self._step_physical(n, until, tap)
         else:
+            buffers = tap.buffers(n) if tap is not None else _NO_RECORDING
             ran = run_ticks(
                 self.kind, w.layers, w.pher, w.pher_scratch, w.base[0], w.base[1], w.pos, w.payload,
                 self.mem, w.acts, self.cparams, w.wparams, w.counters, w.pheromone_on, np.int64(self.scenario.seed),
-                self.tick, n, UNTIL[until], w.total, w.reachable,
+                self.tick, n, UNTIL[until], w.total, w.reachable, tap is not None, *buffers,
             )  # fmt: skip
-        self.wall_seconds += time.perf_counter() - started
+        elapsed = time.perf_counter() - started
+        self.wall_seconds += elapsed
+        if tap is not None and not w.bodies.physical:
+            tap.take(self.tick, int(ran), elapsed)
         self.tick += int(ran)
         return int(ran)
 
-    def _step_physical(self, n: int, until: str) -> int:
+    def _step_physical(self, n: int, until: str, tap) -> int:
         """Tick by tick: the bodies' simulation (pymunk) sits between deciding and the grid rules."""
         w = self.world
         pi, pf = np.empty(PERC_LEN, np.int64), np.empty(PERC_F_LEN, np.float64)
         seed = np.int64(self.scenario.seed)
         for t in range(n):
+            started = time.perf_counter()
             decide_all(self.kind, w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload,
                        self.mem, w.acts, self.cparams, seed, self.tick + t, pi, pf)  # fmt: skip
             w.resolve(self.tick + t)
+            if tap is not None:
+                tap.recorder.capture(self.tick + t, tick_ms=(time.perf_counter() - started) * 1000)
             if self.done(until):
                 return t + 1
         return n
@@ -137,8 +185,7 @@ class Engine:
         recorder=None,
     ) -> RunResult:
         """Run to `until` (or max_iterations).  With a `recorder`
-        (swarm.recording.Recorder) the engine goes one tick at a time and the
-        recorder captures each."""
+        (swarm.recording.Recorder) every tick goes into the recording."""
         if until not in UNTIL:
             raise ValueError(f"unknown --until {until!r}: choose foraged, converged or both")
         if until != "foraged" and self.scenario.controller == "ant":
@@ -149,14 +196,15 @@ class Engine:
 
             bar = tqdm(total=self.world.total, unit="unit", desc="delivered", leave=False)
         shown = 0.0
+        tap = None
+        if recorder is not None:
+            from swarm.recording import EngineTap
+
+            tap = EngineTap(recorder)
+            chunk = min(chunk, tap.block)
         try:
             while not self.done(until) and self.tick < max_iterations:
-                if recorder is None:
-                    self.step(min(chunk, max_iterations - self.tick), until)
-                else:
-                    started = time.perf_counter()
-                    self.step(1, until)
-                    recorder.capture(self.tick - 1, tick_ms=(time.perf_counter() - started) * 1000)
+                self.step(min(chunk, max_iterations - self.tick), until, tap)
                 if bar is not None and time.monotonic() - shown > 0.1:
                     shown = time.monotonic()
                     bar.n = self.world.delivered

@@ -42,7 +42,7 @@ def swarm_up(
     scenario_ref: str, agents: int, controller: str, seed: int | None, run_id: str, listen: str,
     until: str = "foraged", max_iterations: int = 1_000_000, deadline: float = 2.0, progress: bool = True,
     per_process: int = 1, null: bool = False, mode: str = "lockstep", rate: float = 20.0,
-    physics: PhysicsParams | None = None,
+    physics: PhysicsParams | None = None, record: str | None = None, viewer: str | None = None,
 ) -> dict:  # fmt: skip
     """Run the swarm as processes; `per_process` agents share one agent process
     (`swarm agent --count`), `null` runs the benchmark floor (messaging only)."""
@@ -50,9 +50,18 @@ def swarm_up(
         raise ValueError(f"{agents} agents do not split into processes of {per_process}")
     # SIGTERM (docker stop, timeout, kill) must clean up like Ctrl-C does: raise so `finally` runs.
     previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    physics = physics or PhysicsParams()
+    world_options = ["--until", until, "--max-iterations", str(max_iterations), "--deadline", str(deadline),
+                     "--mode", mode, "--rate", str(rate), "--physics", physics.mode,
+                     "--body-diameter", repr(physics.diameter)]  # fmt: skip
+    if seed is not None:
+        world_options += ["--seed", str(seed)]
+    if record:
+        world_options += ["--record", record]
+    if viewer:
+        world_options += ["--viewer", viewer]
     try:
-        return _swarm_up(scenario_ref, agents, controller, seed, run_id, listen, until, max_iterations, deadline,
-                         progress, per_process, null, mode, rate, physics or PhysicsParams())  # fmt: skip
+        return _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null)
     finally:
         signal.signal(signal.SIGTERM, previous)
 
@@ -61,20 +70,15 @@ def _raise_interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
-def _swarm_up(scenario_ref, agents, controller, seed, run_id, listen, until, max_iterations, deadline, progress,
-              per_process, null, mode, rate, physics) -> dict:  # fmt: skip
+def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null) -> dict:
     warm_up()  # once here, so N agents starting together find the kernels in the cache,
     GridWorld(load_scenario(scenario_ref).with_overrides(agents=1)).warm_up()  # and so does the world
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
         summary_file = Path(tmp) / "summary.json"
         world_cmd = [*python, "world", scenario_ref, "--agents", str(agents), "--controller", controller,
-                     "--run-id", run_id, "--listen", listen, "--until", until, "--max-iterations",
-                     str(max_iterations), "--deadline", str(deadline), "--summary-file", str(summary_file),
-                     "--start-timeout", str(60 + 3 * agents), "--mode", mode, "--rate", str(rate)]  # fmt: skip
-        if seed is not None:
-            world_cmd += ["--seed", str(seed)]
-        world_cmd += ["--physics", physics.mode, "--body-diameter", repr(physics.diameter)]
+                     "--run-id", run_id, "--listen", listen, "--summary-file", str(summary_file),
+                     "--start-timeout", str(60 + 3 * agents), *world_options]  # fmt: skip
         agent_cmd = [*python, "agent", "--controller", controller, "--connect", listen, "--run-id", run_id,
                      "--count", str(per_process)]  # fmt: skip
         if null:

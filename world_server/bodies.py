@@ -11,10 +11,10 @@ others and by walls, so robots collide and queue in corridors and at the base.
 The tick ends when every body is within `arrive` of its target, or after
 `timeout` simulated seconds.  A move counts only for a body that arrived; a
 body that did not keeps its logical cell, stays where it was pushed, and drives
-on from there next tick.  The base is a nest: bodies staying on it collide with
-walls but not with other bodies (all agents start there, as in the paper).  A blocked body also steps to its right (keep-right
-traffic rule), so robots that fit side by side pass each other.  Time spent blocked is the simulated time a body with
-an unreached target moved at less than half of its commanded speed.  Bodies
+on from there next tick.  The base is a nest (see `_nest`).  A blocked body
+also steps to its right (keep-right traffic rule), so robots that fit side by
+side pass each other.  Time spent blocked is the simulated time a body with an
+unreached target moved at less than half of its commanded speed.  Bodies
 stop at the end of every tick (stop-and-go robots: no momentum across decisions).
 
 Coordinates are in cells: x = column + 0.5, y = row + 0.5 is a cell's centre.

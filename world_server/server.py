@@ -18,6 +18,7 @@ import queue
 import time
 import uuid
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import zenoh
@@ -73,7 +74,7 @@ class WorldServer:
         deadline: float = 2.0, max_misses: int = 3, expect: int | None = None, start_timeout: float = 60.0,
         until: str = "foraged", max_iterations: int = 1_000_000, null: bool = False,
         state_dir: str | None = None, persist_every: int = 50, resume_timeout: float = 30.0,
-        mode: str = "lockstep", rate: float = 20.0,
+        mode: str = "lockstep", rate: float = 20.0, record: str | None = None, viewer: str | None = None,
     ):  # fmt: skip
         if mode not in ("lockstep", "realtime"):
             raise ValueError(f"unknown mode {mode!r}: lockstep or realtime")
@@ -112,6 +113,8 @@ class WorldServer:
         self.resume_timeout = resume_timeout
         self.state_file = persist.state_path(state_dir, run_id) if state_dir else None
         self.resumed = self._resume()
+        self.recording_path: str | None = None
+        self.recorder = None if null or not record else self._recorder(record, viewer)
         self.session = open_client(connect) if connect else open_router(listen or "tcp/127.0.0.1:7447")
         put = self.events.put
         k = self.keys
@@ -147,6 +150,19 @@ class WorldServer:
         self.stats.rejected = dict(state["stats"].get("rejected", {}))
         self.group_of = {int(a): g for a, g in state["stats"].get("groups", {}).items()}
         return True
+
+    def _recorder(self, record: str, viewer: str | None):
+        """A resumed run records into a new file from its resume tick: the
+        first file stays as it was (rerun merges files of one recording id)."""
+        from swarm.recording import Recorder, run_meta
+
+        path = Path(record)
+        if self.resumed and path.exists():
+            path = path.with_name(f"{path.stem}.from-{self.tick}{path.suffix}")
+        meta = run_meta(self.scenario, self.world, self.keys.run, self.until, self.mode)
+        meta["resumed_at"] = self.tick if self.resumed else None
+        self.recording_path = str(path)
+        return Recorder(path, self.world, meta, viewer=viewer)
 
     def save_state(self) -> None:
         if self.state_file is None:
@@ -385,6 +401,9 @@ class WorldServer:
         if self.persist_every and self.tick % self.persist_every == 0:
             self.save_state()
         self.tick_seconds.append(time.perf_counter() - started)
+        if self.recorder is not None:
+            self.recorder.capture(tick, present=self.slots == ACTIVE, tick_ms=self.tick_seconds[-1] * 1000,
+                                  rejected=self.stats.rejected_total)  # fmt: skip
         self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress()}))
 
     def _groups(self, agents: np.ndarray) -> dict[str, np.ndarray]:
@@ -410,7 +429,14 @@ class WorldServer:
             self.step()
         self._drain(0.0)
         self.save_state()
-        return self.summary()
+        summary = self.summary()
+        self._close_recording(summary)
+        return summary
+
+    def _close_recording(self, summary: dict) -> None:
+        if self.recorder is not None:
+            self.recorder.close(summary)
+            self.recorder = None
 
     def linger(self, until) -> None:
         """Keep serving the key space (marks, info) after the run until
@@ -439,6 +465,7 @@ class WorldServer:
             "agents_lost": self.stats.agents_lost, "joins": self.stats.joins, "missed_ticks": self.stats.missed_ticks,
             "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0,
             "wall_seconds": round(elapsed, 3), **w.bodies.summary(s.agents), **self._latency(),
+            "recording": self.recording_path,
         }  # fmt: skip
 
     def _latency(self) -> dict:
@@ -453,6 +480,7 @@ class WorldServer:
             self.session.put(self.keys.obs(group), proto.stop_message(reason))
 
     def close(self) -> None:
+        self._close_recording(self.summary())  # an interrupted run still ends its recording
         for d in self._decls:
             d.undeclare()
         self.session.close()
