@@ -15,14 +15,26 @@ import uuid
 
 import numpy as np
 
-from agents.controllers import controller_kind, step_controller, warm_up
-from agents.controllers.layout import A_MARK, MARK, MARK_NONE, new_action, new_memory
+from agents.controllers import aot
+from agents.controllers.layout import A_MARK, MARK, MARK_NONE, controller_kind, new_action, new_memory
 from swarm import protocol as proto
 from swarm.bus import DEFAULT_ENDPOINT, open_client
 
 
 class JoinRefused(RuntimeError):
     pass
+
+
+def load_step():
+    """The ahead-of-time build of the controller step when it exists (no numba
+    in this process), else the JIT's (compiled or loaded from the cache now)."""
+    step = aot.load()
+    if step is None:
+        from agents.controllers.dispatch import step_controller, warm_up
+
+        warm_up()
+        step = step_controller
+    return step
 
 
 class AgentRuntime:
@@ -32,7 +44,7 @@ class AgentRuntime:
         self.controller = controller
         self.kind = controller_kind(controller)
         self.null = null  # benchmark floor: answer STAY without running the controller
-        warm_up()  # before joining: the world starts observing us as soon as we join
+        self.step = None if null else load_step()  # before joining: the world observes us at once
         self.idle_timeout = idle_timeout
         self.inbox: queue.Queue = queue.Queue()
         self.session = open_client(connect, timeout=join_timeout)
@@ -104,8 +116,7 @@ class AgentRuntime:
             if self.null:
                 act[0] = 4  # STAY
             else:
-                step_controller(self.kind, obs.pi[i], obs.pf[i], self.mem[slot], act, self.params, seed, agent,
-                                obs.tick)  # fmt: skip
+                self.step(self.kind, obs.pi[i], obs.pf[i], self.mem[slot], act, self.params, seed, agent, obs.tick)
             value = int(act[A_MARK])
             lowers = value != MARK_NONE and value < obs.pi[i, MARK]  # a write that changes nothing is not sent
             if lowers:

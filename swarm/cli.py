@@ -14,10 +14,14 @@ swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
 the plain marking agents and the pheromone ant baseline.
 
 examples:
-  swarm run setup1 --agents 20 --seed 3
+  swarm up setup1 --agents 20 --seed 1          # world + 20 agent processes over zenoh, recorded
+  swarm report runs/<run-id>.rrd                # summary and plots from the recording
+  swarm replay runs/<run-id>.rrd --web          # scrub through it in the rerun web viewer
+  swarm run setup1 --agents 20 --seed 3         # the same swarm in one process (fast)
+  swarm run maze --physics physical --record maze.rrd
   swarm run maze --controller marking --until converged --json
   swarm experiment table1 --reps 100
-  swarm bench engine
+  swarm bench engine | distributed | recording
 """
 
 
@@ -83,8 +87,9 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
 
     bench = sub.add_parser("bench", help="measure throughput", description="Measure throughput.")
-    bench.add_argument("target", choices=["engine", "distributed"],
-                       help="engine: the in-process engine; distributed: world + agent processes")  # fmt: skip
+    bench.add_argument("target", choices=["engine", "distributed", "recording"],
+                       help="engine: the in-process engine; distributed: world + agent processes; "
+                       "recording: what recording costs")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument("--quick", action="store_true", help="shorter measurement")
 
@@ -380,6 +385,12 @@ def cmd_experiment(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    if args.target == "recording":
+        from swarm.bench_recording import bench_recording, format_recording_bench
+
+        result = bench_recording(quick=args.quick)
+        print(json.dumps(result) if args.json else format_recording_bench(result))
+        return 0
     if args.target == "distributed":
         from swarm.bench_distributed import bench_distributed, format_distributed_bench
 

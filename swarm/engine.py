@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from agents.controllers import controller_kind, controller_params, step_controller
-from agents.controllers.layout import A_MODE, PERC_F_LEN, PERC_LEN, new_memory
+from agents.controllers.dispatch import controller_params, step_controller
+from agents.controllers.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind, new_memory
 from swarm.scenario import Layout, Scenario, ScenarioError
 from world_server.grid import (
     C_DELIVERED,

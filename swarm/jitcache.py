@@ -4,7 +4,9 @@ Numba's own cache only notices edits to the file of the cached function, not
 to the functions it calls from other files, so an edited controller could run
 stale inside a cached engine loop.  Keying the cache directory on a hash of
 every source file of the three packages makes any edit recompile everything.
-NUMBA_CACHE_DIR, when set, is left alone.
+NUMBA_CACHE_DIR, when set, is left alone.  Configured through the environment
+(numba reads it when first imported), so importing swarm does not load numba:
+agent processes run without it (agents/controllers/aot.py).
 """
 
 import hashlib
@@ -24,13 +26,20 @@ def source_digest() -> str:
     return h.hexdigest()[:16]
 
 
+def cache_root() -> Path:
+    """Compiled artefacts of this exact source: ~/.cache/swarm/<digest>."""
+    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "swarm"
+    return base / source_digest()
+
+
 def configure() -> None:
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
-    import numba
+    os.environ["NUMBA_CACHE_DIR"] = str(cache_root() / "numba")
+    import sys
 
-    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "swarm" / "numba"
-    numba.config.CACHE_DIR = str(base / source_digest())
+    if "numba" in sys.modules:  # imported before swarm: too late for the environment
+        sys.modules["numba"].config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
 
 
 configure()

@@ -18,7 +18,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from agents.controllers import warm_up
+from agents.controllers import aot
+from agents.controllers.dispatch import warm_up
 from swarm import protocol as proto
 from swarm.bus import open_client
 from swarm.scenario import PhysicsParams, load_scenario
@@ -71,8 +72,18 @@ def _raise_interrupt(signum, frame):
 
 
 def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null) -> dict:
+    builder = None
+    if aot.built() is None:  # agent processes run this build without numba (~35 MB instead of ~150)
+        if progress:
+            print("swarm: building the agents' compiled step (once per source version, about a minute)",
+                  file=sys.stderr)  # fmt: skip
+        builder = subprocess.Popen([sys.executable, "-m", "agents.controllers.aot"], stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.PIPE, text=True)  # fmt: skip
     warm_up()  # once here, so N agents starting together find the kernels in the cache,
     GridWorld(load_scenario(scenario_ref).with_overrides(agents=1)).warm_up()  # and so does the world
+    if builder is not None and builder.wait() != 0:
+        print(f"swarm: note: the ahead-of-time build failed, agents use the JIT (more memory):\n"
+              f"{builder.stderr.read()[-1500:]}", file=sys.stderr)  # fmt: skip
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
         summary_file = Path(tmp) / "summary.json"

@@ -20,8 +20,6 @@ from typing import Any
 
 import numpy as np
 
-from swarm.wavefront import bfs_distances
-
 CONTROLLER_NAMES = ("cmarking", "marking", "ant")
 MAX_AGENTS = (1 << 20) - 2  # trail ids reserve 20 bits for the agent id
 MAP_STREAM = 0x4D4150  # keeps map draws apart from any other use of the seed
@@ -427,6 +425,8 @@ def _layout_from_ascii(s: Scenario) -> Layout:
     grid = np.array([list(r) for r in rows])
     obstacles = grid == "#"
     base_r, base_c = (int(v[0]) for v in np.nonzero(grid == "B"))
+    from swarm.wavefront import bfs_distances  # compiled: loaded only where a map is built
+
     bfs = bfs_distances(obstacles, base_r, base_c)
     resources = np.where(grid == "R", s.quantity, 0).astype(np.int64)
     unreachable = np.argwhere((grid == "R") & (bfs < 0))
@@ -445,6 +445,8 @@ def generate_layout(g: Generator, quantity: int, seed: int, source: str = "gener
     resources on distinct cells reachable from the base.  A draw whose base is
     walled into a pocket holding less than half the free cells (or fewer cells
     than resources) is redrawn from the same seed's stream."""
+    from swarm.wavefront import bfs_distances
+
     rng = np.random.default_rng([seed, MAP_STREAM])
     h, w = g.height, g.width
     base = (h // 2, w // 2)

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from agents.controllers import CMARKING, controller_params, step_controller
 from agents.controllers.cmarking import new_trail_id
+from agents.controllers.dispatch import controller_params, step_controller
 from agents.controllers.layout import (
     A_LOAD,
     A_MARK,
@@ -11,6 +11,7 @@ from agents.controllers.layout import (
     A_TRAIL_ID,
     A_TRAIL_OP,
     CARRY,
+    CMARKING,
     ERASE,
     M_CLIMBING,
     M_LOADING,

@@ -4,8 +4,8 @@ other seeds differ; decisions do not depend on the order agents are stepped."""
 import numpy as np
 import pytest
 
-from agents.controllers import controller_kind, step_controller
-from agents.controllers.layout import new_perception
+from agents.controllers.dispatch import step_controller
+from agents.controllers.layout import controller_kind, new_perception
 from swarm.engine import Engine
 from swarm.scenario import load_scenario
 

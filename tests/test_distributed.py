@@ -260,6 +260,7 @@ def test_swarm_up_equals_swarm_run_and_leaves_no_process(tmp_path, physics):
                 "physics"):  # fmt: skip
         assert a[key] == b[key], key
     assert a["physics"] == physics
+    assert a["agent_process_rss_mb"] < 80  # the ahead-of-time step: no numba in agent processes
     assert {"rejected_messages", "agents_lost", "ticks_per_second"} <= set(a)
     assert _children_alive(f"upeq{physics}") == []
 

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import zenoh
 
-from agents.controllers import controller_params
+from agents.controllers.dispatch import controller_params
 from agents.controllers.layout import (
     A_DEPOSIT,
     A_LOAD,
@@ -124,7 +124,8 @@ class WorldServer:
             self.session.declare_queryable(k.marks, lambda q: put(("marks?", q))),
             self.session.declare_subscriber(k.acts, lambda s: put(("act", s))),
             self.session.declare_subscriber(k.marks, lambda s: put(("mark", s))),
-            self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s))),
+            # history: tokens declared before this subscriber (agents back before a restarted world) count too
+            self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s)), history=True),
         ]
 
     # ------------------------------------------------------------ persistence
@@ -351,6 +352,14 @@ class WorldServer:
                 raise TimeoutError(f"only {int((self.slots == ACTIVE).sum())} of {self.expect} agents joined")
             self._drain(0.05)
 
+    def _wait_for_any_agent(self) -> None:
+        deadline = time.monotonic() + self.start_timeout
+        while not (self.slots == ACTIVE).any():
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"every agent is gone and none joined for {self.start_timeout:g} s; "
+                                   "start agents with `swarm agent --run-id ...`")  # fmt: skip
+            self._drain(0.05)
+
     def step(self) -> None:
         started = time.perf_counter()
         w = self.world
@@ -426,6 +435,8 @@ class WorldServer:
             self.wait_for_agents()
         self.started = time.monotonic()
         while not self.done() and self.tick < self.max_iterations:
+            if not (self.slots == ACTIVE).any():
+                self._wait_for_any_agent()  # a world with nobody in it does not tick on alone
             self.step()
         self._drain(0.0)
         self.save_state()

@@ -89,6 +89,21 @@ MODE_NAMES = ("searching", "returning", "colouring", "removing", "erasing", "men
 N_MODES = len(MODE_NAMES)
 
 
+# Controller kinds (the first argument of dispatch.step_controller).
+MARKING = 0
+CMARKING = 1
+ANT = 2
+CONTROLLERS: dict[str, int] = {"marking": MARKING, "cmarking": CMARKING, "ant": ANT}
+N_PARAMS = 4  # length of the controllers' float parameter vector
+
+
+def controller_kind(name: str) -> int:
+    try:
+        return CONTROLLERS[name]
+    except KeyError:
+        raise ValueError(f"unknown controller {name!r}: choose one of {', '.join(CONTROLLERS)}") from None
+
+
 def new_perception() -> tuple[np.ndarray, np.ndarray]:
     return np.zeros(PERC_LEN, dtype=np.int64), np.zeros(PERC_F_LEN, dtype=np.float64)
 

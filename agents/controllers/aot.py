@@ -1,0 +1,80 @@
+"""Ahead-of-time build of the controllers' step, for agent processes.
+
+`import numba` alone costs an agent process 88 MB.  numba's pycc compiles
+the very same `dispatch.step_controller` (and everything it calls) into a
+plain extension module.  Agent processes import that module, which needs only
+numpy, instead of the JIT.  The module is named after the source digest and lives
+in the compile cache (swarm.jitcache), so an edited controller is rebuilt
+rather than run stale.  Building needs numba and a C compiler; when the build
+is missing, agent processes fall back to the JIT (same step, more memory).
+
+    python -m agents.controllers.aot     # build now (swarm up does it by itself)
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+from swarm.jitcache import cache_root, source_digest
+
+# kind, perception (int, float), memory, action, params, seed, agent, tick
+SIGNATURE = "void(i8, i8[::1], f8[::1], i8[::1], i8[::1], f8[::1], i8, i8, i8)"
+
+
+def module_name() -> str:
+    return f"swarm_steps_{source_digest()}"
+
+
+def build_dir() -> Path:
+    return cache_root() / "aot"
+
+
+def built() -> Path | None:
+    return next(iter(sorted(build_dir().glob(f"{module_name()}.*.so"))), None)
+
+
+def build() -> Path:
+    """Compile the step module (about a minute on 2 cores) unless it exists."""
+    if (done := built()) is not None:
+        return done
+    from numba.pycc import CC
+
+    from agents.controllers.dispatch import step_controller
+
+    out = build_dir()
+    out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=out) as tmp:  # concurrent builds: atomic rename at the end
+        cc = CC(module_name())
+        cc.output_dir = tmp
+        cc.export("step", SIGNATURE)(step_controller.py_func)
+        cc.compile()
+        (result,) = Path(tmp).glob(f"{module_name()}.*.so")
+        final = out / result.name
+        os.replace(result, final)
+    for stale in out.glob("swarm_steps_*"):
+        if not stale.name.startswith(module_name()) and stale.is_file():
+            stale.unlink(missing_ok=True)
+    shutil.rmtree(out / "__pycache__", ignore_errors=True)
+    return final
+
+
+def load():
+    """The compiled `step`, or None when it has not been built for this source."""
+    path = built()
+    if path is None:
+        return None
+    if str(path.parent) not in sys.path:
+        sys.path.insert(0, str(path.parent))
+    try:
+        return importlib.import_module(module_name()).step
+    except ImportError:
+        return None
+
+
+if __name__ == "__main__":
+    print(build())
