@@ -184,3 +184,27 @@ def test_recording_files_stay_small(tmp_path):
     iterations = json.loads(ran.stdout)["iterations"]
     assert rrd.stat().st_size / iterations < 5_000  # bytes per tick (40x40 grid, 20 agents)
     assert Path(rrd).stat().st_size < 50_000_000
+
+
+def test_the_live_viewer_stream_carries_the_same_run(tmp_path):
+    """--viewer URL streams to a rerun gRPC server (here one that saves what it
+    gets, as a compose viewer service would show it) besides the file."""
+    from swarm.review import rerun_binary
+
+    port = int(free_endpoint().rsplit(":", 1)[1])
+    live = tmp_path / "live.rrd"
+    server = subprocess.Popen([rerun_binary(), "--serve-grpc", "--port", str(port), "--save", str(live)],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    try:
+        time.sleep(2)
+        ran = _swarm("run", "maze", "--agents", "3", "--seed", "4", "--record", str(tmp_path / "file.rrd"),
+                     "--viewer", f"rerun+http://127.0.0.1:{port}/proxy", "--json")  # fmt: skip
+        assert ran.returncode == 0, ran.stderr[-2000:]
+        time.sleep(2)
+    finally:
+        server.send_signal(2)  # Ctrl-C: the server finishes its file
+        server.wait(timeout=20)
+    printed = json.loads(ran.stdout)
+    read = summary_from(read_recording(live))
+    for key in SHARED_KEYS:
+        assert read[key] == printed[key], key
