@@ -50,10 +50,11 @@ def is_done(until, counters, total, reachable):
 
 
 @njit(cache=True)
-def decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, mem, acts, cparams, seed, tick, pi, pf):
+def decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, blocked, mem, acts, cparams, seed, tick,
+               pi, pf):  # fmt: skip
     """Steps 1-2 of the tick: every agent perceives the start-of-tick world and chooses."""
     for a in range(pos.shape[0]):
-        perceive(layers, pher, pher_on, base_r, base_c, pos[a, 0], pos[a, 1], payload[a], pi, pf)
+        perceive(layers, pher, pher_on, base_r, base_c, pos[a, 0], pos[a, 1], payload[a], blocked[a], pi, pf)
         step_controller(kind, pi, pf, mem[a], acts[a], cparams, seed, a, tick)
 
 
@@ -85,7 +86,7 @@ def record_tick(t, layers, pos, payload, acts, counters, rec_pos, rec_mode, rec_
 
 @njit(cache=True)
 def run_ticks(
-    kind, layers, pher, pher_scratch, base_r, base_c, pos, payload, mem, acts,
+    kind, layers, pher, pher_scratch, base_r, base_c, pos, payload, blocked, mem, acts,
     cparams, wparams, counters, pher_on, seed, tick0, n_ticks, until, total, reachable,
     record, rec_pos, rec_mode, rec_payload, rec_counters, rec_last, rec_layers, rec_changed,
 ):  # fmt: skip
@@ -95,7 +96,8 @@ def run_ticks(
     pi, pf = np.empty(PERC_LEN, np.int64), np.empty(PERC_F_LEN, np.float64)
     for t in range(n_ticks):
         tick = tick0 + t
-        decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, mem, acts, cparams, seed, tick, pi, pf)
+        decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, blocked, mem, acts, cparams, seed, tick,
+                   pi, pf)  # fmt: skip
         resolve_tick(layers, pher, pher_scratch, base_r, base_c, pos, payload, acts, tick, wparams, counters, pher_on)
         if record:
             record_tick(t, layers, pos, payload, acts, counters, rec_pos, rec_mode, rec_payload, rec_counters,
@@ -145,7 +147,7 @@ class Engine:
         else:
             buffers = tap.buffers(n) if tap is not None else _NO_RECORDING
             ran = run_ticks(
-                self.kind, w.layers, w.pher, w.pher_scratch, w.base[0], w.base[1], w.pos, w.payload,
+                self.kind, w.layers, w.pher, w.pher_scratch, w.base[0], w.base[1], w.pos, w.payload, w.blocked,
                 self.mem, w.acts, self.cparams, w.wparams, w.counters, w.pheromone_on, np.int64(self.scenario.seed),
                 self.tick, n, UNTIL[until], w.total, w.reachable, tap is not None, *buffers,
             )  # fmt: skip
@@ -163,7 +165,7 @@ class Engine:
         seed = np.int64(self.scenario.seed)
         for t in range(n):
             started = time.perf_counter()
-            decide_all(self.kind, w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload,
+            decide_all(self.kind, w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked,
                        self.mem, w.acts, self.cparams, seed, self.tick + t, pi, pf)  # fmt: skip
             w.resolve(self.tick + t)
             if tap is not None:

@@ -168,3 +168,22 @@ def test_the_base_is_a_nest_and_robots_leave_it_one_after_another():
     for i in out:
         for j in out[out > i]:
             assert np.hypot(*(bodies.xy[i] - bodies.xy[j])) >= 0.9 * bodies.params.diameter
+
+
+def test_a_robot_whose_move_failed_senses_it_next_tick():
+    from agents.controllers.layout import BLOCKED, new_perception
+
+    text = '[map]\nascii = """\n#######\n#B...R#\n#######\n"""\n[physics]\nmode = "physical"\ndiameter = 0.7\n'
+    world = GridWorld(parse_scenario_text(text, "c.toml").with_overrides(agents=2))
+    world.bodies.place(np.array([[2.5, 1.5], [3.5, 1.5]]))
+    world.pos[:] = [[1, 2], [1, 3]]
+    world.acts[:, A_MOVE] = [E, W]  # too wide to pass each other
+    world.resolve(0)
+    np.testing.assert_array_equal(world.pos, [[1, 2], [1, 3]])
+    np.testing.assert_array_equal(world.blocked, [1, 1])
+    pi, pf = new_perception()
+    world.perceive(0, pi, pf)
+    assert pi[BLOCKED] == 1
+    world.acts[:, A_MOVE] = [W, E]  # apart: both arrive, nothing to sense
+    world.resolve(1)
+    np.testing.assert_array_equal(world.blocked, [0, 0])

@@ -113,12 +113,13 @@ class Bodies:
 
     # ------------------------------------------------------------------- tick
 
-    def move(self, pos: np.ndarray, acts: np.ndarray) -> None:
+    def move(self, pos: np.ndarray, acts: np.ndarray) -> np.ndarray:
         """Drive every body towards its chosen cell; turn the moves of bodies
         that did not arrive into STAY (in `acts`), so the grid rules see only
-        moves that happened.  Moves into walls are left for the grid to reject."""
+        moves that happened, and return 1 for those bodies (their robots sense
+        it next tick).  Moves into walls are left for the grid to reject."""
         if not self.physical:
-            return
+            return np.zeros(len(pos), dtype=np.int64)
         p = self.params
         target = pos.copy()
         d = acts[:, A_MOVE]
@@ -163,6 +164,7 @@ class Bodies:
         failed = legal & ~arrived
         self.blocked_moves += int(failed.sum())
         acts[failed, A_MOVE] = STAY
+        return failed.astype(np.int64)
 
     def _nest(self, pos: np.ndarray) -> np.ndarray:
         """Bodies on the base collide with walls only; returns who is in the nest.

@@ -30,6 +30,7 @@ from agents.controllers.layout import (
     A_UNLOAD,
     ACT_LEN,
     AT_BASE,
+    BLOCKED,
     CARRY,
     COMPASS_DC,
     COMPASS_DR,
@@ -75,7 +76,7 @@ N_WPARAMS = 4
 
 
 @njit(cache=True, inline="always")
-def perceive(layers, pher, pher_on, base_r, base_c, r, c, payload, pi, pf):
+def perceive(layers, pher, pher_on, base_r, base_c, r, c, payload, blocked, pi, pf):
     """Fill the perception of an agent at (r, c): its cell and 4 neighbours
     (pheromone only when pher_on: no other controller smells it)."""
     h = layers.shape[1]
@@ -102,6 +103,7 @@ def perceive(layers, pher, pher_on, base_r, base_c, r, c, payload, pi, pf):
     pi[COMPASS_DR] = (base_r > r) - (base_r < r)
     pi[COMPASS_DC] = (base_c > c) - (base_c < c)
     pi[CARRY] = payload
+    pi[BLOCKED] = blocked
 
 
 @njit(cache=True, inline="always")
@@ -216,6 +218,7 @@ class GridWorld:
         n = scenario.agents
         self.pos = np.tile(np.array(layout.base, dtype=np.int64), (n, 1))
         self.payload = np.zeros(n, dtype=np.int64)
+        self.blocked = np.zeros(n, dtype=np.int64)  # 1: the agent's last move did not happen (physical)
         self.acts = np.zeros((n, ACT_LEN), dtype=np.int64)
         self.counters = np.zeros(N_COUNTERS, dtype=np.int64)
         self.counters[C_EXPLORED] = 1
@@ -229,14 +232,13 @@ class GridWorld:
 
     def perceive(self, agent: int, pi: np.ndarray, pf: np.ndarray) -> None:
         r, c = self.pos[agent]
-        perceive(
-            self.layers, self.pher, self.pheromone_on, self.base[0], self.base[1], r, c, self.payload[agent], pi, pf
-        )
+        perceive(self.layers, self.pher, self.pheromone_on, self.base[0], self.base[1], r, c, self.payload[agent],
+                 self.blocked[agent], pi, pf)  # fmt: skip
 
     def resolve(self, tick: int) -> None:
         """Move the bodies (physical: only arrived moves count), apply the
         actions in `acts` for `tick` (agent-id order), then spread pheromone."""
-        self.bodies.move(self.pos, self.acts)
+        self.blocked[:] = self.bodies.move(self.pos, self.acts)
         resolve_tick(self.layers, self.pher, self.pher_scratch, self.base[0], self.base[1], self.pos, self.payload,
                      self.acts, tick, self.wparams, self.counters, self.pheromone_on)  # fmt: skip
 
@@ -265,6 +267,7 @@ class GridWorld:
         """A fresh body at the base, empty-handed, for an agent taking over a slot."""
         self.pos[agent] = self.base
         self.payload[agent] = 0
+        self.blocked[agent] = 0
         self.bodies.reset(agent)
 
     def remove_body(self, agent: int) -> None:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-ARRAYS = ("layers", "pher", "pos", "payload", "counters")
+ARRAYS = ("layers", "pher", "pos", "payload", "blocked", "counters")
 
 
 def state_path(state_dir: str | Path, run_id: str) -> Path:

@@ -13,6 +13,8 @@ Perception (what the paper's robot senses, never coordinates): the current cell
     AT_BASE  1 if the current cell is the base
     COMPASS_DR, COMPASS_DC  sign (-1, 0, 1) of the base's direction (ants only)
     CARRY    units of resource the robot carries (its payload sensor)
+    BLOCKED  1 if the robot's last move did not happen (physical bodies that
+             did not reach the cell in time; its odometry tells it so)
 
 Float perception: PHER+k, the pheromone on cell k (ants only).
 
@@ -48,7 +50,8 @@ AT_BASE = 20
 COMPASS_DR = 21
 COMPASS_DC = 22
 CARRY = 23
-PERC_LEN = 24
+BLOCKED = 24
+PERC_LEN = 25
 
 PHER = 0
 PERC_F_LEN = 5
