@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import warnings
@@ -201,12 +202,25 @@ def replay(path: str | Path, web: bool = False, web_port: int = 9090, grpc_port:
     if not web and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         raise RecordingError("no display here for the native viewer: use `swarm replay FILE --web` and open the URL")
     cmd = replay_command(path, web, web_port, grpc_port, bind)
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    # Its own process group: the `rerun` launcher starts the viewer binary as a child, and
+    # Ctrl-C or SIGTERM (a test, docker stop) must end both.
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    previous = signal.signal(signal.SIGTERM, _interrupt)
     if web:
         print(f"serving {path} — open {web_url(web_port, grpc_port)}  (Ctrl-C to stop)", flush=True)
     try:
         return proc.wait()
     except KeyboardInterrupt:
-        proc.terminate()
-        proc.wait(timeout=10)
         return 0
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGTERM)
+            try:
+                proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt

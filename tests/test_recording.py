@@ -166,6 +166,9 @@ def test_the_web_viewer_is_served_and_loads_in_a_headless_browser(tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=20)
+    time.sleep(0.5)
+    left = subprocess.run(["pgrep", "-f", str(rrd)], capture_output=True, text=True).stdout.split()
+    assert left == [], "swarm replay left its viewer running"
 
 
 def test_replay_without_a_display_says_what_to_do(tmp_path, monkeypatch):
