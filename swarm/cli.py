@@ -7,6 +7,7 @@ import json
 import sys
 from pathlib import Path
 
+from swarm.errors import RecordingError
 from swarm.scenario import PRESET_HELP, ScenarioError, bundled_scenarios, load_scenario
 
 DESCRIPTION = """\
@@ -231,7 +232,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return COMMANDS[args.command](args)
-    except ScenarioError as exc:
+    except (ScenarioError, RecordingError) as exc:
         print(f"swarm: error: {exc}", file=sys.stderr)
         return 2
     except (ConnectionError, TimeoutError) as exc:
@@ -346,23 +347,15 @@ def _point_at_recording(path: str) -> None:
 
 
 def cmd_replay(args) -> int:
-    from swarm.review import RecordingError, replay
+    from swarm.review import replay
 
-    try:
-        return replay(args.file, web=args.web, web_port=args.port, grpc_port=args.grpc_port, bind=args.bind)
-    except RecordingError as exc:
-        print(f"swarm: error: {exc}", file=sys.stderr)
-        return 2
+    return replay(args.file, web=args.web, web_port=args.port, grpc_port=args.grpc_port, bind=args.bind)
 
 
 def cmd_report(args) -> int:
-    from swarm.review import RecordingError, report
+    from swarm.review import report
 
-    try:
-        result = report(args.file, args.out)
-    except RecordingError as exc:
-        print(f"swarm: error: {exc}", file=sys.stderr)
-        return 2
+    result = report(args.file, args.out)
     if args.json:
         print(json.dumps(result["summary"]))
     else:

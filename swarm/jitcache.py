@@ -9,6 +9,7 @@ NUMBA_CACHE_DIR, when set, is left alone.  Configured through the environment
 agent processes run without it (agents/controllers/aot.py).
 """
 
+import functools
 import hashlib
 import os
 from pathlib import Path
@@ -16,6 +17,7 @@ from pathlib import Path
 _PACKAGES = ("swarm", "agents", "world_server")
 
 
+@functools.cache
 def source_digest() -> str:
     root = Path(__file__).resolve().parent.parent
     h = hashlib.sha1()

@@ -38,6 +38,7 @@ from agents.controllers.layout import (
     RETURN_REMOVE,
     SEARCH,
 )
+from world_server.bodies import cell_centres
 from world_server.grid import C_DELIVERED, C_EXPLORED, C_OPTIMAL, L_MARK, L_RES, L_TRAIL, GridWorld
 
 STATES = ("searching", "returning", "colouring", "removing", "carrying", "absent")
@@ -117,7 +118,7 @@ class EngineTap:
                   for t, k in zip(*np.nonzero(self.changed[:ran]), strict=True)]  # fmt: skip
         n = self.pos.shape[1]
         self.recorder.add(Block(
-            ticks=np.arange(tick0, tick0 + ran), xy=(self.pos[:ran, :, ::-1] + 0.5).astype(np.float32),
+            ticks=np.arange(tick0, tick0 + ran), xy=cell_centres(self.pos[:ran]).astype(np.float32),
             modes=self.modes[:ran].copy(), payload=self.payload[:ran].copy(), present=np.ones((ran, n), bool),
             counters=self.counters[:ran].copy(), tick_ms=np.full(ran, seconds * 1000 / max(ran, 1)),
             rejected=np.zeros(ran), layers=layers,

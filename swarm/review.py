@@ -21,11 +21,8 @@ from urllib.parse import quote
 
 import numpy as np
 
+from swarm.errors import RecordingError
 from swarm.recording import METRICS, STATES
-
-
-class RecordingError(Exception):
-    """The file is missing, not a swarm recording, damaged or truncated."""
 
 
 @dataclass

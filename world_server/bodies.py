@@ -45,7 +45,7 @@ class Bodies:
         self.sim_seconds = 0.0  # simulated time of the run (physical)
         self.blocked_seconds = 0.0  # summed over bodies
         self.blocked_moves = 0  # moves that did not arrive in time
-        self.xy = np.tile(_centre(np.array([base])), (n, 1))
+        self.xy = np.tile(cell_centres(np.array([base])), (n, 1))
         if self.physical:
             # Deterministic start: a sunflower spiral around the base centre (no two
             # discs on the same point); pymunk pushes the overlapping ones apart.
@@ -87,7 +87,7 @@ class Bodies:
             disc.filter = self._filters["nest"]  # everyone starts on the base
             space.add(body, disc)
             self._shapes.append(disc)
-        self._kind = ["nest"] * n
+        self._kind = np.full(n, "nest", dtype="<U7")  # nest | solid | removed, per body
         self.space = space
         # The batch API walks dynamic bodies in insertion order, then the static body.
         self._force = np.zeros(2 * n + 2, dtype=np.float64)
@@ -133,7 +133,7 @@ class Bodies:
         legal = moving & free
         target[legal] = cand[legal]
         in_nest = self._nest(pos)
-        goal = _centre(target)
+        goal = cell_centres(target)
         xy, vel = self._state()
         blocked = np.zeros(len(xy), dtype=bool)
         t = 0.0
@@ -172,9 +172,8 @@ class Bodies:
         fits one cell: the base is a nest, and robots pass through each other
         in it."""
         nest = (pos[:, 0] == self.base[0]) & (pos[:, 1] == self.base[1])
-        for a in np.flatnonzero(nest != (np.array(self._kind) == "nest")):
-            if self._kind[a] != "removed":
-                self._set_kind(int(a), "nest" if nest[a] else "solid")
+        for a in np.flatnonzero((nest != (self._kind == "nest")) & (self._kind != "removed")):
+            self._set_kind(int(a), "nest" if nest[a] else "solid")
         return nest
 
     def _admit_leavers(self, leavers: np.ndarray, arrived: np.ndarray) -> None:
@@ -182,7 +181,7 @@ class Bodies:
         only if it does not overlap a solid body where it stopped.  Leavers are
         admitted in agent-id order (each admitted one is solid for the next), so
         robots leave one after another instead of spilling out as a heap."""
-        solid = np.array([k == "solid" for k in self._kind])
+        solid = self._kind == "solid"
         near = 0.9 * self.params.diameter  # contacts are slightly soft
         for a in np.flatnonzero(leavers):
             if solid.any() and (np.hypot(*(self.xy[solid] - self.xy[a]).T) < near).any():
@@ -206,23 +205,25 @@ class Bodies:
 
     def reset(self, agent: int) -> None:
         """A fresh body in the nest (a newcomer's); it collides again once it leaves."""
-        self._put(agent, _centre(np.array([self.base]))[0], solid=True)
+        self._put(agent, "nest")
 
     def remove(self, agent: int) -> None:
         """A lost robot leaves the plane: parked at the base, colliding with nothing."""
-        self._put(agent, _centre(np.array([self.base]))[0], solid=False)
+        self._put(agent, "removed")
 
-    def _put(self, agent: int, xy: np.ndarray, solid: bool) -> None:
+    def _put(self, agent: int, kind: str) -> None:
+        """Back to the base centre, at rest, as `kind` (nest: a newcomer; removed: lost)."""
+        xy = cell_centres(np.array([self.base]))[0]
         self.xy[agent] = xy
         if self.physical:
             shape = self._shapes[agent]
             shape.body.position = (float(xy[0]), float(xy[1]))
             shape.body.velocity = (0.0, 0.0)
-            self._set_kind(agent, "nest" if solid else "removed")  # a newcomer starts on the base
+            self._set_kind(agent, kind)
 
     def positions(self, pos: np.ndarray) -> np.ndarray:
         """Each body's (x, y) in cells: the cell centre when ideal."""
-        return self.xy.copy() if self.physical else _centre(pos)
+        return self.xy.copy() if self.physical else cell_centres(pos)
 
     def summary(self, agents: int) -> dict:
         if not self.physical:
@@ -238,7 +239,6 @@ class Bodies:
         }
 
 
-def _centre(cells: np.ndarray) -> np.ndarray:
-    """(row, col) cells to (x, y) centres."""
-    cells = np.asarray(cells, dtype=np.float64)
-    return np.column_stack([cells[:, 1] + 0.5, cells[:, 0] + 0.5])
+def cell_centres(cells: np.ndarray) -> np.ndarray:
+    """(row, col) cells, shape (..., 2), to (x, y) centres."""
+    return np.asarray(cells, dtype=np.float64)[..., ::-1] + 0.5

@@ -491,7 +491,8 @@ class WorldServer:
             self.session.put(self.keys.obs(group), proto.stop_message(reason))
 
     def close(self) -> None:
-        self._close_recording(self.summary())  # an interrupted run still ends its recording
+        if self.recorder is not None:  # an interrupted run still ends its recording
+            self._close_recording(self.summary())
         for d in self._decls:
             d.undeclare()
         self.session.close()
