@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: install browser demo test lint experiments bench clean
+.PHONY: install browser docker demo test lint experiments bench clean
 
 install: $(STAMP)
 
@@ -26,7 +26,14 @@ browser:
 		&& apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; } \
 		|| echo "note: chromium not installed (needs root and apt); the web viewer test will be skipped"
 
-test: install browser
+# The compose test starts a real Docker engine (Debian's docker.io, compose v1, debootstrap for a base image).
+docker:
+	@{ command -v dockerd && command -v docker-compose && command -v debootstrap && command -v ip; } >/dev/null \
+		|| { command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] && apt-get update -qq \
+		&& DEBIAN_FRONTEND=noninteractive apt-get install -y -qq docker.io docker-compose debootstrap iproute2 >/dev/null; } \
+		|| echo "note: Docker engine not installed (needs root and apt); the compose test will be skipped"
+
+test: install browser docker
 	$(BIN)/ruff check .
 	$(BIN)/python -m pytest -q
 

@@ -39,7 +39,8 @@ def load_step():
 
 class AgentRuntime:
     def __init__(self, run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
-                 join_timeout: float = 60.0, idle_timeout: float = 120.0, null: bool = False):  # fmt: skip
+                 join_timeout: float = 60.0, idle_timeout: float = 120.0, null: bool = False,
+                 rejoin_after: float = 5.0):  # fmt: skip
         self.keys = proto.Keys(run_id)
         self.controller = controller
         self.kind = controller_kind(controller)
@@ -51,16 +52,19 @@ class AgentRuntime:
         self.group = uuid.uuid4().hex  # this process: its agents' messages travel together
         # Subscribed before joining: the world starts observing an agent as soon as it sees its token.
         self._decls = [self.session.declare_subscriber(self.keys.obs(self.group), self.inbox.put)]
-        self.agents: list[int] = []
+        self.agents: list[int] = []  # our agents' ids, by slot (row of self.mem)
+        self.tokens: dict[int, object] = {}  # agent id -> its liveliness token
         self.mem = new_memory(count)
         self.act = new_action()
         self.seed = 0
         self.params = np.zeros(1)
+        self.rejoin_after = rejoin_after
         for _ in range(count):
-            self._join(join_timeout)
+            self.agents.append(self._join(join_timeout))
         self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
 
-    def _join(self, timeout: float) -> None:
+    def _join(self, timeout: float) -> int:
+        """Ask the world for an id; returns it once our liveliness token is declared."""
         nonce = uuid.uuid4().hex
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -77,20 +81,24 @@ class AgentRuntime:
                     agent = int(msg["agent"])
                     self.seed = int(msg["seed"])
                     self.params = np.array(msg["params"], dtype=np.float64)
-                    self.agents.append(agent)
-                    self._decls.append(self.session.liveliness().declare_token(self.keys.alive(agent)))
-                    return
+                    self.tokens[agent] = self.session.liveliness().declare_token(self.keys.alive(agent))
+                    return agent
             time.sleep(0.2)
         raise TimeoutError(f"no world answered on {self.keys.join} within {timeout:.0f} s")
 
     def run(self) -> int:
         """Answer observations until the world says stop; returns agent-steps answered."""
         answered = 0
+        heard = time.monotonic()
         while True:
             try:
-                batch = [self.inbox.get(timeout=self.idle_timeout)]
+                batch = [self.inbox.get(timeout=self.rejoin_after)]
             except queue.Empty:
-                raise TimeoutError(f"no observation for {self.idle_timeout:.0f} s; is the world gone?") from None
+                if time.monotonic() - heard > self.idle_timeout:
+                    raise TimeoutError(f"no observation for {self.idle_timeout:.0f} s; is the world gone?") from None
+                self._rejoin_if_dropped()
+                continue
+            heard = time.monotonic()
             while not self.inbox.empty():  # behind (real time): answer only the newest
                 batch.append(self.inbox.get_nowait())
             latest = None
@@ -102,6 +110,36 @@ class AgentRuntime:
                     latest = msg
             if latest is not None:
                 answered += self._answer(latest)
+
+    def _rejoin_if_dropped(self) -> None:
+        """Quiet for a while: if the world has declared some of our agents lost
+        (a cut link, a stall), join again for them as new agents with fresh
+        memories.  A world that does not answer, or that simply has not
+        started, is left alone."""
+        try:
+            replies = list(self.session.get(self.keys.info, timeout=2.0))
+        except Exception:  # zenoh errors while the link is down: try again later
+            return
+        for reply in replies:
+            if not reply.ok:
+                continue
+            info = proto.unpack(reply.ok.payload.to_bytes())
+            if isinstance(info, proto.Rejected) or info.get("type") != "info" or info.get("ended"):
+                continue
+            members = set(info.get("members", []))
+            for slot, agent in enumerate(list(self.agents)):
+                if agent in members:
+                    continue
+                if (token := self.tokens.pop(agent, None)) is not None:
+                    token.undeclare()
+                try:
+                    new = self._join(timeout=5.0)
+                except TimeoutError:
+                    return
+                self.agents[slot] = new
+                self.mem[slot] = new_memory(1)[0]
+            self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
+            return
 
     def _answer(self, obs: proto.Obs) -> int:
         """Step every agent of ours in the batch; one mark message, one action message."""
@@ -133,6 +171,6 @@ class AgentRuntime:
         return len(agents)
 
     def close(self) -> None:
-        for d in self._decls:
+        for d in [*self._decls, *self.tokens.values()]:
             d.undeclare()
         self.session.close()

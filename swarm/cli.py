@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 from pathlib import Path
 
@@ -106,6 +107,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="host a router listening here (default tcp/127.0.0.1:7447)")  # fmt: skip
     where.add_argument("--connect", metavar="ENDPOINT", help="join an existing router instead")
     _tick_args(world)
+    world.add_argument("--start-with", type=_positive, metavar="K",
+                       help="start ticking once K agents have joined (default: --agents); more may join later, "
+                       "up to --agents")  # fmt: skip
     world.add_argument("--max-misses", type=_positive, default=3, metavar="K",
                        help="an agent that misses K ticks in a row is lost (default 3)")  # fmt: skip
     world.add_argument("--summary-file", metavar="FILE", help="also write the summary JSON here")
@@ -122,7 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="give up if the agents have not all joined after S seconds (default 600)")  # fmt: skip
     world.add_argument("--linger", type=float, default=0.0, metavar="S",
                        help="keep serving swarm/<run-id>/marks/** for S seconds after the run")  # fmt: skip
-    _record_args(world, "write a rerun recording of the run to FILE (.rrd)")
+    _record_args(world, "write a rerun recording of the run to FILE (.rrd), or into FOLDER/ as <run-id>-<UTC time>.rrd")
 
     agent = sub.add_parser(
         "agent",
@@ -169,6 +173,51 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("file", metavar="FILE", help="a .rrd written by swarm up or swarm run --record")
     rep.add_argument("--out", metavar="DIR", help="where the plots go (default: FILE without .rrd)")
     rep.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+
+    mon = sub.add_parser(
+        "monitor",
+        help="follow a running world and print its summary when the run ends",
+        description="Follow a world's run over zenoh (progress bar on a terminal, else a log line every few "
+        "seconds), print the run summary when the world says it has ended, and exit 0 if the run finished "
+        "(1 if it stopped unfinished).  `docker compose up swarm` runs this.",
+    )
+    mon.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
+    mon.add_argument("--run-id", default="default", help="the world's run id (default: default)")
+    mon.add_argument("--log-every", type=float, default=5.0, metavar="S", help="seconds between log lines")
+    mon.add_argument("--start-timeout", type=float, default=600.0, metavar="S",
+                     help="give up if no world answers for S seconds (default 600)")  # fmt: skip
+    mon.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+
+    st = sub.add_parser(
+        "status",
+        help="ask a router or a world whether it is up (health checks)",
+        description="Exit 0 and print the run's state if the world of --run-id answers (with --router: if "
+        "the router accepts a session); exit 1 if not.",
+    )
+    st.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
+    st.add_argument("--run-id", default="default", help="the world's run id (default: default)")
+    st.add_argument("--router", action="store_true", help="only check that the router answers")
+    st.add_argument("--timeout", type=float, default=3.0, metavar="S", help="how long to wait (default 3)")
+    st.add_argument("--json", action="store_true", help="print one JSON object")
+
+    router = sub.add_parser(
+        "router",
+        help="run a bare zenoh router (for worlds and agents on several hosts)",
+        description="Run a zenoh router that worlds (--connect), agents and monitors join; multicast "
+        "scouting stays off, so every process names the router's endpoint.",
+    )
+    router.add_argument("--listen", default="tcp/0.0.0.0:7447", metavar="ENDPOINT",
+                        help="where to listen (default tcp/0.0.0.0:7447)")  # fmt: skip
+
+    prep = sub.add_parser(
+        "prepare",
+        help="compile the kernels and the agents' step now, so runs start at once",
+        description="Compile (once per source version, ~1-2 minutes on 2 cores) the engine, world and "
+        "controller kernels and the agents' ahead-of-time step into ~/.cache/swarm (or $XDG_CACHE_HOME). "
+        "swarm up does it by itself; container images do it at build time.",
+    )
+    prep.add_argument("--require-aot", action="store_true",
+                      help="fail if the ahead-of-time build cannot be made (no C compiler)")  # fmt: skip
 
     sub.add_parser("scenarios", help="list presets and bundled scenarios")
     return parser
@@ -230,6 +279,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 2
+    # SIGTERM (docker stop, kill) ends a command like Ctrl-C: its `finally` blocks close sessions and recordings.
+    signal.signal(signal.SIGTERM, _raise_interrupt)
     try:
         return COMMANDS[args.command](args)
     except (ScenarioError, RecordingError) as exc:
@@ -242,6 +293,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("swarm: interrupted", file=sys.stderr)
         return 130
+
+
+def _raise_interrupt(signum, frame):
+    raise KeyboardInterrupt
 
 
 def _print_summary(summary: dict, as_json: bool, until: str) -> int:
@@ -259,7 +314,8 @@ def _print_summary(summary: dict, as_json: bool, until: str) -> int:
         if "agents_lost" in summary:
             print(
                 f"  {summary['ticks_per_second']} ticks/s, rejected messages {summary['rejected_messages']}, "
-                f"agents lost {summary['agents_lost']}, missed ticks {summary['missed_ticks']}"
+                f"agents joined {summary['joins']} (at most {summary.get('agents_peak')} at once), "
+                f"lost {summary['agents_lost']}, missed ticks {summary['missed_ticks']}"
             )
     return 0 if summary["finished"] else 1
 
@@ -282,6 +338,7 @@ def cmd_world(args) -> int:
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
     summary = serve(scenario, args.run_id, args.summary_file, listen=None if args.connect else args.listen,
                     connect=args.connect, deadline=args.deadline, max_misses=args.max_misses, until=args.until,
+                    start_with=args.start_with,
                     max_iterations=args.max_iterations, linger=args.linger,
                     start_timeout=args.start_timeout, null=args.null,
                     state_dir=args.state_dir, persist_every=args.persist_every, mode=args.mode,
@@ -290,9 +347,14 @@ def cmd_world(args) -> int:
 
 
 def cmd_agent(args) -> int:
-    from agents.runtime import AgentRuntime
+    from agents.runtime import AgentRuntime, JoinRefused
+    from swarm.protocol import ENDED
 
-    runtime = AgentRuntime(args.run_id, args.controller, args.connect, args.count, null=args.null)
+    try:
+        runtime = AgentRuntime(args.run_id, args.controller, args.connect, args.count, null=args.null)
+    except JoinRefused as exc:
+        print(f"swarm: {exc}", file=sys.stderr)
+        return 0 if ENDED in str(exc) else 2  # a late agent of a finished run has nothing to do
     try:
         runtime.run()
     finally:
@@ -398,6 +460,48 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def cmd_monitor(args) -> int:
+    from swarm.monitor import monitor
+
+    summary = monitor(args.connect, args.run_id, progress=not args.json and sys.stderr.isatty(),
+                      log_every=args.log_every, start_timeout=args.start_timeout)  # fmt: skip
+    return _print_summary(summary, args.json, summary.get("until", "foraged"))
+
+
+def cmd_status(args) -> int:
+    from swarm.monitor import status
+
+    info = status(args.connect, args.run_id, router_only=args.router, timeout=args.timeout)
+    if info is None:
+        what = f"router at {args.connect}" if args.router else f"world of run {args.run_id!r} via {args.connect}"
+        print(f"swarm: no {what} answered", file=sys.stderr)
+        return 1
+    if args.json:
+        print(json.dumps({k: v for k, v in info.items() if k != "members"}))
+    elif args.router:
+        print(f"router at {args.connect}: up")
+    else:
+        state = "ended" if info.get("ended") else "running"
+        print(f"run {args.run_id}: {state} at tick {info['iterations']}, delivered {info['delivered']}/"
+              f"{info['total']}, {info['agents_alive']} agents alive")  # fmt: skip
+    return 0
+
+
+def cmd_router(args) -> int:
+    from swarm.monitor import serve_router
+
+    serve_router(args.listen)
+    return 0
+
+
+def cmd_prepare(args) -> int:
+    from swarm.launcher import prepare
+
+    aot_built = prepare(progress=True, engine=True)
+    print(f"swarm: kernels compiled; agents' ahead-of-time step: {'built' if aot_built else 'MISSING (JIT fallback)'}")
+    return 0 if aot_built or not args.require_aot else 1
+
+
 def cmd_scenarios(args) -> int:
     print(f"presets: {PRESET_HELP}")
     print(f"bundled: {', '.join(bundled_scenarios())}  (in {Path(__file__).parent / 'scenarios'})")
@@ -406,7 +510,8 @@ def cmd_scenarios(args) -> int:
 
 COMMANDS = {"run": cmd_run, "experiment": cmd_experiment, "bench": cmd_bench, "scenarios": cmd_scenarios,
             "world": cmd_world, "agent": cmd_agent, "up": cmd_up, "replay": cmd_replay,
-            "report": cmd_report}  # fmt: skip
+            "report": cmd_report, "monitor": cmd_monitor, "status": cmd_status, "router": cmd_router,
+            "prepare": cmd_prepare}  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -71,7 +71,11 @@ def _raise_interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
-def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null) -> dict:
+def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = False) -> bool:
+    """Compile everything a run needs before it starts: the agents' ahead-of-time
+    step (in a subprocess, in parallel), the controller and world kernels, and
+    with `engine` the in-process engine loop.  Returns whether the
+    ahead-of-time build exists.  Container images run it at build time."""
     builder = None
     if aot.built() is None:  # agent processes run this build without numba (~35 MB instead of ~150)
         if progress:
@@ -80,10 +84,20 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
         builder = subprocess.Popen([sys.executable, "-m", "agents.controllers.aot"], stdout=subprocess.DEVNULL,
                                    stderr=subprocess.PIPE, text=True)  # fmt: skip
     warm_up()  # once here, so N agents starting together find the kernels in the cache,
-    GridWorld(load_scenario(scenario_ref).with_overrides(agents=1)).warm_up()  # and so does the world
+    scenario = load_scenario(scenario_ref).with_overrides(agents=2)
+    GridWorld(scenario).warm_up()  # and so does the world
+    if engine:
+        from swarm.engine import Engine
+
+        Engine(scenario).step(2)
     if builder is not None and builder.wait() != 0:
         print(f"swarm: note: the ahead-of-time build failed, agents use the JIT (more memory):\n"
               f"{builder.stderr.read()[-1500:]}", file=sys.stderr)  # fmt: skip
+    return aot.built() is not None
+
+
+def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null) -> dict:
+    prepare(scenario_ref, progress)
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
         summary_file = Path(tmp) / "summary.json"

@@ -36,6 +36,7 @@ FAMILY_GRID = "grid"
 FAMILIES = (FAMILY_GRID,)
 MAX_MESSAGE_BYTES = 64 * 1024
 INT64_MAX = 2**63 - 1
+ENDED = "the run has ended"  # the world's refusal to a join after the run (the agent then exits quietly)
 
 
 class Keys:

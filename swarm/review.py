@@ -111,6 +111,7 @@ def summary_from(rec: Recording) -> dict:
         tick_ms = rec.values("tick_ms")[1]
         summary.update({
             "run_id": m["run_id"], "mode": m["runtime"], "rejected_messages": int(rec.last("rejected_messages")),
+            "agents_peak": int(rec.values("agents_alive")[1].max(initial=0)),
             "tick_ms_p50": round(float(np.percentile(tick_ms, 50)), 3) if len(tick_ms) else 0.0,
             "tick_ms_p99": round(float(np.percentile(tick_ms, 99)), 3) if len(tick_ms) else 0.0,
         })  # fmt: skip

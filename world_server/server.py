@@ -13,8 +13,10 @@ a fresh body at the base.
 
 from __future__ import annotations
 
+import functools
 import json
 import queue
+import sys
 import time
 import uuid
 from dataclasses import dataclass, field
@@ -71,7 +73,7 @@ class Stats:
 class WorldServer:
     def __init__(
         self, scenario: Scenario, run_id: str, listen: str | None = None, connect: str | None = None,
-        deadline: float = 2.0, max_misses: int = 3, expect: int | None = None, start_timeout: float = 60.0,
+        deadline: float = 2.0, max_misses: int = 3, start_with: int | None = None, start_timeout: float = 60.0,
         until: str = "foraged", max_iterations: int = 1_000_000, null: bool = False,
         state_dir: str | None = None, persist_every: int = 50, resume_timeout: float = 30.0,
         mode: str = "lockstep", rate: float = 20.0, record: str | None = None, viewer: str | None = None,
@@ -89,7 +91,10 @@ class WorldServer:
         self.cparams = controller_params(scenario)
         self.deadline = deadline
         self.max_misses = max_misses
-        self.expect = scenario.agents if expect is None else expect
+        # Ticking starts once `start_with` agents are active; more may join later, up to scenario.agents.
+        self.start_with = scenario.agents if start_with is None else min(start_with, scenario.agents)
+        self.final: dict | None = None  # the summary, frozen when the run has ended
+        self.agents_peak = 0  # most agents active at the end of one tick
         self.start_timeout = start_timeout
         self.until = until
         self.max_iterations = max_iterations
@@ -154,11 +159,15 @@ class WorldServer:
 
     def _recorder(self, record: str, viewer: str | None):
         """A resumed run records into a new file from its resume tick: the
-        first file stays as it was (rerun merges files of one recording id)."""
+        first file stays as it was (rerun merges files of one recording id).
+        `record` may name a folder (ending in /): the file is then
+        <run-id>-<UTC time>.rrd in it, as containers write to a mounted folder."""
         from swarm.recording import Recorder, run_meta
 
         path = Path(record)
-        if self.resumed and path.exists():
+        if record.endswith("/") or path.is_dir():  # a folder: one new file per run, never overwritten
+            path = path / f"{self.keys.run}-{time.strftime('%Y%m%d-%H%M%S', time.gmtime())}.rrd"
+        elif self.resumed and path.exists():
             path = path.with_name(f"{path.stem}.from-{self.tick}{path.suffix}")
         meta = run_meta(self.scenario, self.world, self.keys.run, self.until, self.mode)
         meta["resumed_at"] = self.tick if self.resumed else None
@@ -182,7 +191,7 @@ class WorldServer:
         elif kind == "join":
             self._on_join(item)
         elif kind == "info":
-            self._reply(item, self.keys.info, proto.pack({"type": "info", **self.summary()}))
+            self._reply(item, self.keys.info, proto.pack(self.info()))
         elif kind == "marks?":
             self._on_marks_query(item)
         elif kind == "alive":
@@ -204,6 +213,9 @@ class WorldServer:
         if request.get("controller") != self.scenario.controller:
             reason = f"this run uses controller {self.scenario.controller!r}, not {request.get('controller')!r}"
             self._reply(query, self.keys.join, proto.refuse_reply(reason))
+            return
+        if self.final is not None:
+            self._reply(query, self.keys.join, proto.refuse_reply(proto.ENDED))
             return
         nonce = request["nonce"]
         agent = self.nonces.get(nonce)  # a retried join gets the same id
@@ -347,9 +359,9 @@ class WorldServer:
                 self._lose(int(agent))  # did not come back
             return
         deadline = time.monotonic() + self.start_timeout
-        while int((self.slots == ACTIVE).sum()) < self.expect:
+        while int((self.slots == ACTIVE).sum()) < self.start_with:
             if time.monotonic() > deadline:
-                raise TimeoutError(f"only {int((self.slots == ACTIVE).sum())} of {self.expect} agents joined")
+                raise TimeoutError(f"only {int((self.slots == ACTIVE).sum())} of {self.start_with} agents joined")
             self._drain(0.05)
 
     def _wait_for_any_agent(self) -> None:
@@ -410,8 +422,10 @@ class WorldServer:
         if self.persist_every and self.tick % self.persist_every == 0:
             self.save_state()
         self.tick_seconds.append(time.perf_counter() - started)
+        present = self.slots == ACTIVE
+        self.agents_peak = max(self.agents_peak, int(present.sum()))
         if self.recorder is not None:
-            self.recorder.capture(tick, present=self.slots == ACTIVE, tick_ms=self.tick_seconds[-1] * 1000,
+            self.recorder.capture(tick, present=present, tick_ms=self.tick_seconds[-1] * 1000,
                                   rejected=self.stats.rejected_total)  # fmt: skip
         self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress()}))
 
@@ -440,8 +454,9 @@ class WorldServer:
             self.step()
         self._drain(0.0)
         self.save_state()
-        summary = self.summary()
+        self.final = summary = self.summary()
         self._close_recording(summary)
+        self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress(), "ended": True}))
         return summary
 
     def _close_recording(self, summary: dict) -> None:
@@ -454,6 +469,16 @@ class WorldServer:
         `until()` is true: clients can still read the final marking environment."""
         while not until():
             self._drain(0.1)
+
+    def info(self) -> dict:
+        """What `swarm status`, `swarm monitor` and agents checking their
+        membership read: the summary so far (final once ended), the ids of the
+        agents in the run, and whether it has ended."""
+        members = np.flatnonzero((self.slots == ACTIVE) | (self.slots == JOINING)).tolist()
+        summary = self.final if self.final is not None else self.summary()
+        return {"type": "info", **summary, "members": members, "ended": self.final is not None,
+                "agents_alive": int((self.slots == ACTIVE).sum()), "start_with": self.start_with,
+                "tick": self.tick}  # fmt: skip
 
     def progress(self) -> dict:
         w = self.world
@@ -474,6 +499,7 @@ class WorldServer:
             "grid": list(w.layout.shape), "run_id": self.keys.run, "mode": self.mode,
             "rejected_messages": self.stats.rejected_total, "rejected_by_reason": dict(self.stats.rejected),
             "agents_lost": self.stats.agents_lost, "joins": self.stats.joins, "missed_ticks": self.stats.missed_ticks,
+            "agents_peak": self.agents_peak,
             "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0,
             "wall_seconds": round(elapsed, 3), **w.bodies.summary(s.agents), **self._latency(),
             "recording": self.recording_path,
@@ -523,8 +549,15 @@ def new_run_id() -> str:
 
 def serve(scenario: Scenario, run_id: str, summary_file: str | None = None, linger: float = 0.0, **kw) -> dict:
     server = WorldServer(scenario, run_id, **kw)
+    log = functools.partial(print, file=sys.stderr, flush=True)
     try:
+        log(f"swarm world: run {run_id!r}, {scenario.name} (seed {scenario.seed}, {scenario.controller}): "
+            f"{server.start_with} agents start it, up to {scenario.agents} may join")  # fmt: skip
         summary = server.run()
+        log(f"swarm world: run {run_id!r} {'finished' if summary['finished'] else 'stopped'} after "
+            f"{summary['iterations']} ticks; recording: {summary['recording']}")  # fmt: skip
+        if linger > 0:
+            log(f"swarm world: serving the final state for {linger:g} s")
         server.stop_agents("finished" if summary["finished"] else "stopped")
         if summary_file:
             with open(summary_file, "w") as f:

@@ -1,0 +1,114 @@
+"""Watching a run from outside: `swarm status`, `swarm monitor`, `swarm router`.
+
+These are the pieces a deployment needs besides the world and the agents
+(compose.yaml uses all three): a zenoh router on its own, a probe that says
+whether a router or a world answers (health checks), and a monitor that
+follows a run on its `state` key and prints the summary when the world says
+the run has ended.  All of them only read the run's key space.
+"""
+
+from __future__ import annotations
+
+import queue
+import signal
+import sys
+import threading
+import time
+
+from swarm import protocol as proto
+from swarm.bus import open_client, open_router
+
+
+def world_info(session, keys: proto.Keys, timeout: float = 2.0) -> dict | None:
+    """The world's answer on swarm/<run>/info, or None if no world answers."""
+    for reply in session.get(keys.info, timeout=timeout):
+        if reply.ok:
+            info = proto.unpack(reply.ok.payload.to_bytes())
+            if isinstance(info, dict) and info.get("type") == "info":
+                return info
+    return None
+
+
+def status(connect: str, run_id: str, router_only: bool = False, timeout: float = 3.0) -> dict | None:
+    """{"router": ...} if only the router is asked, else the world's info; None if nobody answers."""
+    try:
+        session = open_client(connect, timeout=timeout)
+    except ConnectionError:
+        return None
+    try:
+        if router_only:
+            return {"router": connect}
+        return world_info(session, proto.Keys(run_id), timeout=timeout)
+    finally:
+        session.close()
+
+
+def serve_router(listen: str) -> None:
+    """A bare zenoh router until SIGTERM or Ctrl-C."""
+    session = open_router(listen)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    print(f"swarm: zenoh router listening on {listen}", file=sys.stderr, flush=True)
+    try:
+        while not stop.wait(1.0):
+            pass
+    finally:
+        session.close()
+
+
+def monitor(connect: str, run_id: str, progress: bool, log_every: float = 5.0, start_timeout: float = 600.0) -> dict:
+    """Follow a run until its world says it has ended; returns the final summary.
+
+    Progress goes to stderr: a bar on a terminal, else one line every
+    `log_every` seconds (container logs).  The end is read from the world's
+    info, polled once a second, so a monitor that starts late, even after the
+    run, still gets the summary."""
+    from tqdm import tqdm
+
+    keys = proto.Keys(run_id)
+    session = open_client(connect, timeout=start_timeout)
+    states: queue.Queue = queue.Queue()
+    sub = session.declare_subscriber(keys.state, states.put)
+    bar = tqdm(desc="delivered", unit="unit", disable=not progress, leave=False)
+    last_log = seen = 0.0
+    deadline = time.monotonic() + start_timeout
+    try:
+        while True:
+            info = world_info(session, keys)
+            if info is None and not seen and time.monotonic() > deadline:
+                raise TimeoutError(f"no world answered on {keys.info} for {start_timeout:g} s; is it running?")
+            if info is not None:
+                seen = True
+                if info.get("ended"):
+                    return {k: v for k, v in info.items() if k not in ("type", "members", "ended")}
+            latest = None
+            try:
+                while True:
+                    msg = proto.unpack(states.get(timeout=0.05 if latest else 1.0).payload.to_bytes())
+                    if isinstance(msg, dict):
+                        latest = msg
+            except queue.Empty:
+                pass
+            state = latest or info
+            if state is None:
+                continue
+            if state.get("tick", 0) == 0 and info is not None:  # the world waits for its first agents
+                bar.set_description(f"waiting for agents {info['agents_alive']}/{info['start_with']}")
+            else:
+                bar.set_description("delivered")
+            bar.total, bar.n = state.get("total"), state.get("delivered", 0)
+            bar.set_postfix(tick=state.get("tick"), alive=state.get("agents_alive"), tps=state.get("ticks_per_second"))
+            bar.refresh()
+            if not progress and time.monotonic() - last_log >= log_every:
+                last_log = time.monotonic()
+                if state.get("tick", 0) == 0 and info is not None:
+                    print(f"waiting for agents: {info['agents_alive']} of {info['start_with']} joined",
+                          file=sys.stderr, flush=True)  # fmt: skip
+                    continue
+                print(f"tick {state.get('tick')}: delivered {state.get('delivered')}/{state.get('total')}, "
+                      f"{state.get('agents_alive')} agents, {state.get('ticks_per_second')} ticks/s",
+                      file=sys.stderr, flush=True)  # fmt: skip
+    finally:
+        bar.close()
+        sub.undeclare()
+        session.close()

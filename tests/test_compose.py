@@ -1,0 +1,126 @@
+"""`docker compose up swarm` against a real Docker engine (compose.yaml, Dockerfile).
+
+The image is built from a debootstrapped base and a host-built wheelhouse (no
+registry is reachable here).  One run of 3 agent containers goes to the end:
+the monitor's summary and its exit code, and the recording in ./runs.  A second,
+longer run is scaled from 3 to 5 agents while the world ticks: the two new
+containers join it.  Debian ships compose v1 (`docker-compose`), whose
+`--exit-code-from` is broken on Python 3.11, so exit codes are read with
+`docker inspect`.  Everything is torn down, run or fail.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import subprocess
+import sys
+import time
+import uuid
+
+import pytest
+
+from tests.docker_engine import BASE_TAG, ROOT, build_base, build_wheelhouse, docker_engine, why_no_engine
+
+pytestmark = pytest.mark.timeout(900)
+
+reason = why_no_engine()
+if reason is not None:
+    pytest.skip(f"compose smoke test needs a Docker engine: {reason}", allow_module_level=True)
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Compose:
+    def __init__(self, project: str, **settings: str):
+        self.project = project
+        self.env = {**os.environ, "BASE": BASE_TAG, **settings}
+
+    def __call__(self, *args: str, timeout: float = 300, check: bool = True) -> subprocess.CompletedProcess:
+        return subprocess.run(["docker-compose", "-p", self.project, *args], cwd=ROOT, env=self.env, text=True,
+                              capture_output=True, timeout=timeout, check=check)  # fmt: skip
+
+    def exit_code(self, service: str) -> int:
+        (cid,) = self("ps", "-q", service).stdout.split()
+        out = subprocess.run(["docker", "inspect", "-f", "{{.State.ExitCode}}", cid], capture_output=True, text=True)
+        return int(out.stdout.strip())
+
+    def status(self) -> dict | None:
+        """The world's info, asked from the host through the router's published port."""
+        out = subprocess.run(
+            [sys.executable, "-m", "swarm", "status", "--json", "--connect", f"tcp/127.0.0.1:{self.env['ROUTER_PORT']}",
+             "--run-id", self.env["RUN_ID"]], capture_output=True, text=True, timeout=60)  # fmt: skip
+        return json.loads(out.stdout) if out.returncode == 0 else None
+
+
+@pytest.fixture(scope="module")
+def compose():
+    project = f"swarmtest{uuid.uuid4().hex[:6]}"
+    ports = {"ROUTER_PORT": str(_free_port()), "VIEWER_PORT": str(_free_port()), "GRPC_PORT": str(_free_port())}
+    with docker_engine():
+        build_base()
+        build_wheelhouse()
+        c = Compose(project, **ports)
+        try:
+            started = time.monotonic()
+            c("build", "router", timeout=900)  # every service runs this one image (swarm:local)
+            print(f"image built in {time.monotonic() - started:.0f} s")
+            yield c
+        finally:
+            c("down", "--remove-orphans", "--timeout", "5", check=False, timeout=300)
+            for wheel in (ROOT / "wheels").glob("*.whl"):
+                wheel.unlink()
+
+
+def test_compose_up_swarm_runs_to_the_end_and_records(compose):
+    run_id = f"smoke{uuid.uuid4().hex[:6]}"
+    compose.env.update(RUN_ID=run_id, SCENARIO="open", SEED="1", AGENTS="3", MAX_AGENTS="3")
+    started = time.monotonic()
+    out = compose("up", "--scale", "agent=3", "swarm", timeout=600)
+    took = time.monotonic() - started
+    log = compose("logs", "--no-color", "swarm").stdout
+    assert compose.exit_code("swarm") == 0, log
+    assert "open: cmarking x3, seed 1: finished after 2367 iterations" in log, out.stdout + log  # = swarm run
+    assert "delivered 6000/6000" in log
+    assert "agents joined 3 (at most 3 at once), lost 0" in log
+    recordings = sorted((ROOT / "runs").glob(f"{run_id}-*.rrd"))
+    assert len(recordings) == 1
+    try:
+        from swarm.review import read_recording, summary_from
+
+        summary = summary_from(read_recording(recordings[0]))
+        assert (summary["iterations"], summary["delivered"], summary["agents_peak"]) == (2367, 6000, 3)
+    finally:
+        recordings[0].unlink()
+    assert took < 120, f"`up swarm` with images built took {took:.0f} s"
+    print(f"docker compose up swarm (images built): {took:.1f} s")
+
+
+def test_scaling_a_running_world_from_3_to_5_agents(compose):
+    run_id = f"scale{uuid.uuid4().hex[:6]}"
+    compose.env.update(RUN_ID=run_id, SCENARIO="setup1", SEED="1", AGENTS="3", MAX_AGENTS="5")
+    compose("up", "-d", "--scale", "agent=3", "agent", timeout=600)
+    deadline = time.monotonic() + 120
+    while (info := compose.status()) is None or info["tick"] < 50:
+        assert time.monotonic() < deadline, "the world did not start ticking with 3 agents"
+        time.sleep(0.5)
+    assert info["agents_alive"] == 3 and not info["ended"]
+    compose("up", "-d", "--scale", "agent=5", "--no-recreate", "agent", timeout=600)
+    deadline = time.monotonic() + 120
+    while (info := compose.status()) is None or info["agents_alive"] < 5:
+        assert info is None or not info["ended"], f"the run ended before the new agents joined: {info}"
+        assert time.monotonic() < deadline, f"the new agents did not join: {info}"
+        time.sleep(0.5)
+    joined_at = info["tick"]
+    compose("up", "--scale", "agent=5", "swarm", timeout=300)  # without --scale: back to AGENTS
+    log = compose("logs", "--no-color", "swarm").stdout
+    assert compose.exit_code("swarm") == 0, log
+    assert "finished after" in log and "agents joined 5 (at most 5 at once), lost 0" in log, log
+    for recording in (ROOT / "runs").glob(f"{run_id}-*.rrd"):
+        recording.unlink()
+    print(f"5 agents active from tick {joined_at}")
