@@ -24,6 +24,7 @@ pytestmark = pytest.mark.timeout(600)
 
 NODES = ("router", "world", "a1", "a2", "a3")
 SUBNET = "10.201.0"
+LINK_DOWN_SECONDS = 15
 
 
 def _ip(*args: str, check: bool = True) -> subprocess.CompletedProcess:
@@ -136,11 +137,14 @@ def test_an_agent_cut_off_is_lost_and_rejoins_when_its_link_returns(hosts, tmp_p
             _wait(hosts, run_id, "3 agents ticking", lambda i: i["agents_alive"] == 3 and i["tick"] > 50, 300)
 
             _ip("-n", hosts.hub, "link", "set", hosts.link("a1"), "down")  # cut a1 off
+            cut = time.monotonic()
             lost = _wait(hosts, run_id, "the world declares the cut agent lost",
                          lambda i: i["agents_lost"] >= 1 and i["agents_alive"] == 2, 60)  # fmt: skip
             goes_on = _wait(hosts, run_id, "the run goes on with 2 agents",
                             lambda i: i["tick"] > lost["tick"] + 100 and i["agents_alive"] == 2, 60)  # fmt: skip
             assert not goes_on["ended"]
+            # Longer than zenoh's lease (10 s): the agent's session to the router is gone and must reconnect.
+            time.sleep(max(0.0, cut + LINK_DOWN_SECONDS - time.monotonic()))
 
             _ip("-n", hosts.hub, "link", "set", hosts.link("a1"), "up")  # restore the link
             back = _wait(hosts, run_id, "the agent joins again",
