@@ -16,6 +16,7 @@ from numba import njit
 
 from agents.controllers.dispatch import controller_params, step_controller
 from agents.controllers.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind, new_memory
+from swarm.layer_classes import K_MARKS, K_RESOURCES, K_TRAILS, class_image
 from swarm.scenario import Layout, Scenario, ScenarioError
 from world_server.grid import (
     C_DELIVERED,
@@ -35,7 +36,8 @@ UNTIL_CONVERGED = 1
 UNTIL_BOTH = 2
 UNTIL = {"foraged": UNTIL_FORAGED, "converged": UNTIL_CONVERGED, "both": UNTIL_BOTH}
 DEFAULT_MAX_ITERATIONS = 1_000_000
-RECORDED_LAYERS = (L_MARK, L_TRAIL, L_RES)  # the grid layers a recording holds per tick
+RECORDED_LAYERS = (L_MARK, L_TRAIL, L_RES)  # the grid layers a recording holds per tick, of these class kinds:
+assert (K_MARKS, K_TRAILS, K_RESOURCES) == (0, 1, 2)
 
 
 @njit(cache=True)
@@ -60,9 +62,10 @@ def decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, blocke
 
 @njit(cache=True)
 def record_tick(t, layers, pos, payload, acts, counters, rec_pos, rec_mode, rec_payload, rec_counters, rec_last,
-                rec_layers, rec_changed):  # fmt: skip
+                rec_layers, rec_changed, rec_scales, rec_levels):  # fmt: skip
     """Copy tick t of a block into the recording buffers; a recorded layer is
-    copied only when it differs from the last copy (most ticks change little)."""
+    kept, as its class image (swarm.layer_classes), only when it differs from
+    the last copy (most ticks change little)."""
     rec_pos[t] = pos
     rec_mode[t] = acts[:, A_MODE]
     rec_payload[t] = payload
@@ -81,14 +84,14 @@ def record_tick(t, layers, pos, payload, acts, counters, rec_pos, rec_mode, rec_
         rec_changed[t, k] = changed
         if changed:
             last[:, :] = layer
-            rec_layers[t, k] = layer
+            class_image(k, layer, rec_scales[k], rec_levels[k], rec_layers[t, k])
 
 
 @njit(cache=True)
 def run_ticks(
     kind, layers, pher, pher_scratch, base_r, base_c, pos, payload, blocked, mem, acts,
     cparams, wparams, counters, pher_on, seed, tick0, n_ticks, until, total, reachable,
-    record, rec_pos, rec_mode, rec_payload, rec_counters, rec_last, rec_layers, rec_changed,
+    record, rec_pos, rec_mode, rec_payload, rec_counters, rec_last, rec_layers, rec_changed, rec_scales, rec_levels,
 ):  # fmt: skip
     """Run up to n_ticks ticks from tick0; stop early once `until` holds.
     Returns the number of ticks run.  With `record`, tick t of the call is
@@ -101,15 +104,15 @@ def run_ticks(
         resolve_tick(layers, pher, pher_scratch, base_r, base_c, pos, payload, acts, tick, wparams, counters, pher_on)
         if record:
             record_tick(t, layers, pos, payload, acts, counters, rec_pos, rec_mode, rec_payload, rec_counters,
-                        rec_last, rec_layers, rec_changed)  # fmt: skip
+                        rec_last, rec_layers, rec_changed, rec_scales, rec_levels)  # fmt: skip
         if is_done(until, counters, total, reachable):
             return t + 1
     return n_ticks
 
 
 _NO_RECORDING = (np.zeros((0, 0, 2), np.int64), np.zeros((0, 0), np.int64), np.zeros((0, 0), np.int64),
-                 np.zeros((0, 0), np.int64), np.zeros((0, 0, 0), np.int64), np.zeros((0, 0, 0, 0), np.int64),
-                 np.zeros((0, 0), np.bool_))  # fmt: skip
+                 np.zeros((0, 0), np.int64), np.zeros((0, 0, 0), np.int64), np.zeros((0, 0, 0, 0), np.uint16),
+                 np.zeros((0, 0), np.bool_), np.zeros(3, np.int64), np.ones(3, np.int64))  # fmt: skip
 
 
 @dataclass

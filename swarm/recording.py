@@ -7,19 +7,23 @@ after tick t's actions):
     run/summary         static: JSON of the summary the run printed (for people)
     world/obstacles     static RGBA image (walls, free cells)
     world/base          static point
-    world/marks         RGBA heat map of the marks (logged only when they change)
-    world/trails        RGBA trail colours (only when they change)
-    world/resources     RGBA, opacity = remaining quantity (only when it changes)
+    world/marks         class image: mark + 1 (0 = unmarked), coloured by a static
+                        viridis annotation context (logged only when they change)
+    world/trails        class image: trail id mod 20 + 1 (0 = none), 20 colours
+    world/resources     class image: remaining quantity, opacity rising with it
     world/agents        one batched point cloud, class id = agent state (STATES)
     metrics/<name>      scalar time series (METRICS, and agents/<state> counts)
 
 Capturing a tick only copies arrays (and only the layers that changed); the
-colouring and the rerun calls run once per `flush_every` ticks with
-`send_columns`, so recording costs little per tick and memory stays bounded.
+rerun calls run once per `flush_every` ticks with `send_columns`, so recording
+costs little per tick and memory stays bounded.  Grid layers travel as 16-bit
+class images and the viewer colours them from the annotation contexts: no
+colouring per tick here, and half the bytes of RGBA.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import platform
 from dataclasses import dataclass
@@ -31,13 +35,13 @@ import numpy as np
 from agents.controllers.layout import (
     A_MODE,
     ERASE,
-    MARK_NONE,
     RETURN,
     RETURN_COLOUR,
     RETURN_MEND,
     RETURN_REMOVE,
     SEARCH,
 )
+from swarm.layer_classes import class_images, level_range, n_levels
 from world_server.bodies import cell_centres
 from world_server.grid import C_DELIVERED, C_EXPLORED, C_OPTIMAL, L_MARK, L_RES, L_TRAIL, GridWorld
 
@@ -62,6 +66,7 @@ def agent_states(modes: np.ndarray, payload: np.ndarray, present: np.ndarray) ->
     return np.where(present, states, ABSENT).astype(np.uint16)
 
 
+@functools.cache
 def software_versions() -> dict[str, str]:
     versions = {"python": platform.python_version()}
     for dist in ("swarm", "numpy", "numba", "eclipse-zenoh", "pymunk", "rerun-sdk", "msgpack"):
@@ -74,8 +79,8 @@ def software_versions() -> dict[str, str]:
 
 @dataclass
 class Block:
-    """Consecutive recorded ticks: per tick and agent arrays, and the layer
-    snapshots (tick, layer name, array) of the ticks where a layer changed."""
+    """Consecutive recorded ticks: per tick and agent arrays, and for each grid
+    layer the snapshots of the ticks where it changed."""
 
     ticks: np.ndarray  # (T,)
     xy: np.ndarray  # (T, n, 2) float32 body positions
@@ -85,7 +90,7 @@ class Block:
     counters: np.ndarray  # (T, N_COUNTERS)
     tick_ms: np.ndarray  # (T,)
     rejected: np.ndarray  # (T,)
-    layers: list[tuple[int, str, np.ndarray]]
+    layers: dict[str, tuple[np.ndarray, np.ndarray]]  # name -> (ticks (k,), snapshots (k, H, W))
 
 
 class EngineTap:
@@ -103,19 +108,24 @@ class EngineTap:
         self.counters = np.zeros((self.block, len(w.counters)), np.int64)
         self.last = np.stack([w.layers[i] for i in LAYERS.values()])
         self.last[:] = -1  # nothing recorded yet: the first tick stores every layer
-        self.layers = np.zeros((self.block, len(LAYERS), h, w_), np.int64)
+        self.layers = np.zeros((self.block, len(LAYERS), h, w_), np.uint16)  # class images
         self.changed = np.zeros((self.block, len(LAYERS)), np.bool_)
+        self.scales = np.array(recorder.scales, np.int64)
+        self.levels = np.array([n_levels(k, scale) for k, scale in enumerate(recorder.scales)], np.int64)
 
     def buffers(self, n_ticks: int) -> tuple:
         if n_ticks > self.block:
             raise ValueError(f"record at most {self.block} ticks per engine step")
-        return self.pos, self.modes, self.payload, self.counters, self.last, self.layers, self.changed
+        return (self.pos, self.modes, self.payload, self.counters, self.last, self.layers, self.changed, self.scales,
+                self.levels)  # fmt: skip
 
     def take(self, tick0: int, ran: int, seconds: float) -> None:
         """Hand the `ran` ticks just run (from tick0) to the recorder."""
-        names = list(LAYERS)
-        layers = [(tick0 + t, names[k], self.layers[t, k].copy())
-                  for t, k in zip(*np.nonzero(self.changed[:ran]), strict=True)]  # fmt: skip
+        layers = {}
+        for k, name in enumerate(LAYERS):
+            rows = np.flatnonzero(self.changed[:ran, k])
+            if len(rows):
+                layers[name] = (tick0 + rows, self.layers[rows, k])  # class images; fancy indexing copies
         n = self.pos.shape[1]
         self.recorder.add(Block(
             ticks=np.arange(tick0, tick0 + ran), xy=cell_centres(self.pos[:ran]).astype(np.float32),
@@ -170,8 +180,8 @@ class Recorder:
         self._blocks: list[Block] = []
         self._held = 0  # ticks in the blocks not yet flushed
         self._last: dict[str, np.ndarray] = {}
-        self._mark_scale = max(1, int(world.layout.bfs.max()))
-        self._res_scale = max(1, int(world.layers[L_RES].max()))
+        # per layer kind (swarm.layer_classes): the value that gets the last class
+        self.scales = (max(1, int(world.layout.bfs.max())), 0, max(1, int(world.layers[L_RES].max())))
         self._log_static()
 
     # ------------------------------------------------------------------ static
@@ -183,9 +193,11 @@ class Recorder:
         h, w_ = w.layout.shape
         walls = np.where(w.layout.obstacles[..., None], [40, 40, 48, 255], [235, 235, 228, 255]).astype(np.uint8)
         rec.log("world/obstacles", rr.Image(walls, color_model="RGBA", draw_order=0.0), static=True)
-        fmt = rr.components.ImageFormat(width=w_, height=h, color_model="RGBA", channel_datatype="U8")
+        fmt = rr.components.ImageFormat(width=w_, height=h, channel_datatype="U16")
         for order, name in enumerate(LAYERS, start=1):
-            rec.log(f"world/{name}", rr.Image.from_fields(format=fmt, draw_order=float(order)), static=True)
+            rec.log(f"world/{name}", rr.AnnotationContext(self._legend(name)),
+                    rr.SegmentationImage.from_fields(format=fmt, opacity=1.0, draw_order=float(order)),
+                    static=True)  # fmt: skip
         r, c = w.base
         rec.log("world/base", rr.Points2D([[c + 0.5, r + 0.5]], radii=0.5, colors=[[220, 30, 30]], labels=["base"],
                                           draw_order=8.0), static=True)  # fmt: skip
@@ -203,13 +215,13 @@ class Recorder:
         """Take tick `tick` (just resolved) from the world: cheap copies only."""
         w = self.world
         n = len(w.pos)
-        layers = []
+        layers = {}
         for name, index in LAYERS.items():
             layer = w.layers[index]
             last = self._last.get(name)
             if last is None or not np.array_equal(layer, last):
                 self._last[name] = layer.copy()
-                layers.append((tick, name, self._last[name]))
+                layers[name] = (np.array([tick]), self._classes(name, self._last[name][None]))
         self.add(Block(
             ticks=np.array([tick]), xy=w.body_xy[None].astype(np.float32), modes=w.acts[None, :, A_MODE].copy(),
             payload=w.payload[None].copy(), present=(np.ones(n, bool) if present is None else present.copy())[None],
@@ -252,19 +264,35 @@ class Recorder:
             rec.send_columns("world/agents", indexes=index, columns=rr.Points2D.columns(
                 positions=xy, class_ids=states.ravel()).partition([n] * len(ticks)))  # fmt: skip
         for name in LAYERS:
-            changes = [(t, layer) for b in blocks for t, which, layer in b.layers if which == name]
+            changes = [b.layers[name] for b in blocks if name in b.layers]
             if changes:
-                rgba = self._colour(name, np.stack([layer for _, layer in changes]))
-                rec.send_columns(f"world/{name}", indexes=[rr.TimeColumn("tick", sequence=[t for t, _ in changes])],
-                                 columns=rr.Image.columns(buffer=rgba.reshape(len(changes), -1)))  # fmt: skip
+                ticks_changed = np.concatenate([t for t, _ in changes]).astype(np.int64)
+                classes = np.concatenate([snap for _, snap in changes])
+                rec.send_columns(f"world/{name}", indexes=[rr.TimeColumn("tick", sequence=ticks_changed)],
+                                 columns=rr.SegmentationImage.columns(
+                                     buffer=classes.reshape(len(classes), -1).view(np.uint8)))  # fmt: skip
 
-    def _colour(self, name: str, layers: np.ndarray) -> np.ndarray:
-        """RGBA of a stack of layer snapshots (k, H, W) -> (k, H, W, 4)."""
-        if name == "marks":
-            return _heat(layers, self._mark_scale)
+    def _classes(self, name: str, layers: np.ndarray) -> np.ndarray:
+        kind = list(LAYERS).index(name)
+        return class_images(kind, layers, self.scales[kind])
+
+    def _legend(self, name: str) -> list[tuple[int, str, tuple[int, int, int, int]]]:
+        """The annotation context that colours a layer's class image; class 0 is transparent."""
+        none = (0, "none", (0, 0, 0, 0))
         if name == "trails":
-            return _trail_colours(layers)
-        return _resource_colours(layers, self._res_scale)
+            return [none, *((k + 1, f"trail id mod {len(TAB20)} = {k}", (*map(int, c[:3]), 230))
+                            for k, c in enumerate(TAB20))]  # fmt: skip
+        kind = list(LAYERS).index(name)
+        scale = self.scales[kind]
+        legend = [none]
+        for level in range(n_levels(kind, scale)):
+            low, high = level_range(kind, level, scale)
+            text = f"{low}" if low == high else f"{low}-{high}"
+            if name == "marks":  # viridis from the base (0) to the farthest cell
+                legend.append((level + 1, f"mark {text}", (*map(int, VIRIDIS[low * 255 // scale][:3]), 200)))
+            else:  # resources: opacity rises with the quantity left
+                legend.append((level + 1, f"{text} units", (250, 170, 20, 60 + high * 195 // scale)))
+        return legend
 
     def close(self, summary: dict | None = None) -> None:
         """Flush what is left, store the printed summary, close the file."""
@@ -288,25 +316,3 @@ VIRIDIS = np.stack([np.interp(np.linspace(0, 8, 256), np.arange(9), _VIRIDIS_ANC
                    axis=1).astype(np.uint8)  # fmt: skip
 TAB20 = _hex("1f77b4 aec7e8 ff7f0e ffbb78 2ca02c 98df8a d62728 ff9896 9467bd c5b0d5 "
              "8c564b c49c94 e377c2 f7b6d2 7f7f7f c7c7c7 bcbd22 dbdb8d 17becf 9edae5")  # fmt: skip
-
-
-def _heat(marks: np.ndarray, scale: int) -> np.ndarray:
-    """Marks as a viridis heat map (0 = base, `scale` = the farthest cell); unmarked cells transparent."""
-    marked = marks != MARK_NONE
-    rgba = VIRIDIS[np.clip(np.where(marked, marks, 0) * 255 // scale, 0, 255)]
-    rgba[..., 3] = np.where(marked, 200, 0)
-    return rgba
-
-
-def _trail_colours(trails: np.ndarray) -> np.ndarray:
-    """Each trail id one of 20 distinct colours; no trail transparent."""
-    rgba = TAB20[trails % 20]
-    rgba[..., 3] = np.where(trails > 0, 230, 0)
-    return rgba
-
-
-def _resource_colours(res: np.ndarray, scale: int) -> np.ndarray:
-    rgba = np.zeros((*res.shape, 4), dtype=np.uint8)
-    rgba[..., :3] = (250, 170, 20)
-    rgba[..., 3] = np.where(res > 0, 60 + np.minimum(res, scale) * 195 // scale, 0)
-    return rgba
