@@ -113,6 +113,7 @@ def build_parser() -> argparse.ArgumentParser:
     world.add_argument("--max-misses", type=_positive, default=3, metavar="K",
                        help="an agent that misses K ticks in a row is lost (default 3)")  # fmt: skip
     world.add_argument("--summary-file", metavar="FILE", help="also write the summary JSON here")
+    world.add_argument("--quiet", action="store_true", help="no log lines on stderr (swarm up shows its own progress)")
     world.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
     world.add_argument(
         "--state-dir",
@@ -336,7 +337,8 @@ def cmd_world(args) -> int:
     scenario = _scenario(args)
     if args.until != "foraged" and scenario.controller == "ant":
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
-    summary = serve(scenario, args.run_id, args.summary_file, listen=None if args.connect else args.listen,
+    summary = serve(scenario, args.run_id, args.summary_file, quiet=args.quiet,
+                    listen=None if args.connect else args.listen,
                     connect=args.connect, deadline=args.deadline, max_misses=args.max_misses, until=args.until,
                     start_with=args.start_with,
                     max_iterations=args.max_iterations, linger=args.linger,

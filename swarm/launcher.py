@@ -103,7 +103,7 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
         summary_file = Path(tmp) / "summary.json"
         world_cmd = [*python, "world", scenario_ref, "--agents", str(agents), "--controller", controller,
                      "--run-id", run_id, "--listen", listen, "--summary-file", str(summary_file),
-                     "--start-timeout", str(60 + 3 * agents), *world_options]  # fmt: skip
+                     "--start-timeout", str(60 + 3 * agents), "--quiet", *world_options]  # fmt: skip
         agent_cmd = [*python, "agent", "--controller", controller, "--connect", listen, "--run-id", run_id,
                      "--count", str(per_process)]  # fmt: skip
         if null:

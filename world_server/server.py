@@ -547,9 +547,10 @@ def new_run_id() -> str:
     return uuid.uuid4().hex[:8]
 
 
-def serve(scenario: Scenario, run_id: str, summary_file: str | None = None, linger: float = 0.0, **kw) -> dict:
+def serve(scenario: Scenario, run_id: str, summary_file: str | None = None, linger: float = 0.0, quiet: bool = False,
+          **kw) -> dict:  # fmt: skip
     server = WorldServer(scenario, run_id, **kw)
-    log = functools.partial(print, file=sys.stderr, flush=True)
+    log = (lambda *_: None) if quiet else functools.partial(print, file=sys.stderr, flush=True)
     try:
         log(f"swarm world: run {run_id!r}, {scenario.name} (seed {scenario.seed}, {scenario.controller}): "
             f"{server.start_with} agents start it, up to {scenario.agents} may join")  # fmt: skip
