@@ -24,6 +24,7 @@ examples:
   swarm run maze --controller marking --until converged --json
   swarm experiment table1 --reps 100
   swarm bench engine | distributed | recording
+  docker compose up swarm                       # the same in containers (compose.yaml, docs/docker.md)
 """
 
 
