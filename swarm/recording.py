@@ -195,7 +195,7 @@ class Recorder:
         rec.log("world/obstacles", rr.Image(walls, color_model="RGBA", draw_order=0.0), static=True)
         fmt = rr.components.ImageFormat(width=w_, height=h, channel_datatype="U16")
         for order, name in enumerate(LAYERS, start=1):
-            rec.log(f"world/{name}", rr.AnnotationContext(self._legend(name)),
+            rec.log(f"world/{name}", _annotation_context(name, self.scales[list(LAYERS).index(name)]),
                     rr.SegmentationImage.from_fields(format=fmt, opacity=1.0, draw_order=float(order)),
                     static=True)  # fmt: skip
         r, c = w.base
@@ -276,24 +276,6 @@ class Recorder:
         kind = list(LAYERS).index(name)
         return class_images(kind, layers, self.scales[kind])
 
-    def _legend(self, name: str) -> list[tuple[int, str, tuple[int, int, int, int]]]:
-        """The annotation context that colours a layer's class image; class 0 is transparent."""
-        none = (0, "none", (0, 0, 0, 0))
-        if name == "trails":
-            return [none, *((k + 1, f"trail id mod {len(TAB20)} = {k}", (*map(int, c[:3]), 230))
-                            for k, c in enumerate(TAB20))]  # fmt: skip
-        kind = list(LAYERS).index(name)
-        scale = self.scales[kind]
-        legend = [none]
-        for level in range(n_levels(kind, scale)):
-            low, high = level_range(kind, level, scale)
-            text = f"{low}" if low == high else f"{low}-{high}"
-            if name == "marks":  # viridis from the base (0) to the farthest cell
-                legend.append((level + 1, f"mark {text}", (*map(int, VIRIDIS[low * 255 // scale][:3]), 200)))
-            else:  # resources: opacity rises with the quantity left
-                legend.append((level + 1, f"{text} units", (250, 170, 20, 60 + high * 195 // scale)))
-        return legend
-
     def close(self, summary: dict | None = None) -> None:
         """Flush what is left, store the printed summary, close the file."""
         self.flush()
@@ -304,6 +286,28 @@ class Recorder:
 
 
 # ------------------------------------------------------------------ colouring
+
+
+@functools.cache
+def _annotation_context(name: str, scale: int):
+    """What colours (and names) a layer's classes; class 0 is transparent.  Made
+    once per process and layer: rerun converts class descriptions slowly (~65 µs each)."""
+    import rerun as rr
+
+    none = (0, "none", (0, 0, 0, 0))
+    if name == "trails":
+        return rr.AnnotationContext([none, *((k + 1, f"trail id mod {len(TAB20)} = {k}", (*map(int, c[:3]), 230))
+                                             for k, c in enumerate(TAB20))])  # fmt: skip
+    kind = list(LAYERS).index(name)
+    legend = [none]
+    for level in range(n_levels(kind, scale)):
+        low, high = level_range(kind, level, scale)
+        text = f"{low}" if low == high else f"{low}-{high}"
+        if name == "marks":  # viridis from the base (0) to the farthest cell
+            legend.append((level + 1, f"mark {text}", (*map(int, VIRIDIS[low * 255 // scale][:3]), 200)))
+        else:  # resources: opacity rises with the quantity left
+            legend.append((level + 1, f"{text} units", (250, 170, 20, 60 + high * 195 // scale)))
+    return rr.AnnotationContext(legend)
 
 
 def _hex(colours: str) -> np.ndarray:
