@@ -17,6 +17,7 @@ import socket
 import subprocess
 import sys
 import time
+import urllib.request
 import uuid
 
 import pytest
@@ -97,6 +98,8 @@ def test_compose_up_swarm_runs_to_the_end_and_records(compose):
         assert (summary["iterations"], summary["delivered"], summary["agents_peak"]) == (2367, 6000, 3)
     finally:
         recordings[0].unlink()
+    with urllib.request.urlopen(f"http://127.0.0.1:{compose.env['VIEWER_PORT']}", timeout=10) as page:
+        assert page.status == 200  # the web viewer, published on the host
     assert took < 120, f"`up swarm` with images built took {took:.0f} s"
     print(f"docker compose up swarm (images built): {took:.1f} s")
 
