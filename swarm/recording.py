@@ -148,7 +148,10 @@ def default_blueprint():
 
     plots = [rrb.TimeSeriesView(origin=f"/metrics/{name}", name=name.replace("_", " "))
              for name in ("delivered", "optimal_share", "agents_alive")]  # fmt: skip
-    plots.append(rrb.TimeSeriesView(origin="/metrics/agents", name="agents per state"))
+    # the empty slots ("absent") stay in the recording but not in the plot: a world with 64 slots and
+    # 3 agents would otherwise show little else
+    plots.append(rrb.TimeSeriesView(origin="/metrics/agents", name="agents per state",
+                                    contents=["$origin/**", f"- $origin/{STATES[ABSENT]}"]))  # fmt: skip
     return rrb.Blueprint(
         rrb.Horizontal(
             rrb.Spatial2DView(origin="/world", name="grid"),

@@ -152,8 +152,9 @@ def write_plots(rec: Recording, out: Path) -> list[Path]:
 
     fig, ax = plt.subplots(figsize=(6, 3.5))
     ticks = rec.values(f"agents/{STATES[0]}")[0]
-    counts = [rec.values(f"agents/{s}")[1] for s in STATES]
-    ax.stackplot(ticks, *counts, labels=STATES)
+    present = [s for s in STATES if s != "absent"]  # empty slots are not agents
+    counts = [rec.values(f"agents/{s}")[1] for s in present]
+    ax.stackplot(ticks, *counts, labels=present)
     ax.set(xlabel="tick", ylabel="agents", title="Agents per state")
     ax.legend(loc="upper right", fontsize="small")
     save(fig, "agent_states.png")
