@@ -19,6 +19,7 @@ from agents.controllers import aot
 from agents.controllers.layout import A_MARK, MARK, MARK_NONE, controller_kind, new_action, new_memory
 from swarm import protocol as proto
 from swarm.bus import DEFAULT_ENDPOINT, open_client
+from swarm.monitor import world_info
 
 
 class JoinRefused(RuntimeError):
@@ -117,29 +118,23 @@ class AgentRuntime:
         memories.  A world that does not answer, or that simply has not
         started, is left alone."""
         try:
-            replies = list(self.session.get(self.keys.info, timeout=2.0))
+            info = world_info(self.session, self.keys)
         except Exception:  # zenoh errors while the link is down: try again later
             return
-        for reply in replies:
-            if not reply.ok:
-                continue
-            info = proto.unpack(reply.ok.payload.to_bytes())
-            if isinstance(info, proto.Rejected) or info.get("type") != "info" or info.get("ended"):
-                continue
-            members = set(info.get("members", []))
-            for slot, agent in enumerate(list(self.agents)):
-                if agent in members:
-                    continue
-                if (token := self.tokens.pop(agent, None)) is not None:
-                    token.undeclare()
-                try:
-                    new = self._join(timeout=5.0)
-                except TimeoutError:
-                    return
-                self.agents[slot] = new
-                self.mem[slot] = new_memory(1)[0]
-            self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
+        if info is None or info.get("ended"):
             return
+        members = set(info.get("members", []))
+        for slot, agent in enumerate(self.agents):
+            if agent in members:
+                continue
+            if (token := self.tokens.pop(agent, None)) is not None:
+                token.undeclare()
+            try:
+                self.agents[slot] = self._join(timeout=5.0)
+            except TimeoutError:
+                break
+            self.mem[slot] = new_memory(1)[0]
+        self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
 
     def _answer(self, obs: proto.Obs) -> int:
         """Step every agent of ours in the batch; one mark message, one action message."""

@@ -8,7 +8,7 @@ import signal
 import sys
 from pathlib import Path
 
-from swarm.errors import RecordingError
+from swarm.errors import RecordingError, raise_interrupt
 from swarm.scenario import PRESET_HELP, ScenarioError, bundled_scenarios, load_scenario
 
 DESCRIPTION = """\
@@ -281,8 +281,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 2
-    # SIGTERM (docker stop, kill) ends a command like Ctrl-C: its `finally` blocks close sessions and recordings.
-    signal.signal(signal.SIGTERM, _raise_interrupt)
+    signal.signal(signal.SIGTERM, raise_interrupt)
     try:
         return COMMANDS[args.command](args)
     except (ScenarioError, RecordingError) as exc:
@@ -295,10 +294,6 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("swarm: interrupted", file=sys.stderr)
         return 130
-
-
-def _raise_interrupt(signum, frame):
-    raise KeyboardInterrupt
 
 
 def _print_summary(summary: dict, as_json: bool, until: str) -> int:

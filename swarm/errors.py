@@ -1,6 +1,13 @@
-"""Errors the `swarm` command reports as one line (exit status 2), kept in a
-module that imports nothing heavy so the command can catch them cheaply."""
+"""Errors the `swarm` command reports as one line (exit status 2), and the
+SIGTERM handler that turns termination into KeyboardInterrupt, kept in a module
+that imports nothing heavy so the command can use them cheaply."""
 
 
 class RecordingError(Exception):
     """A recording is missing, not a swarm recording, damaged or truncated."""
+
+
+def raise_interrupt(signum, frame):
+    """SIGTERM handler: end like Ctrl-C, so `finally` blocks close sessions, recordings and children
+    (docker stop, kill, a timeout; python as a container's PID 1 would otherwise ignore SIGTERM)."""
+    raise KeyboardInterrupt

@@ -22,6 +22,7 @@ from agents.controllers import aot
 from agents.controllers.dispatch import warm_up
 from swarm import protocol as proto
 from swarm.bus import open_client
+from swarm.errors import raise_interrupt
 from swarm.scenario import PhysicsParams, load_scenario
 from world_server.grid import GridWorld
 
@@ -50,7 +51,7 @@ def swarm_up(
     if agents % per_process:
         raise ValueError(f"{agents} agents do not split into processes of {per_process}")
     # SIGTERM (docker stop, timeout, kill) must clean up like Ctrl-C does: raise so `finally` runs.
-    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    previous = signal.signal(signal.SIGTERM, raise_interrupt)
     physics = physics or PhysicsParams()
     world_options = ["--until", until, "--max-iterations", str(max_iterations), "--deadline", str(deadline),
                      "--mode", mode, "--rate", str(rate), "--physics", physics.mode,
@@ -65,10 +66,6 @@ def swarm_up(
         return _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null)
     finally:
         signal.signal(signal.SIGTERM, previous)
-
-
-def _raise_interrupt(signum, frame):
-    raise KeyboardInterrupt
 
 
 def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = False) -> bool:

@@ -92,22 +92,20 @@ def monitor(connect: str, run_id: str, progress: bool, log_every: float = 5.0, s
             state = latest or info
             if state is None:
                 continue
-            if state.get("tick", 0) == 0 and info is not None:  # the world waits for its first agents
-                bar.set_description(f"waiting for agents {info['agents_alive']}/{info['start_with']}")
-            else:
-                bar.set_description("delivered")
-            bar.total, bar.n = state.get("total"), state.get("delivered", 0)
-            bar.set_postfix(tick=state.get("tick"), alive=state.get("agents_alive"), tps=state.get("ticks_per_second"))
-            bar.refresh()
-            if not progress and time.monotonic() - last_log >= log_every:
+            waiting = state.get("tick", 0) == 0 and info is not None  # the world waits for its first agents
+            if progress:
+                bar.set_description(f"waiting for agents {info['agents_alive']}/{info['start_with']}"
+                                    if waiting else "delivered")  # fmt: skip
+                bar.total, bar.n = state.get("total"), state.get("delivered", 0)
+                bar.set_postfix(tick=state.get("tick"), alive=state.get("agents_alive"),
+                                tps=state.get("ticks_per_second"))  # fmt: skip
+                bar.refresh()
+            elif time.monotonic() - last_log >= log_every:
                 last_log = time.monotonic()
-                if state.get("tick", 0) == 0 and info is not None:
-                    print(f"waiting for agents: {info['agents_alive']} of {info['start_with']} joined",
-                          file=sys.stderr, flush=True)  # fmt: skip
-                    continue
-                print(f"tick {state.get('tick')}: delivered {state.get('delivered')}/{state.get('total')}, "
-                      f"{state.get('agents_alive')} agents, {state.get('ticks_per_second')} ticks/s",
-                      file=sys.stderr, flush=True)  # fmt: skip
+                line = (f"waiting for agents: {info['agents_alive']} of {info['start_with']} joined" if waiting else
+                        f"tick {state.get('tick')}: delivered {state.get('delivered')}/{state.get('total')}, "
+                        f"{state.get('agents_alive')} agents, {state.get('ticks_per_second')} ticks/s")  # fmt: skip
+                print(line, file=sys.stderr, flush=True)
     finally:
         bar.close()
         sub.undeclare()

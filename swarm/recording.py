@@ -41,7 +41,7 @@ from agents.controllers.layout import (
     RETURN_REMOVE,
     SEARCH,
 )
-from swarm.layer_classes import class_images, level_range, n_levels
+from swarm.layer_classes import K_MARKS, K_TRAILS, class_images, level_range, n_levels
 from world_server.bodies import cell_centres
 from world_server.grid import C_DELIVERED, C_EXPLORED, C_OPTIMAL, L_MARK, L_RES, L_TRAIL, GridWorld
 
@@ -54,7 +54,7 @@ CARRYING, ABSENT = STATES.index("carrying"), STATES.index("absent")
 # Time series, in the order they are captured.
 METRICS = ("delivered", "in_transit", "explored_cells", "optimal_cells", "optimal_share", "agents_alive",
            "tick_ms", "rejected_messages")  # fmt: skip
-LAYERS = {"marks": L_MARK, "trails": L_TRAIL, "resources": L_RES}
+LAYERS = {"marks": L_MARK, "trails": L_TRAIL, "resources": L_RES}  # in the order of swarm.layer_classes' kinds
 FORMAT_VERSION = 1
 
 
@@ -197,9 +197,9 @@ class Recorder:
         walls = np.where(w.layout.obstacles[..., None], [40, 40, 48, 255], [235, 235, 228, 255]).astype(np.uint8)
         rec.log("world/obstacles", rr.Image(walls, color_model="RGBA", draw_order=0.0), static=True)
         fmt = rr.components.ImageFormat(width=w_, height=h, channel_datatype="U16")
-        for order, name in enumerate(LAYERS, start=1):
-            rec.log(f"world/{name}", _annotation_context(name, self.scales[list(LAYERS).index(name)]),
-                    rr.SegmentationImage.from_fields(format=fmt, opacity=1.0, draw_order=float(order)),
+        for kind, name in enumerate(LAYERS):
+            rec.log(f"world/{name}", _annotation_context(kind, self.scales[kind]),
+                    rr.SegmentationImage.from_fields(format=fmt, opacity=1.0, draw_order=float(kind + 1)),
                     static=True)  # fmt: skip
         r, c = w.base
         rec.log("world/base", rr.Points2D([[c + 0.5, r + 0.5]], radii=0.5, colors=[[220, 30, 30]], labels=["base"],
@@ -219,12 +219,12 @@ class Recorder:
         w = self.world
         n = len(w.pos)
         layers = {}
-        for name, index in LAYERS.items():
+        for kind, (name, index) in enumerate(LAYERS.items()):
             layer = w.layers[index]
             last = self._last.get(name)
             if last is None or not np.array_equal(layer, last):
                 self._last[name] = layer.copy()
-                layers[name] = (np.array([tick]), self._classes(name, self._last[name][None]))
+                layers[name] = (np.array([tick]), class_images(kind, self._last[name][None], self.scales[kind]))
         self.add(Block(
             ticks=np.array([tick]), xy=w.body_xy[None].astype(np.float32), modes=w.acts[None, :, A_MODE].copy(),
             payload=w.payload[None].copy(), present=(np.ones(n, bool) if present is None else present.copy())[None],
@@ -275,10 +275,6 @@ class Recorder:
                                  columns=rr.SegmentationImage.columns(
                                      buffer=classes.reshape(len(classes), -1).view(np.uint8)))  # fmt: skip
 
-    def _classes(self, name: str, layers: np.ndarray) -> np.ndarray:
-        kind = list(LAYERS).index(name)
-        return class_images(kind, layers, self.scales[kind])
-
     def close(self, summary: dict | None = None) -> None:
         """Flush what is left, store the printed summary, close the file."""
         self.flush()
@@ -292,21 +288,20 @@ class Recorder:
 
 
 @functools.cache
-def _annotation_context(name: str, scale: int):
+def _annotation_context(kind: int, scale: int):
     """What colours (and names) a layer's classes; class 0 is transparent.  Made
     once per process and layer: rerun converts class descriptions slowly (~65 µs each)."""
     import rerun as rr
 
     none = (0, "none", (0, 0, 0, 0))
-    if name == "trails":
+    if kind == K_TRAILS:
         return rr.AnnotationContext([none, *((k + 1, f"trail id mod {len(TAB20)} = {k}", (*map(int, c[:3]), 230))
                                              for k, c in enumerate(TAB20))])  # fmt: skip
-    kind = list(LAYERS).index(name)
     legend = [none]
     for level in range(n_levels(kind, scale)):
         low, high = level_range(kind, level, scale)
         text = f"{low}" if low == high else f"{low}-{high}"
-        if name == "marks":  # viridis from the base (0) to the farthest cell
+        if kind == K_MARKS:  # viridis from the base (0) to the farthest cell
             legend.append((level + 1, f"mark {text}", (*map(int, VIRIDIS[low * 255 // scale][:3]), 200)))
         else:  # resources: opacity rises with the quantity left
             legend.append((level + 1, f"{text} units", (250, 170, 20, 60 + high * 195 // scale)))

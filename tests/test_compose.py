@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import os
-import socket
 import subprocess
 import sys
 import time
@@ -22,6 +21,7 @@ import uuid
 
 import pytest
 
+from tests.distributed import free_endpoint
 from tests.docker_engine import BASE_TAG, ROOT, build_base, build_wheelhouse, docker_engine, why_no_engine
 
 pytestmark = pytest.mark.timeout(900)
@@ -29,12 +29,6 @@ pytestmark = pytest.mark.timeout(900)
 reason = why_no_engine()
 if reason is not None:
     pytest.skip(f"compose smoke test needs a Docker engine: {reason}", allow_module_level=True)
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 class Compose:
@@ -62,7 +56,7 @@ class Compose:
 @pytest.fixture(scope="module")
 def compose():
     project = f"swarmtest{uuid.uuid4().hex[:6]}"
-    ports = {"ROUTER_PORT": str(_free_port()), "VIEWER_PORT": str(_free_port()), "GRPC_PORT": str(_free_port())}
+    ports = {name: free_endpoint().rsplit(":", 1)[1] for name in ("ROUTER_PORT", "VIEWER_PORT", "GRPC_PORT")}
     with docker_engine():
         build_base()
         build_wheelhouse()

@@ -456,7 +456,6 @@ class WorldServer:
         self.save_state()
         self.final = summary = self.summary()
         self._close_recording(summary)
-        self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress(), "ended": True}))
         return summary
 
     def _close_recording(self, summary: dict) -> None:
