@@ -25,6 +25,7 @@ pytestmark = pytest.mark.timeout(600)
 NODES = ("router", "world", "a1", "a2", "a3")
 SUBNET = "10.201.0"
 LINK_DOWN_SECONDS = 15
+RATE_HZ = 50  # setup1 needs > 13,000 ticks: over 4 minutes at this rate
 
 
 def _ip(*args: str, check: bool = True) -> subprocess.CompletedProcess:
@@ -129,8 +130,11 @@ def test_an_agent_cut_off_is_lost_and_rejoins_when_its_link_returns(hosts, tmp_p
     router = f"tcp/{hosts.addr['router']}:7447"
     with open(tmp_path / "processes.log", "w") as log:
         hosts.start("router", "router", "--listen", router, log=log)
+        # Real time at a fixed rate: the run lasts minutes of wall-clock time however fast the machine
+        # is (lock-step setup1 ends in ~20 s on a fast one, before the cut link comes back).
         world = hosts.start("world", "world", "setup1", "--agents", "3", "--seed", "1", "--connect", router,
-                            "--run-id", run_id, "--deadline", "1", "--state-dir", str(tmp_path), log=log)  # fmt: skip
+                            "--run-id", run_id, "--mode", "realtime", "--rate", str(RATE_HZ),
+                            "--max-misses", str(RATE_HZ // 2), "--state-dir", str(tmp_path), log=log)  # fmt: skip
         for agent in ("a1", "a2", "a3"):
             hosts.start(agent, "agent", "--connect", router, "--run-id", run_id, log=log)
         try:
