@@ -149,7 +149,8 @@ def test_kill_9_an_agent_then_a_fresh_one_joins_and_the_run_finishes():
     import signal
     import time
 
-    scenario = load_scenario("open").with_overrides(agents=3, seed=7)
+    # setup1 lasts ~10,000 ticks: the newcomer's process has time to start on any machine (`open` ends in ~3 s)
+    scenario = load_scenario("setup1").with_overrides(agents=3, seed=7)
     endpoint = free_endpoint()
     world = ServerThread(scenario, "faults", endpoint, deadline=5.0).start()
     procs = start_agents(endpoint, "faults", "cmarking", 3)

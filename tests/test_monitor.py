@@ -40,7 +40,9 @@ def test_router_world_monitor_and_a_late_agent(tmp_path):
         while _status(endpoint, run_id, "--router").returncode != 0:
             assert time.monotonic() < deadline, "the router did not come up"
         world = subprocess.Popen(
-            [*SWARM, "world", "open", "--agents", "3", "--start-with", "2", "--seed", "1", "--connect", endpoint,
+            # setup1: with 2 agents ~29,000 ticks (tens of seconds), long enough for the late agent to join on
+            # any machine (`open` ends in ~3 s, close to the time one `swarm status` takes to start)
+            [*SWARM, "world", "setup1", "--agents", "3", "--start-with", "2", "--seed", "1", "--connect", endpoint,
              "--run-id", run_id, "--record", f"{tmp_path}/", "--linger", "60", "--state-dir", str(tmp_path)],
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
         procs.append(world)
@@ -59,7 +61,7 @@ def test_router_world_monitor_and_a_late_agent(tmp_path):
 
         out, err = monitor.communicate(timeout=180)
         assert monitor.returncode == 0, err
-        assert "open: cmarking x3, seed 1: finished after" in out
+        assert "setup1: cmarking x3, seed 1: finished after" in out
         assert "agents joined 3 (at most 3 at once), lost 0" in out, out
         assert "waiting for agents" in err or "tick " in err  # progress went to the log
 
