@@ -46,6 +46,7 @@ experiments: install
 	$(BIN)/swarm experiment table2 --reps 5000
 	$(BIN)/swarm experiment table3 --reps 50
 	$(BIN)/swarm experiment ants --reps 20
+	$(BIN)/swarm experiment congestion --reps 10 --seed 1
 
 bench: install
 	$(BIN)/swarm bench engine

@@ -77,8 +77,8 @@ def build_parser() -> argparse.ArgumentParser:
     exp = sub.add_parser(
         "experiment",
         help="reproduce a table of the paper",
-        description="Rerun one of the paper's experiments and write runs.csv, summary.csv, "
-        "table.md (paper beside ours) and plot.png.",
+        description="Rerun one of the paper's experiments (or the congestion study, which adds robot bodies "
+        "to Table 1) and write runs.csv, summary.csv, table.md (paper beside ours) and plot.png.",
     )
     from swarm.experiments import EXPERIMENTS
 

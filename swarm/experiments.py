@@ -19,7 +19,19 @@ import numpy as np
 
 from swarm import paper
 
-RUN_FIELDS = ["experiment", "scenario", "size", "agents", "controller", "seed", "iterations", "finished"]
+RUN_FIELDS = ["experiment", "scenario", "size", "agents", "controller", "physics", "seed", "iterations", "finished",
+              "blocked_share", "blocked_moves", "wall_seconds"]  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Config:
+    """One configuration of an experiment; it runs once per seed."""
+
+    scenario: str
+    size: int  # side of the grid, for tables over sizes
+    agents: int
+    controller: str = "cmarking"
+    physics: str = "ideal"
 
 
 @dataclass(frozen=True)
@@ -29,6 +41,7 @@ class RunSpec:
     size: int
     agents: int
     controller: str
+    physics: str
     seed: int
     max_iterations: int
 
@@ -38,7 +51,7 @@ class Experiment:
     name: str
     title: str
     default_reps: int
-    configs: Callable[[], list[tuple[str, int, int, str]]]  # (scenario, size, agents, controller)
+    configs: Callable[[], list[Config]]
     max_iterations: int
     report: Callable[[list[dict]], tuple[list[dict], str]]
     plot: Callable[[list[dict], Path], None]
@@ -49,18 +62,22 @@ def run_one(spec: RunSpec) -> dict:
     from swarm.scenario import load_scenario
 
     scenario = load_scenario(spec.scenario).with_overrides(
-        agents=spec.agents, controller=spec.controller, seed=spec.seed
+        agents=spec.agents, controller=spec.controller, seed=spec.seed, physics=spec.physics
     )
-    result = Engine(scenario).run("foraged", spec.max_iterations)
+    s = Engine(scenario).run("foraged", spec.max_iterations).summary
     return {
         "experiment": spec.experiment,
         "scenario": spec.scenario,
         "size": spec.size,
         "agents": spec.agents,
         "controller": spec.controller,
+        "physics": spec.physics,
         "seed": spec.seed,
-        "iterations": result.iterations,
-        "finished": result.finished,
+        "iterations": s["iterations"],
+        "finished": s["finished"],
+        "blocked_share": s.get("blocked_share", 0.0),
+        "blocked_moves": s.get("blocked_moves", 0),
+        "wall_seconds": s["wall_seconds"],
     }
 
 
@@ -87,7 +104,7 @@ def _md(header: list[str], lines: list[list[str]]) -> str:
 
 
 def _table1_configs():
-    return [("setup1", 40, n, "cmarking") for n in paper.TABLE1]
+    return [Config("setup1", 40, n) for n in paper.TABLE1]
 
 
 def _table1_report(rows):
@@ -124,7 +141,7 @@ def _table1_plot(rows, path):
 
 
 def _table2_configs():
-    return [("setup2", 20, n, "cmarking") for n in paper.TABLE2]
+    return [Config("setup2", 20, n) for n in paper.TABLE2]
 
 
 def _table2_report(rows):
@@ -167,7 +184,7 @@ SETUP3_SIZES = tuple(paper.TABLE3)
 
 
 def _table3_configs():
-    return [(f"setup3-{s}", s, 50, "cmarking") for s in SETUP3_SIZES]
+    return [Config(f"setup3-{s}", s, 50) for s in SETUP3_SIZES]
 
 
 def _table3_report(rows):
@@ -205,7 +222,7 @@ ANT_SIZES = (12, 25, 50, 100)
 
 
 def _ants_configs():
-    return [(f"setup3-{s}", s, 50, c) for s in ANT_SIZES for c in ("cmarking", "ant")]
+    return [Config(f"setup3-{s}", s, 50, c) for s in ANT_SIZES for c in ("cmarking", "ant")]
 
 
 def _ants_report(rows):
@@ -233,6 +250,55 @@ def _ants_plot(rows, path):
         ax.plot(ANT_SIZES, [_stats(rows, size=s, controller=c)[0] for s in ANT_SIZES], "o-", label=c)
     ax.set(xscale="log", yscale="log", xlabel="side of the square environment",
            ylabel="iterations to forage", title="c-marking vs ants (setup 3, 50 agents)")  # fmt: skip
+    ax.legend()
+    _save(fig, path)
+
+
+# ------------------------------------------------------------------ congestion
+
+CONGESTION_AGENTS = (10, 20, 40, 80, 160)
+CONGESTION_CAP = 50_000  # a run that jams is cut here (counted unfinished); the same cap for both kinds
+
+
+def _congestion_configs():
+    return [Config("setup1", 40, n, physics=p) for n in CONGESTION_AGENTS for p in ("ideal", "physical")]
+
+
+def _congestion_report(rows):
+    summary, lines = [], []
+    for n in CONGESTION_AGENTS:
+        ideal, _, runs, ideal_unf = _stats(rows, agents=n, physics="ideal")
+        phys, phys_std, _, phys_unf = _stats(rows, agents=n, physics="physical")
+        bodies = [r for r in rows if r["agents"] == n and r["physics"] == "physical"]
+        share = float(np.mean([r["blocked_share"] for r in bodies])) if bodies else float("nan")
+        moves = float(np.mean([r["blocked_moves"] for r in bodies])) if bodies else float("nan")
+        seconds = sum(r["wall_seconds"] for r in bodies)
+        rate = sum(r["iterations"] for r in bodies) / seconds if seconds else float("nan")
+        summary.append({"agents": n, "runs": runs, "ideal_mean": round(ideal, 1), "ideal_unfinished": ideal_unf,
+                        "physical_mean": round(phys, 1), "physical_std": round(phys_std, 1),
+                        "physical_unfinished": phys_unf, "physical_over_ideal": round(phys / ideal, 3),
+                        "blocked_share": round(share, 4), "blocked_moves": round(moves, 1),
+                        "physical_ticks_per_second": round(rate), "paper_mean": paper.TABLE1[n][0]})  # fmt: skip
+        lines.append([str(n), str(paper.TABLE1[n][0]), _fmt(ideal, 0), _fmt(phys, 0), _fmt(phys / ideal, 2),
+                      _fmt(share, 3), _fmt(moves, 0), _fmt(rate, 0), f"{phys_unf}/{len(bodies)}"])  # fmt: skip
+    md = _md(["agents", "paper (Table 1): mean", "ideal: mean", "physical: mean", "physical / ideal",
+              "blocked share", "blocked moves per run", "physical ticks/s", "physical unfinished"], lines)  # fmt: skip
+    md += (f"\n\nPhysical: pymunk discs (the scenario's bodies: diameter 0.4 cells by default). A run still "
+           f"foraging after {CONGESTION_CAP:,} ticks is cut there, counted as unfinished, and enters the mean at "
+           "the cap. Ticks/s: one run per core while the others run.")  # fmt: skip
+    return summary, md
+
+
+def _congestion_plot(rows, path):
+    plt = _pyplot()
+    ns = list(CONGESTION_AGENTS)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for physics, marker in (("ideal", "o-"), ("physical", "^-")):
+        ax.plot(ns, [_stats(rows, agents=n, physics=physics)[0] for n in ns], marker, label=f"swarm: {physics}")
+    ax.plot(ns, [paper.TABLE1[n][0] for n in ns], "s:", label="paper (Table 1, grid)")
+    ax.axhline(CONGESTION_CAP, color="grey", lw=0.8, ls="--", label="cap")
+    ax.set(xscale="log", yscale="log", xlabel="agents", ylabel="iterations to forage",
+           title="Setup 1: what robot bodies cost")  # fmt: skip
     ax.legend()
     _save(fig, path)
 
@@ -266,18 +332,27 @@ EXPERIMENTS: dict[str, Experiment] = {
                          1_000_000, _table3_report, _table3_plot),
     "ants": Experiment("ants", "Section 5.5: c-marking vs the ant model, setup 3 sizes", 10,
                        _ants_configs, 1_000_000, _ants_report, _ants_plot),
+    "congestion": Experiment("congestion", "Congestion: setup 1, ideal vs physical bodies, agents 10..160", 10,
+                             _congestion_configs, CONGESTION_CAP, _congestion_report, _congestion_plot),
 }  # fmt: skip
 
 
 def plan(name: str, reps: int, seed: int) -> list[RunSpec]:
     exp = EXPERIMENTS[name]
     specs = [
-        RunSpec(name, scenario, size, agents, controller, seed + rep, exp.max_iterations)
-        for scenario, size, agents, controller in exp.configs()
+        RunSpec(name, c.scenario, c.size, c.agents, c.controller, c.physics, seed + rep, exp.max_iterations)
+        for c in exp.configs()
         for rep in range(reps)
     ]
-    # Biggest work first so the pool is not left waiting on one long run.
-    return sorted(specs, key=lambda s: -(s.size**2) * (3 if s.controller == "ant" else 1))
+    return sorted(specs, key=_expected_work, reverse=True)
+
+
+def _expected_work(spec: RunSpec) -> float:
+    """Biggest work first, so the pool is not left waiting on one long run at the end."""
+    work = spec.size**2 * (3 if spec.controller == "ant" else 1)
+    if spec.physics == "physical":  # bodies cost per agent, and crowds jam
+        work *= 10 * spec.agents
+    return work
 
 
 def run_experiment(
@@ -295,7 +370,7 @@ def run_experiment(
     out.mkdir(parents=True, exist_ok=True)
     specs = plan(name, reps, seed)
     rows = _execute(specs, jobs, progress, exp.title)
-    rows.sort(key=lambda r: (r["size"], r["agents"], r["controller"], r["seed"]))
+    rows.sort(key=lambda r: (r["size"], r["agents"], r["controller"], r["physics"], r["seed"]))
     with open(out / "runs.csv", "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=RUN_FIELDS)
         writer.writeheader()
@@ -311,9 +386,21 @@ def run_experiment(
     return {"name": name, "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
 
 
+def warm_up(physics: list[str]) -> None:
+    """Load (or compile) the engine's kernels for these physics modes, so that no
+    run's wall time, and so no ticks/s in a table, includes compiling."""
+    from swarm.engine import Engine
+    from swarm.scenario import load_scenario
+
+    for mode in physics:
+        Engine(load_scenario("setup2").with_overrides(agents=2, physics=mode)).step(2)
+
+
 def _execute(specs: list[RunSpec], jobs: int, progress: bool, title: str) -> list[dict]:
     from tqdm import tqdm
 
+    physics = sorted({s.physics for s in specs})
+    warm_up(physics)  # compiles into the cache once, before the workers load it
     bar = tqdm(total=len(specs), desc=title.split(":")[0], unit="run", disable=not progress)
     rows: list[dict] = []
     try:
@@ -322,8 +409,10 @@ def _execute(specs: list[RunSpec], jobs: int, progress: bool, title: str) -> lis
                 rows.append(run_one(spec))
                 bar.update()
         else:
-            with mp.get_context("spawn").Pool(jobs) as pool:
-                for row in pool.imap_unordered(run_one, specs, chunksize=4):
+            with mp.get_context("spawn").Pool(jobs, initializer=warm_up, initargs=(physics,)) as pool:
+                # many short runs go in chunks (less messaging); a few long ones one by one (a live progress bar)
+                chunk = max(1, min(16, len(specs) // (jobs * 100)))
+                for row in pool.imap_unordered(run_one, specs, chunksize=chunk):
                     rows.append(row)
                     bar.update()
     finally:

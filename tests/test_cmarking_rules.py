@@ -10,9 +10,12 @@ from agents.controllers.layout import (
     A_MOVE,
     A_TRAIL_ID,
     A_TRAIL_OP,
+    BLOCKED,
     CARRY,
     CMARKING,
     ERASE,
+    M_CLIMB_MAX,
+    M_CLIMB_STALL,
     M_CLIMBING,
     M_LOADING,
     M_MODE,
@@ -99,6 +102,18 @@ def test_climb_goes_to_the_highest_coloured_neighbour_but_not_back():
     assert act[A_MOVE] == N or act[A_MOVE] == E  # E is the previous cell: never chosen
     assert act[A_MOVE] == N
     assert mem[M_CLIMBING] == 1
+
+
+def test_a_blocked_climber_forgets_its_previous_cell_but_not_its_climb():
+    # its last move (from E) did not happen, so E is not where it came from; the climb's
+    # progress stays: it has seen mark 7 and stalled 3 steps, and this step stalls again
+    mem = new_memory()[0]
+    mem[M_CLIMBING], mem[M_PREV], mem[M_CLIMB_MAX], mem[M_CLIMB_STALL] = 1, E, 7, 3
+    pi, pf = _perception([5, 4, 6, 7, X], trails=(8, 8, 8, 0, 0))
+    pi[BLOCKED] = 1
+    act = _step(pi, pf, mem)
+    assert act[A_MOVE] == E  # the highest trail neighbour, no longer excluded
+    assert mem[M_CLIMBING] == 1 and mem[M_CLIMB_MAX] == 7 and mem[M_CLIMB_STALL] == 4
 
 
 def test_a_climb_that_ends_nowhere_erases_the_fragment():

@@ -187,3 +187,24 @@ def test_a_robot_whose_move_failed_senses_it_next_tick():
     world.acts[:, A_MOVE] = [W, E]  # apart: both arrive, nothing to sense
     world.resolve(1)
     np.testing.assert_array_equal(world.blocked, [0, 0])
+
+
+def test_80_bodies_on_setup1_forage_without_jamming():
+    # seed 2 jammed (20,000 ticks, 89% of the time blocked) when a blocked climber also
+    # forgot its climb; with the climb kept it finishes in about 500 ticks
+    scenario = load_scenario("setup1").with_overrides(agents=80, seed=2, physics="physical")
+    summary = Engine(scenario).run("foraged", 5000).summary
+    assert summary["finished"] and summary["blocked_share"] < 0.3, summary
+
+
+def test_a_body_pushed_around_a_corner_finds_its_way_back_along_the_grid():
+    rows = ["#######", "#B....#", "####.##", "#.....#", "#######"]
+    walls = np.array([[ch == "#" for ch in row] for row in rows])
+    bodies = Bodies(_physical(), walls, 1, (1, 1))
+    bodies.place(np.array([[2.5, 3.5]]))  # in cell (3, 2); its robot's cell is (1, 2), behind the wall at (2, 2)
+    pos = np.array([[1, 2]])
+    for _ in range(4):  # 6 cells round the wall at 2 cells/s, 2 s per tick at most
+        bodies.move(pos, _acts([STAY]))
+        if np.hypot(*(bodies.xy[0] - (2.5, 1.5))) <= bodies.params.arrive:
+            break
+    assert np.hypot(*(bodies.xy[0] - (2.5, 1.5))) <= bodies.params.arrive, bodies.xy[0]  # not stuck on the wall

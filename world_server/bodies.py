@@ -11,7 +11,8 @@ others and by walls, so robots collide and queue in corridors and at the base.
 The tick ends when every body is within `arrive` of its target, or after
 `timeout` simulated seconds.  A move counts only for a body that arrived; a
 body that did not keeps its logical cell, stays where it was pushed, and drives
-on from there next tick.  The base is a nest (see `_nest`).  A blocked body
+on from there next tick (round walls along the grid when it was pushed more than
+a cell away: world_server/steering.py).  The base is a nest (see `_nest`).  A blocked body
 also steps to its right (keep-right traffic rule), so robots that fit side by
 side pass each other.  Time spent blocked is the simulated time a body with an
 unreached target moved at less than half of its commanded speed.  Bodies
@@ -28,6 +29,7 @@ import numpy as np
 
 from agents.controllers.layout import A_MOVE, DIR_DC, DIR_DR, N_DIRS, STAY
 from swarm.scenario import PhysicsParams
+from world_server.steering import waypoints
 
 _GOLDEN_ANGLE = np.pi * (3.0 - np.sqrt(5.0))
 # Collision categories: walls; bodies; bodies in the nest (the base cell), which
@@ -136,13 +138,15 @@ class Bodies:
         goal = cell_centres(target)
         xy, vel = self._state()
         blocked = np.zeros(len(xy), dtype=bool)
+        drive_to = np.empty_like(goal)
         t = 0.0
         for _ in range(round(p.timeout / p.dt)):
-            delta = goal - xy
-            dist = np.hypot(delta[:, 0], delta[:, 1])
-            away = dist > p.arrive
+            away = np.hypot(*(goal - xy).T) > p.arrive
             if not away.any():
                 break
+            waypoints(xy, target, self.obstacles, drive_to)  # the goal, or the way round a wall
+            delta = drive_to - xy
+            dist = np.hypot(delta[:, 0], delta[:, 1])
             command = np.minimum(p.speed, dist / p.dt)
             heading = delta / np.maximum(dist, 1e-12)[:, None]
             # Keep right: a blocked body also sidesteps to its right, so two robots

@@ -49,6 +49,7 @@ from agents.controllers.layout import (
 )
 from swarm.scenario import Layout, PhysicsParams, Scenario
 from world_server.bodies import Bodies
+from world_server.steering import waypoints
 
 # Integer layers of the grid, stacked in one (N_LAYERS, H, W) array.
 L_OBST = 0
@@ -252,6 +253,9 @@ class GridWorld:
         if len(scratch.pos):
             scratch.perceive(0, pi, pf)
         scratch.resolve(-1)
+        # and the physical bodies' steering, compiled on its own
+        waypoints(np.zeros((1, 2)), np.zeros((1, 2), np.int64), np.asarray(self.layout.obstacles, dtype=bool),
+                  np.zeros((1, 2)))  # fmt: skip
 
     def drop_load(self, agent: int) -> None:
         """A lost robot's cargo falls on its cell and becomes resource there

@@ -14,16 +14,19 @@ from agents.controllers.ant import (
     ant_step,
 )
 from agents.controllers.cmarking import P_CLIMB_PATIENCE, cmarking_step
-from agents.controllers.layout import A_MODE, BLOCKED, CMARKING, M_CLIMBING, M_MODE, M_PREV, MARKING, N_PARAMS
+from agents.controllers.layout import A_MODE, BLOCKED, CMARKING, M_MODE, M_PREV, MARKING, N_PARAMS
 from agents.controllers.marking import marking_step
 from swarm.scenario import Scenario
 
 
 @njit(cache=True)
 def step_controller(kind, pi, pf, mem, act, params, seed, agent, tick):
-    if pi[BLOCKED] != 0:  # the last move did not happen: forget where we "came from"
+    if pi[BLOCKED] != 0:
+        # The last move did not happen: forget where we "came from" (a cell we never
+        # left).  The climb goes on: a climber stuck on a trail keeps counting towards
+        # its patience, so a crowd held on a trail that leads nowhere erases it and
+        # disperses (resetting the climb here made 80 robots jam; docs/physics.md).
         mem[M_PREV] = -1
-        mem[M_CLIMBING] = 0
     if kind == CMARKING:
         cmarking_step(pi, pf, mem, act, params, seed, agent, tick)
     elif kind == MARKING:
