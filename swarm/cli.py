@@ -136,8 +136,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Join a world over zenoh and run one controller (or K with --count).",
     )
     agent.add_argument("--controller", choices=["cmarking", "marking", "ant"], default="cmarking")
-    agent.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
-    agent.add_argument("--run-id", default="default", help="the world's run id (default: default)")
+    _client_args(agent)
     agent.add_argument("--count", type=_positive, default=1, metavar="K", help="independent agents in this process")
     agent.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
 
@@ -183,8 +182,7 @@ def build_parser() -> argparse.ArgumentParser:
         "seconds), print the run summary when the world says it has ended, and exit 0 if the run finished "
         "(1 if it stopped unfinished).  `docker compose up swarm` runs this.",
     )
-    mon.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
-    mon.add_argument("--run-id", default="default", help="the world's run id (default: default)")
+    _client_args(mon)
     mon.add_argument("--log-every", type=float, default=5.0, metavar="S", help="seconds between log lines")
     mon.add_argument("--start-timeout", type=float, default=600.0, metavar="S",
                      help="give up if no world answers for S seconds (default 600)")  # fmt: skip
@@ -196,8 +194,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Exit 0 and print the run's state if the world of --run-id answers (with --router: if "
         "the router accepts a session); exit 1 if not.",
     )
-    st.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
-    st.add_argument("--run-id", default="default", help="the world's run id (default: default)")
+    _client_args(st)
     st.add_argument("--router", action="store_true", help="only check that the router answers")
     st.add_argument("--timeout", type=float, default=3.0, metavar="S", help="how long to wait (default 3)")
     st.add_argument("--json", action="store_true", help="print one JSON object")
@@ -223,6 +220,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     sub.add_parser("scenarios", help="list presets and bundled scenarios")
     return parser
+
+
+def _client_args(p: argparse.ArgumentParser) -> None:
+    """Where a client of a running world finds it: agents, monitor, status."""
+    p.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
+    p.add_argument("--run-id", default="default", help="the world's run id (default: default)")
 
 
 def _tick_args(p: argparse.ArgumentParser) -> None:
