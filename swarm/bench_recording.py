@@ -20,12 +20,16 @@ from swarm.scenario import load_scenario
 from world_server.server import new_run_id
 
 
+def _recorder(engine: Engine, path: Path, runtime: str = "in-process") -> Recorder:
+    return Recorder(path, engine.world, run_meta(engine.scenario, engine.world, path.stem, "foraged", runtime))
+
+
 def _warm_up(tmp: Path) -> None:
     """Compile (or load) both engine loops and import rerun before timing anything."""
     scenario = load_scenario("setup2").with_overrides(agents=2, seed=0)
     Engine(scenario).step(10)
     engine = Engine(scenario)
-    recorder = Recorder(tmp / "warm.rrd", engine.world, run_meta(scenario, engine.world, "warm", "foraged", "warm"))
+    recorder = _recorder(engine, tmp / "warm.rrd", "warm")
     engine.run(max_iterations=10, recorder=recorder)
     recorder.close()
 
@@ -43,7 +47,7 @@ def _in_process(agents: int, seeds: range, tmp: Path) -> dict:
         engine = Engine(scenario)
         path = tmp / f"inproc-{agents}-{seed}.rrd"
         started = time.perf_counter()
-        recorder = Recorder(path, engine.world, run_meta(scenario, engine.world, path.stem, "foraged", "in-process"))
+        recorder = _recorder(engine, path)
         opened = time.perf_counter()
         summary = engine.run(recorder=recorder).summary
         ran = time.perf_counter()
@@ -58,7 +62,8 @@ def _in_process(agents: int, seeds: range, tmp: Path) -> dict:
             "cost": round(1 - plain / recorded, 3), "bytes_per_tick": round(size / ticks),
             "mb_per_run": round(size / len(seeds) / 1e6, 2), "plain_ms_per_run": round(plain * per_run, 1),
             "open_ms_per_run": round(opening * per_run, 1), "recorded_run_ms_per_run": round(running * per_run, 1),
-            "close_ms_per_run": round(closing * per_run, 1)}  # fmt: skip
+            "close_ms_per_run": round(closing * per_run, 1),
+            "drained_close_ms_per_run": _close_floor(agents, seeds, tmp)}  # fmt: skip
 
 
 def _close_floor(agents: int, seeds: range, tmp: Path) -> float:
@@ -69,7 +74,7 @@ def _close_floor(agents: int, seeds: range, tmp: Path) -> float:
         scenario = load_scenario("setup1").with_overrides(agents=agents, seed=seed)
         engine = Engine(scenario)
         path = tmp / f"floor-{agents}-{seed}.rrd"
-        recorder = Recorder(path, engine.world, run_meta(scenario, engine.world, path.stem, "foraged", "in-process"))
+        recorder = _recorder(engine, path)
         summary = engine.run(recorder=recorder).summary
         recorder.flush()
         recorder.rec.flush()
@@ -107,8 +112,6 @@ def bench_recording(quick: bool = False, port: int = 7650) -> dict:
     with tempfile.TemporaryDirectory(prefix="swarm-bench-rec-") as tmp:
         _warm_up(Path(tmp))
         rows = [_in_process(n, seeds, Path(tmp)) for n in (20, 160)]
-        for row in rows:
-            row["drained_close_ms_per_run"] = _close_floor(row["agents"], seeds, Path(tmp))
         pairs = 1 if quick else 3
         rows += [_distributed(20, 1, Path(tmp), port, pairs), _distributed(160, 10, Path(tmp), port + 2, pairs)]
     return {"benchmark": "recording", "scenario": "setup1", "runs": rows}
