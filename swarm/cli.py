@@ -9,7 +9,10 @@ import sys
 from pathlib import Path
 
 from swarm.errors import RecordingError, raise_interrupt
-from swarm.scenario import PRESET_HELP, ScenarioError, bundled_scenarios, load_scenario
+from swarm.cli_arena import add_arena_run_args, add_sense_parser, arena_overrides, cmd_sense, run_arena
+from swarm.scenario import PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
+
+CONTROLLERS = ["cmarking", "marking", "ant", "carrot"]
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -59,9 +62,10 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"a TOML file, a preset ({PRESET_HELP}) or a bundled name ({', '.join(bundled_scenarios())})",
     )
     run.add_argument("--agents", type=_positive, help="number of agents (default: the scenario's)")
-    run.add_argument("--controller", choices=["cmarking", "marking", "ant"], help="controller to run")
+    run.add_argument("--controller", choices=CONTROLLERS, help="controller to run")
     run.add_argument("--seed", type=_seed, help="seed of the map and of every random choice")
     _physics_args(run)
+    add_arena_run_args(run)
     _record_args(run, "write a rerun recording of the run to FILE (.rrd)")
     run.add_argument(
         "--until",
@@ -90,9 +94,9 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
 
     bench = sub.add_parser("bench", help="measure throughput", description="Measure throughput.")
-    bench.add_argument("target", choices=["engine", "distributed", "recording"],
+    bench.add_argument("target", choices=["engine", "distributed", "recording", "arena"],
                        help="engine: the in-process engine; distributed: world + agent processes; "
-                       "recording: what recording costs")  # fmt: skip
+                       "recording: what recording costs; arena: sensing and physics of the arena")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument("--quick", action="store_true", help="shorter measurement")
 
@@ -218,6 +222,7 @@ def build_parser() -> argparse.ArgumentParser:
     prep.add_argument("--require-aot", action="store_true",
                       help="fail if the ahead-of-time build cannot be made (no C compiler)")  # fmt: skip
 
+    add_sense_parser(sub)
     sub.add_parser("scenarios", help="list presets and bundled scenarios")
     return parser
 
@@ -270,7 +275,7 @@ def _physics_args(p: argparse.ArgumentParser) -> None:
 def _scenario_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", metavar="SCENARIO", help=f"a TOML file, a preset ({PRESET_HELP}) or a bundled name")
     p.add_argument("--agents", type=_positive, help="number of agents (default: the scenario's)")
-    p.add_argument("--controller", choices=["cmarking", "marking", "ant"], help="controller to run")
+    p.add_argument("--controller", choices=CONTROLLERS, help="controller to run")
     p.add_argument("--seed", type=_seed, help="seed of the map and of every random choice")
     _physics_args(p)
     p.add_argument("--until", choices=["foraged", "converged", "both"], default="foraged", help="when the run ends")
@@ -321,19 +326,27 @@ def _print_summary(summary: dict, as_json: bool, until: str) -> int:
 
 
 def _scenario(args):
-    return load_scenario(args.scenario).with_overrides(
-        agents=args.agents,
-        controller=args.controller,
-        seed=args.seed,
-        physics=args.physics,
-        body_diameter=args.body_diameter,
-    )
+    scenario = load_scenario(args.scenario)
+    common = {"agents": args.agents, "controller": args.controller, "seed": args.seed}
+    if is_arena(scenario):
+        return scenario.with_overrides(**common, **arena_overrides(args))
+    if args.controller == "carrot":
+        raise ScenarioError("command line", "controller", "carrot drives arena robots; pick an arena scenario "
+                            "(zmaze, large-maze, ...) or a grid controller")  # fmt: skip
+    return scenario.with_overrides(**common, physics=args.physics, body_diameter=args.body_diameter)
+
+
+def _grid_only(scenario, command: str) -> None:
+    if is_arena(scenario):
+        raise ScenarioError("command line", "scenario", f"swarm {command} runs grid scenarios only for now: the "
+                            "distributed arena runtime is not built yet; run arena scenarios with swarm run")  # fmt: skip
 
 
 def cmd_world(args) -> int:
     from world_server.server import serve
 
     scenario = _scenario(args)
+    _grid_only(scenario, "world")
     if args.until != "foraged" and scenario.controller == "ant":
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
     summary = serve(scenario, args.run_id, args.summary_file, quiet=args.quiet,
@@ -368,6 +381,7 @@ def cmd_up(args) -> int:
     from world_server.server import new_run_id
 
     scenario = _scenario(args)
+    _grid_only(scenario, "up")
     if args.until != "foraged" and scenario.controller == "ant":
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
     run_id = args.run_id or new_run_id()
@@ -385,6 +399,8 @@ def cmd_run(args) -> int:
     from swarm.engine import Engine
 
     scenario = _scenario(args)
+    if is_arena(scenario):
+        return run_arena(args, scenario)
     engine = Engine(scenario)
     recorder = None
     if args.record:
@@ -441,6 +457,12 @@ def cmd_experiment(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    if args.target == "arena":
+        from swarm.bench_arena import bench_arena, format_arena_bench
+
+        result = bench_arena(quick=args.quick)
+        print(json.dumps(result) if args.json else format_arena_bench(result))
+        return 0
     if args.target == "recording":
         from swarm.bench_recording import bench_recording, format_recording_bench
 
@@ -512,7 +534,7 @@ def cmd_scenarios(args) -> int:
 COMMANDS = {"run": cmd_run, "experiment": cmd_experiment, "bench": cmd_bench, "scenarios": cmd_scenarios,
             "world": cmd_world, "agent": cmd_agent, "up": cmd_up, "replay": cmd_replay,
             "report": cmd_report, "monitor": cmd_monitor, "status": cmd_status, "router": cmd_router,
-            "prepare": cmd_prepare}  # fmt: skip
+            "prepare": cmd_prepare, "sense": cmd_sense}  # fmt: skip
 
 
 if __name__ == "__main__":

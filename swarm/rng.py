@@ -38,3 +38,39 @@ def draw_below(seed, agent, tick, draw, n):
     """A uniform integer in [0, n) by multiply-shift of 32 random bits (bias < 2**-28
     for the n <= 16 that controllers ask for)."""
     return np.int64(((draw_u64(seed, agent, tick, draw) >> _S32) * np.uint64(n)) >> _S32)
+
+
+_TO_UNIT = 1.0 / 9007199254740992.0  # 2**-53
+_S11 = np.uint64(11)
+
+
+@njit(cache=True, inline="always")
+def draw_unit(seed, agent, tick, draw):
+    """A uniform float in [0, 1) from the top 53 bits of one draw."""
+    return np.float64(draw_u64(seed, agent, tick, draw) >> _S11) * _TO_UNIT
+
+
+@njit(cache=True, inline="always")
+def draw_normal(seed, agent, tick, draw):
+    """A standard normal (Box-Muller over draws 2*draw and 2*draw + 1): each
+    normal owns two counters, so no draw is shared between normals."""
+    u1 = 1.0 - draw_unit(seed, agent, tick, 2 * draw)  # (0, 1]: log is finite
+    u2 = draw_unit(seed, agent, tick, 2 * draw + 1)
+    return np.sqrt(-2.0 * np.log(u1)) * np.cos(2.0 * np.pi * u2)
+
+
+@njit(cache=True)
+def fill_normal(seed, agents, tick, stream, out):
+    """out[i, j] = normal number (stream << 24) + j of agents[i] at tick: the
+    noise of one sensor for every robot in one call (streams never overlap)."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            out[i, j] = draw_normal(seed, agents[i], tick, (stream << 24) + j)
+
+
+@njit(cache=True)
+def fill_uniform(seed, agents, tick, stream, out):
+    """Like fill_normal, uniform in [-1, 1) (the papers' +-bounds)."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            out[i, j] = 2.0 * draw_unit(seed, agents[i], tick, (1 << 40) + (stream << 24) + j) - 1.0

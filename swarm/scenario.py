@@ -212,17 +212,31 @@ def load_scenario(ref: str) -> Scenario:
     return parse_scenario_text(path.read_text(encoding="utf-8", errors="replace"), str(path))
 
 
+def is_arena(scenario) -> bool:
+    return getattr(scenario, "kind", "grid") == "arena"
+
+
 # --------------------------------------------------------------------- parsing
 
 _TOP_KEYS = {"name", "seed", "agents", "controller", "q_max", "quantity", "map", "generator"}
-_TOP_KEYS |= {"ant", "cmarking", "physics"}
+_TOP_KEYS |= {"ant", "cmarking", "physics", "kind"}
+WORLD_KINDS = ("grid", "arena")
 
 
-def parse_scenario_text(text: str, source: str = "<string>") -> Scenario:
+def parse_scenario_text(text: str, source: str = "<string>"):
+    """A grid Scenario, or an ArenaScenario when the file says kind = "arena"."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(source, "TOML", f"not valid TOML ({exc})") from None
+    kind = data.get("kind", "grid")
+    if kind not in WORLD_KINDS:
+        raise ScenarioError(source, "kind", f"unknown world kind {kind!r}; expected one of {', '.join(WORLD_KINDS)}")
+    if kind == "arena":
+        from swarm.arena.scenario import parse_arena
+
+        return parse_arena(data, source, Path(source).stem)
+    data.pop("kind", None)
     _no_unknown(data, _TOP_KEYS, source, "top level")
     has_map, has_gen = "map" in data, "generator" in data
     if has_map == has_gen:

@@ -1,0 +1,106 @@
+"""The carrot controller: plan once with A*, then follow the carrot.
+
+The plan starts where the position sensor first says the robot is (with its
+noise), on the occupancy grid of the map the robot is given (1 cm cells, 4 cm
+clearance by default), to the goal or through the waypoints of a route.  The
+robot stops once its sensor puts it within `arrive` of the last point.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from agents.controllers.navigation.astar import Planner
+from agents.controllers.navigation.follow import CarrotFollower
+
+
+@dataclass(frozen=True)
+class CarrotParams:
+    cell: float = 0.01  # A* grid (paper: 1 cm)
+    clearance: float = 0.04  # minimum obstacle distance (paper: 4 cm)
+    k_fic: float = 3.0  # steering gain, 1/s (not in the paper)
+    k_look: float = 0.01  # look-ahead distance (paper: 1 cm)
+    speed: float = 0.05  # cruise speed, m/s (about the DFT robot's: docs/arena.md)
+    window: int = 40  # path points searched ahead of the last carrot
+    arrive: float = 0.02  # stop within this distance of the end (by the sensor)
+
+    @classmethod
+    def from_table(cls, table: dict[str, Any] | None) -> CarrotParams:
+        table = table or {}
+        known = {f.name: f.type for f in fields(cls)}
+        unknown = sorted(set(table) - set(known))
+        if unknown:
+            raise ValueError(f"[carrot]: unknown field {unknown[0]!r}; expected one of {', '.join(known)}")
+        return cls(**{k: (int(v) if k == "window" else float(v)) for k, v in table.items()})
+
+
+class CarrotController:
+    def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
+        self.agent = agent
+        self.p = CarrotParams.from_table(params.get("carrot"))
+        robot = params["robot"]
+        self.axle, self.max_wheel = float(robot["axle"]), float(robot["max_wheel_speed"])
+        m = params["map"]
+        self.planner = Planner(tuple(m["size"]), np.asarray(m["rects"], np.float64),
+                               np.asarray(m["segments"], np.float64), self.p.cell, self.p.clearance)  # fmt: skip
+        route = params.get("route")
+        goal = params.get("goal")
+        self.targets = [tuple(w) for w in route] if route else ([tuple(goal)] if goal is not None else [])
+        self.follower: CarrotFollower | None = None
+        self.planned = False
+        self.stopped = not self.targets
+        self.no_path = False
+
+    def _plan(self, x: float, y: float) -> None:
+        legs, here = [], (x, y)
+        for target in self.targets:
+            length, points = self.planner.plan(here, target)
+            if not math.isfinite(length):
+                self.no_path, self.stopped = True, True
+                return
+            legs.append(points)
+            here = target
+        path = np.concatenate(legs) if legs else np.zeros((1, 2))
+        self.follower = CarrotFollower(path, self.p.k_fic, self.p.k_look, self.p.speed, self.p.window)
+
+    def step(self, perception: dict[str, np.ndarray]) -> np.ndarray:
+        if "position" not in perception or "compass" not in perception:
+            raise ValueError("carrot needs the position and compass sensors (the epuck has them)")
+        x, y = (float(v) for v in perception["position"])
+        heading = float(perception["compass"])
+        if not self.planned:
+            self.planned = True
+            if not self.stopped:
+                self._plan(x, y)
+        if self.stopped or self.follower is None:
+            return np.zeros(2)
+        end = self.follower.path[-1]
+        if self.follower.at_end and math.hypot(end[0] - x, end[1] - y) < self.p.arrive:
+            self.stopped = True
+            return np.zeros(2)
+        left, right = self.follower.wheels(x, y, heading, self.axle, self.max_wheel)
+        return np.array([left, right])
+
+    def snapshot(self) -> dict[str, Any]:
+        f = self.follower
+        return {"planned": self.planned, "stopped": self.stopped, "no_path": self.no_path,
+                "path": None if f is None else f.path.copy(), "index": 0 if f is None else f.index,
+                "params": asdict(self.p)}  # fmt: skip
+
+    def restore(self, state: dict[str, Any]) -> None:
+        self.planned, self.stopped, self.no_path = state["planned"], state["stopped"], state["no_path"]
+        self.follower = None
+        if state["path"] is not None:
+            p = self.p
+            self.follower = CarrotFollower(np.asarray(state["path"]), p.k_fic, p.k_look, p.speed, p.window)
+            self.follower.index = int(state["index"])
+
+    def record(self) -> dict[str, np.ndarray]:
+        f = self.follower
+        if f is None:
+            return {"path": np.zeros((0, 2))}
+        return {"path": f.path, "carrot": f.path[f.index]}

@@ -1,0 +1,122 @@
+"""The in-process arena engine: the world and every robot's controller in one
+process, in the lock-step tick of world_server.arena (all perceive, all
+decide, the world integrates one control period)."""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from agents.controllers.arena import make_controller
+from agents.controllers.navigation.astar import Planner
+from swarm.arena.scenario import ArenaScenario, controller_params
+from world_server.arena import ArenaWorld
+
+OPTIMUM_CELL, OPTIMUM_CLEARANCE = 0.01, 0.04  # the DFT paper's A* optimum
+MAX_OPTIMUM_CELLS = 4_000_000  # coarser cells on large floors (docs/arena.md)
+
+
+@functools.lru_cache(maxsize=8)
+def _planner(size: tuple[float, float], walls: tuple) -> Planner:
+    cell = max(OPTIMUM_CELL, math.sqrt(size[0] * size[1] / MAX_OPTIMUM_CELLS))
+    rects = np.array([w.coords for w in walls if w.shape == "rect"], np.float64).reshape(-1, 4)
+    segments = np.array([w.coords for w in walls if w.shape == "segment"], np.float64).reshape(-1, 4)
+    return Planner(size, rects, segments, cell, OPTIMUM_CLEARANCE)
+
+
+def optimal_lengths(s: ArenaScenario, starts: np.ndarray) -> list[float]:
+    """L_o per robot: A* (1 cm, 4 cm clearance) from its true start through its
+    route or to its goal; inf when there is none or no path keeps the clearance."""
+    planner = _planner(s.size, s.walls)
+    routes = [s.routes[g.route] if g.route else None for g in s.groups for _ in range(g.count)]
+    out = []
+    for a, goal in enumerate(s.goals()):
+        targets = routes[a] or ([goal] if goal is not None else [])
+        here, total = (float(starts[a, 0]), float(starts[a, 1])), 0.0 if targets else math.inf
+        for t in targets:
+            total += planner.plan(here, tuple(t))[0]
+            here = tuple(t)
+        out.append(total)
+    return out
+
+
+class ArenaEngine:
+    def __init__(self, scenario: ArenaScenario):
+        self.scenario = scenario
+        self.world = ArenaWorld(scenario)
+        self.controllers = []
+        for a, g in enumerate(g for g in scenario.groups for _ in range(g.count)):
+            c = make_controller(g.controller)
+            c.reset(scenario.seed, a, controller_params(scenario, a))
+            self.controllers.append(c)
+        self.wall_seconds = 0.0
+        self.actions = np.zeros((self.world.n, 2))
+
+    @property
+    def tick(self) -> int:
+        return self.world.tick
+
+    def step(self, n: int = 1) -> int:
+        """Up to n ticks (fewer once the run is done); returns ticks run."""
+        w = self.world
+        started = time.perf_counter()
+        ran = 0
+        while ran < n and not w.done():
+            for a, (c, p) in enumerate(zip(self.controllers, w.perceive(), strict=True)):
+                self.actions[a] = c.step(p)
+            w.apply(self.actions)
+            ran += 1
+        self.wall_seconds += time.perf_counter() - started
+        return ran
+
+    def run(self, progress: bool = False, chunk: int = 50) -> dict[str, Any]:
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=self.scenario.max_ticks, unit="tick", desc=self.scenario.name, leave=False)
+        try:
+            while not self.world.done():
+                ran = self.step(chunk)
+                if bar is not None:
+                    bar.update(ran)
+        finally:
+            if bar is not None:
+                bar.close()
+        return self.summary()
+
+    def summary(self) -> dict[str, Any]:
+        return arena_summary(self.world, self.wall_seconds, "in-process")
+
+
+def arena_summary(world: ArenaWorld, wall_seconds: float, runtime: str) -> dict[str, Any]:
+    s = world.scenario
+    robots = world.robot_summaries(optimal_lengths(s, world.start_pose))
+    goals = [r for r in robots if r["goal"] is not None]
+    ratios = [r["path_ratio"] for r in robots if r["path_ratio"] is not None]
+    return {
+        "scenario": s.name,
+        "kind": "arena",
+        "controller": s.controller,
+        "agents": s.agents,
+        "seed": s.seed,
+        "noise": s.noise.level,
+        "runtime": runtime,
+        "ticks": world.tick,
+        "iterations": world.tick,
+        "finished": bool(goals) and all(r["reached"] for r in goals),
+        "reached": sum(r["reached"] for r in goals),
+        "with_goal": len(goals),
+        "sim_seconds": round(world.tick * s.control_period, 3),
+        "wall_seconds": round(wall_seconds, 4),
+        "ticks_per_second": round(world.tick / wall_seconds, 1) if wall_seconds else None,
+        "mean_path_ratio": round(float(np.mean(ratios)), 4) if ratios else None,
+        "collisions": int(world.bodies.collisions.sum()),
+        "rejected_actions": sum(world.rejected.values()),
+        "rejected": dict(world.rejected),
+        "robots": robots,
+    }

@@ -1,0 +1,120 @@
+"""The arena's side of the `swarm` command: run options, the summary, `swarm sense`."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+import numpy as np
+
+from swarm.scenario import ScenarioError
+
+
+def _floats(n_min: int, n_max: int, what: str):
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(v) for v in text.split(","))
+        except ValueError:
+            values = ()
+        if not n_min <= len(values) <= n_max or not all(math.isfinite(v) for v in values):
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
+        return values
+
+    return parse
+
+
+def add_arena_run_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("arena scenarios")
+    g.add_argument("--start", type=_floats(2, 3, "X,Y or X,Y,THETA (metres, radians)"), metavar="X,Y[,THETA]",
+                   help="start pose of a one-robot run")  # fmt: skip
+    g.add_argument("--goal", type=_floats(2, 2, "X,Y (metres)"), metavar="X,Y", help="goal of a one-robot run")
+    g.add_argument("--noise", choices=["none", "low", "high"], help="sensor noise level (the DFT paper's)")
+    g.add_argument("--max-ticks", type=int, metavar="T", help="stop after T control periods")
+
+
+def arena_overrides(args) -> dict:
+    return {k: getattr(args, k, None) for k in ("start", "goal", "noise", "max_ticks")}
+
+
+def run_arena(args, scenario) -> int:
+    if getattr(args, "record", None):
+        raise ScenarioError("command line", "--record", "arena recordings are not built yet; run without --record")
+    from swarm.arena.engine import ArenaEngine
+
+    summary = ArenaEngine(scenario).run(progress=not args.json and sys.stderr.isatty())
+    return print_arena_summary(summary, args.json)
+
+
+def print_arena_summary(summary: dict, as_json: bool) -> int:
+    if as_json:
+        print(json.dumps(summary))
+    else:
+        state = "finished" if summary["finished"] else "NOT finished"
+        print(f"{summary['scenario']}: {summary['controller']} x{summary['agents']}, seed {summary['seed']}, "
+              f"noise {summary['noise']}: {state} after {summary['ticks']} ticks ({summary['sim_seconds']} s "
+              f"simulated, {summary['ticks_per_second']} ticks/s)\n"
+              f"  reached {summary['reached']}/{summary['with_goal']}, collisions {summary['collisions']}, "
+              f"rejected actions {summary['rejected_actions']}")  # fmt: skip
+        for r in summary["robots"][:20]:
+            ratio = "n/a" if r["path_ratio"] is None else f"{r['path_ratio']:.3f}"
+            lo = "n/a" if r["optimal_length"] is None else f"{r['optimal_length']:.3f}"
+            print(f"  robot {r['agent']} ({r['controller']}): {'reached' if r['reached'] else 'not reached'}"
+                  f"{'' if r['ticks_to_goal'] is None else ' at tick ' + str(r['ticks_to_goal'])}, "
+                  f"L_p {r['path_length']:.3f} m, L_o {lo} m, L_p/L_o {ratio}, collisions {r['collisions']}")  # fmt: skip
+        if len(summary["robots"]) > 20:
+            print(f"  ... {len(summary['robots']) - 20} more robots (--json lists them all)")
+    return 0 if summary["finished"] else 1
+
+
+def sense(scenario, pose: tuple[float, ...], group: int = 0) -> dict:
+    """What one robot of `group` senses at `pose`, alone in the arena at tick 0."""
+    from dataclasses import replace
+
+    from world_server.arena import ArenaWorld
+
+    if not 0 <= group < len(scenario.groups):
+        raise ScenarioError("command line", "--group", f"expected 1 to {len(scenario.groups)}")
+    g = replace(scenario.groups[group], count=1, starts=((pose[0], pose[1], pose[2] if len(pose) > 2 else 0.0),))
+    world = ArenaWorld(replace(scenario, groups=(g,)))
+    reading = world.perceive()[0]
+    out = {"scenario": scenario.name, "robot": g.robot.name, "pose": list(world.pose[0]), "noise": scenario.noise.level}
+    for k, v in reading.items():
+        out[k] = np.asarray(v).tolist()
+    return out
+
+
+def cmd_sense(args) -> int:
+    from swarm.scenario import is_arena, load_scenario
+
+    scenario = load_scenario(args.scenario)
+    if not is_arena(scenario):
+        raise ScenarioError(args.scenario, "kind", "swarm sense is for arena scenarios")
+    if args.noise:
+        scenario = scenario.with_overrides(noise=args.noise)
+    result = sense(scenario, args.pose, args.group - 1)
+    if args.json:
+        print(json.dumps(result))
+        return 0
+    print(f"{result['scenario']}: {result['robot']} at x={result['pose'][0]:.4f} m, y={result['pose'][1]:.4f} m, "
+          f"heading {math.degrees(result['pose'][2]):.1f} deg (noise {result['noise']})")  # fmt: skip
+    for k, v in result.items():
+        if k in ("scenario", "robot", "pose", "noise"):
+            continue
+        arr = np.asarray(v)
+        text = np.array2string(arr, precision=4, max_line_width=110, threshold=80) if arr.ndim else f"{v}"
+        print(f"  {k}: {text}")
+    return 0
+
+
+def add_sense_parser(sub) -> None:
+    p = sub.add_parser("sense", help="print what a robot senses at a pose (arena scenarios)",
+                       description="Place one robot of the scenario at a pose, alone, and print every reading of "
+                       "its sensors at tick 0: a debugging aid, and a way to check a sensor by hand.")  # fmt: skip
+    p.add_argument("scenario", metavar="SCENARIO", help="an arena scenario (TOML file or bundled name)")
+    p.add_argument("--pose", required=True, type=_floats(2, 3, "X,Y[,THETA]"), metavar="X,Y[,THETA]",
+                   help="where the robot stands (metres) and its heading (radians CCW from +x, default 0)")  # fmt: skip
+    p.add_argument("--group", type=int, default=1, help="whose robot model (the scenario's group number, default 1)")
+    p.add_argument("--noise", choices=["none", "low", "high"], help="noise level (default: the scenario's)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")

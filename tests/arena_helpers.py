@@ -1,0 +1,30 @@
+"""Small arena scenarios for the tests."""
+
+from swarm.arena.scenario import parse_arena_text
+
+BOX = """
+kind = "arena"
+size = [{w}, {h}]
+robot = "{robot}"
+noise = "{noise}"
+max_ticks = {max_ticks}
+[[wall]]
+rect = [0.0, 0.0, {w}, 0.02]
+[[wall]]
+rect = [0.0, {h2}, {w}, {h}]
+[[wall]]
+rect = [0.0, 0.0, 0.02, {h}]
+[[wall]]
+rect = [{w2}, 0.0, {w}, {h}]
+"""
+
+
+def box(body: str = "", w: float = 1.0, h: float = 1.0, robot: str = "epuck", noise: str = "none",
+        max_ticks: int = 200) -> str:  # fmt: skip
+    """A walled w x h box (2 cm walls) plus `body` (more walls, groups...)."""
+    head = BOX.format(w=w, h=h, w2=w - 0.02, h2=h - 0.02, robot=robot, noise=noise, max_ticks=max_ticks)
+    return head + body
+
+
+def arena(body: str, **kw):
+    return parse_arena_text(box(body, **kw), "test.toml")

@@ -1,0 +1,176 @@
+"""The arena world: bodies, actions, schedules, scenarios, A* and the carrot controller."""
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from agents.controllers.navigation.astar import Planner
+from swarm.arena.engine import ArenaEngine
+from swarm.scenario import ScenarioError, load_scenario, parse_scenario_text
+from tests.arena_helpers import arena, box
+from world_server.arena import ArenaWorld
+
+ONE = '[[group]]\ncount = 1\ncontroller = "carrot"\nstart = [{x}, {y}, {t}]\n'
+
+
+def _world(x=0.5, y=0.5, t=0.0, extra="", **kw) -> ArenaWorld:
+    return ArenaWorld(arena(extra + ONE.format(x=x, y=y, t=t), **kw))
+
+
+def test_straight_and_turning_drive_match_the_kinematics():
+    w = _world(0.3, 0.5, 0.0)
+    for _ in range(10):
+        w.apply(np.array([[0.1, 0.1]]))
+    # from rest the body lags one substep (chipmunk moves, then accelerates): 10 periods less 16 ms
+    assert w.pose[0, 0] == pytest.approx(0.3 + 0.1 * (0.064 * 10 - 0.016), abs=1e-9)
+    assert w.pose[0, 1] == pytest.approx(0.5, abs=1e-9)
+    assert w.bodies.distance[0] == pytest.approx(0.1 * (0.064 * 10 - 0.016), abs=1e-9)
+    w = _world()
+    w.apply(np.array([[-0.05, 0.05]]))  # on the spot, counter-clockwise
+    assert w.pose[0, 2] == pytest.approx(2 * 0.05 / 0.053 * 0.064, abs=1e-9)
+    assert np.hypot(*(w.pose[0, :2] - 0.5)) < 1e-12
+
+
+def test_the_animat_turns_at_most_10_degrees_per_second():
+    w = _world(robot="animat")
+    w.apply(np.array([[-0.4, 0.4]]))
+    assert w.pose[0, 2] == pytest.approx(math.radians(10) * 0.064, rel=1e-9)
+
+
+def test_a_robot_driving_into_a_wall_stops_there_and_counts_it():
+    w = _world(0.8, 0.5, 0.0)  # the east wall's face is at x = 0.98
+    for _ in range(60):
+        w.apply(np.array([[0.129, 0.129]]))
+    assert 0.98 - 0.037 - 0.003 < w.pose[0, 0] <= 0.98 - 0.037 + 0.001
+    assert w.bodies.collisions[0] >= 1 and w.bodies.blocked_seconds[0] > 1.0
+
+
+def test_two_robots_meeting_head_on_do_not_pass_through_each_other():
+    body = '[[group]]\ncount = 2\ncontroller = "carrot"\nstarts = [[0.3, 0.5, 0.0], [0.7, 0.5, 3.141592653589793]]\n'
+    w = ArenaWorld(arena(body))
+    for _ in range(80):
+        w.apply(np.array([[0.1, 0.1], [0.1, 0.1]]))
+    assert w.pose[1, 0] - w.pose[0, 0] >= 2 * 0.037 - 0.003
+    assert w.bodies.collisions.min() >= 1
+
+
+def test_bad_actions_are_counted_and_never_acted_on():
+    w = _world()
+    before = w.pose.copy()
+    w.apply(np.array([[math.nan, 0.1]]))
+    w.apply(np.array([[10.0, 10.0]]))  # far over the e-puck's 12.9 cm/s
+    w.apply(np.array([[0.1, 0.1, 0.1]]))
+    w.apply(np.array([[math.inf, -math.inf]]))
+    assert np.array_equal(w.pose, before)
+    assert w.rejected == {"not finite": 2, "over the wheel limit": 1, "wrong shape": 1}
+    assert w.tick == 4
+
+
+def test_a_scheduled_obstacle_blocks_only_while_present():
+    extra = "[[obstacle]]\nrect = [0.6, 0.3, 0.7, 0.7]\nappear = 2\nvanish = 4\n"
+    w = _world(0.4, 0.5, 0.0, extra=extra)
+    seen = []
+    for _ in range(6):
+        seen.append(w.cast(np.array([0]), np.array([0.0]), np.array([5.0]))[0][0])
+        w.apply(np.zeros((1, 2)))
+    assert seen == pytest.approx([0.58, 0.58, 0.2, 0.2, 0.58, 0.58], abs=1e-9)
+
+
+def test_zones_are_sensed():
+    w = _world(0.5, 0.5, extra='[[zone]]\nkind = "dangerous"\ndisc = [0.5, 0.5, 0.1]\n', robot="animat")
+    assert w.perceive()[0]["zones"] == 1 << 3
+
+
+@pytest.mark.parametrize("body,where", [
+    ("[[wall]]\nrect = [0.5, 0.5, 0.4, 0.6]\n" + ONE.format(x=0.2, y=0.2, t=0), "wall 5.rect"),
+    ("[[wall]]\nrect = [0.5, 0.5, 1.5, 0.6]\n" + ONE.format(x=0.2, y=0.2, t=0), "wall 5"),
+    ("[[wall]]\nrect = [0.4, 0.4, 0.6, 0.6]\n" + ONE.format(x=0.5, y=0.5, t=0), "group 1.starts[1]"),
+    ('[[group]]\ncount = 1\ncontroller = "dft9"\n', "group 1.controller"),
+    ('[[group]]\ncount = 1\nrobot = "tank"\n', "group 1.robot"),
+    ('[[group]]\ncount = 2\nstarts = [[0.5, 0.5]]\n', "group 1.starts"),
+    ('[[group]]\ncount = 1\nroute = "tour"\n', "group 1.route"),
+    ('[[group]]\ncount = 1\nspeed = 3\n', "speed"),
+    ('[[zone]]\nkind = "lava"\ndisc = [0.5, 0.5, 0.1]\n[[group]]\n', "zone 1.kind"),
+    ("[[obstacle]]\nrect = [0.3, 0.3, 0.4, 0.4]\nappear = 5\nvanish = 5\n[[group]]\n", "obstacle 1"),
+])  # fmt: skip
+def test_broken_arena_scenarios_name_the_field(body, where):
+    with pytest.raises(ScenarioError) as err:
+        parse_scenario_text(box(body), "bad.toml")
+    assert err.value.source == "bad.toml" and where in err.value.where
+
+
+def test_drawn_starts_follow_the_seed_and_keep_their_clearance():
+    text = box("[[wall]]\nrect = [0.3, 0.3, 0.7, 0.7]\n" + '[[group]]\ncount = 6\ncontroller = "carrot"\nclearance = 0.05\n')
+    a = parse_scenario_text(text, "t.toml").start_poses()
+    assert np.array_equal(a, parse_scenario_text(text, "t.toml").start_poses())
+    assert not np.array_equal(a, parse_scenario_text(text.replace("kind", "seed = 9\nkind"), "t.toml").start_poses())
+    from swarm.arena.scenario import clearance_at
+
+    s = parse_scenario_text(text, "t.toml")
+    assert (clearance_at(a[:, :2], s.wall_rects(), s.wall_segments()) >= 0.037 + 0.05).all()
+    gaps = np.hypot(*(a[:, None, :2] - a[None, :, :2]).transpose(2, 0, 1)) + np.eye(6)
+    assert gaps.min() >= 2 * 0.037
+
+
+def test_astar_finds_the_straight_line_and_respects_clearance():
+    empty = Planner((1.0, 1.0), np.zeros((0, 4)), np.zeros((0, 4)), 0.01, 0.04)
+    length, path = empty.plan((0.1, 0.5), (0.9, 0.5))
+    assert length == pytest.approx(0.8, abs=1e-9) and len(path) == 81
+    # a 6 cm gap is narrower than twice the 4 cm clearance: no way through
+    wall = np.array([[0.45, 0.0, 0.55, 0.47], [0.45, 0.53, 0.55, 1.0]])
+    blocked = Planner((1.0, 1.0), wall, np.zeros((0, 4)), 0.01, 0.04)
+    assert blocked.plan((0.1, 0.5), (0.9, 0.5))[0] == math.inf
+    wide = np.array([[0.45, 0.0, 0.55, 0.40], [0.45, 0.60, 0.55, 1.0]])
+    length, path = Planner((1.0, 1.0), wide, np.zeros((0, 4)), 0.01, 0.04).plan((0.1, 0.9), (0.9, 0.9))
+    assert math.isfinite(length) and length > 0.8
+    from swarm.arena.scenario import clearance_at
+
+    # clearance is counted between cell centres, as in the original code: within half a cell of 4 cm
+    assert clearance_at(path, wide, np.zeros((0, 4))).min() >= 0.04 - 0.005
+
+
+def test_carrot_reaches_zmaze_goals_close_to_the_optimum():
+    s = load_scenario("zmaze")
+    for start, goal in (((0.395, 0.205, 0.0), (0.695, 0.705)), ((0.695, 0.405, 0.0), (0.195, 0.805))):
+        summary = ArenaEngine(s.with_overrides(start=start, goal=goal, noise="none")).run()
+        robot = summary["robots"][0]
+        assert summary["finished"] and robot["reached"] and robot["collisions"] == 0
+        assert 0.9 < robot["path_ratio"] < 1.15
+
+
+def test_arena_runs_are_deterministic_bit_for_bit():
+    s = load_scenario("large-maze").with_overrides(noise="high")
+    a, b = ArenaEngine(s), ArenaEngine(s)
+    a.step(300)
+    b.step(300)
+    assert np.array_equal(a.world.pose, b.world.pose)
+
+
+def test_several_robots_share_a_maze():
+    text = load_scenario("large-maze")
+    s = text.with_overrides(agents=4, seed=5)  # drawn starts, the scenario's goal for all
+    e = ArenaEngine(s)
+    e.step(1500)
+    assert e.world.bodies.distance.min() > 0.3
+    assert int(e.world.finished.sum()) >= 1
+
+
+def _swarm(*args) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "swarm.cli", *args], capture_output=True, text=True, timeout=300)
+
+
+def test_cli_runs_and_senses_an_arena():
+    out = _swarm("run", "zmaze", "--noise", "none", "--json")
+    assert out.returncode == 0, out.stderr
+    summary = json.loads(out.stdout)
+    assert summary["kind"] == "arena" and summary["robots"][0]["reached"]
+    sense = _swarm("sense", "zmaze", "--pose", "0.2,0.5,0", "--json")
+    assert sense.returncode == 0, sense.stderr
+    reading = json.loads(sense.stdout)
+    assert reading["position"] and len(reading["ir"]) == 8
+    bad = _swarm("run", "zmaze", "--agents", "2", "--start", "0.2,0.2")
+    assert bad.returncode == 2 and "one-robot" in bad.stderr and "Traceback" not in bad.stderr

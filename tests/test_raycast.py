@@ -1,0 +1,110 @@
+"""The compiled ray pass against brute force, and sensors against hand calculations."""
+
+import math
+
+import numpy as np
+import pytest
+
+from tests.arena_helpers import arena
+from world_server.arena import ArenaWorld
+from world_server.raycast import NO_HIT, brute_force
+from world_server.sensors import IR_DISTANCE, IR_VALUE
+
+
+def _random_world(seed: int, robots: int, obstacles: int, cell: float | None = None) -> ArenaWorld:
+    rng = np.random.default_rng(seed)
+    walls = ""
+    for _ in range(obstacles):
+        x, y = rng.uniform(0.5, 9.0, 2)
+        wx, wy = rng.uniform(0.1, 1.0, 2)
+        walls += f"[[wall]]\nrect = [{x}, {y}, {min(x + wx, 9.9)}, {min(y + wy, 9.9)}]\n"
+    for _ in range(5):  # diagonal segments too
+        a = rng.uniform(0.5, 9.5, 4)
+        walls += f"[[wall]]\nsegment = [{a[0]}, {a[1]}, {a[2]}, {a[3]}]\n"
+    body = walls + f'[[group]]\ncount = {robots}\ncontroller = "carrot"\nrobot = "scout"\nclearance = 0.0\n'
+    return ArenaWorld(arena(body, w=10.0, h=10.0), index_cell=cell)
+
+
+@pytest.mark.parametrize("seed,cell", [(1, None), (2, 0.3), (3, 2.5)])
+def test_index_equals_brute_force(seed, cell):
+    world = _random_world(seed, robots=40, obstacles=30, cell=cell)
+    rng = np.random.default_rng(seed + 100)
+    k = 3000
+    robot = rng.integers(0, world.n, k)
+    bearing = rng.uniform(-math.pi, math.pi, k)
+    max_range = rng.uniform(0.5, 12.0, k)
+    ranges, what = world.cast(robot, bearing, max_range)
+    xy = world.pose[:, :2]
+    for i in range(k):
+        r = robot[i]
+        d, w = brute_force(xy[r, 0], xy[r, 1], world.pose[r, 2] + bearing[i], max_range[i], r, world.segs,
+                           world.seg_on, xy, world.radius)  # fmt: skip
+        assert ranges[i] == pytest.approx(d, abs=1e-9)
+        if w != what[i]:  # two things at the same distance (a rectangle's corner): either may win
+            assert d == pytest.approx(ranges[i], abs=1e-9)
+    assert (what == NO_HIT).any() and (what >= 0).any() and (what <= -2).any()
+
+
+def test_rays_never_see_their_own_robot_and_robots_block_each_other():
+    body = '[[group]]\ncount = 2\ncontroller = "carrot"\nstarts = [[0.3, 0.5, 0.0], [0.6, 0.5, 3.14159]]\n'
+    world = ArenaWorld(arena(body))
+    ranges, what = world.cast(np.array([0, 1]), np.array([0.0, 0.0]), np.array([5.0, 5.0]))
+    assert what[0] == -2 - 1 and what[1] == -2 - 0
+    assert ranges[0] == pytest.approx(0.3 - world.radius[1], abs=1e-6)
+
+
+def _one(body_extra: str, start: str, robot: str = "epuck", noise: str = "none") -> dict:
+    body = body_extra + f'[[group]]\ncount = 1\ncontroller = "carrot"\nstart = {start}\n'
+    return ArenaWorld(arena(body, robot=robot, noise=noise)).perceive()[0]
+
+
+def test_ir_reads_the_response_curve_at_the_hand_computed_distance():
+    # A wall face at x = 0.55, the e-puck (radius 37 mm) at x = 0.5 facing it.
+    p = _one("[[wall]]\nrect = [0.55, 0.3, 0.6, 0.7]\n", "[0.5, 0.5, 0.0]")
+    for k, bearing in ((0, -0.30), (7, 0.30)):
+        d = 0.05 / math.cos(bearing) - 0.037
+        assert p["ir"][k] == pytest.approx(np.interp(d, IR_DISTANCE, IR_VALUE), rel=1e-9)
+    assert p["ir"][1] > 0 and p["ir"][3] == 0.0 and p["ir"][4] == 0.0  # the back sees nothing within 7 cm
+
+
+def test_camera_sector_sees_the_coloured_wall_ahead_and_its_grey_level():
+    p = _one("[[wall]]\nrect = [0.8, 0.2, 0.85, 0.8]\ncolour = [255, 0, 0]\n", "[0.5, 0.5, 0.0]", robot="animat")
+    assert list(p["camera_rgb"][0]) == [255, 0, 0]
+    assert p["camera_grey"][0] == round(0.299 * 255)
+    assert p["camera_range"][0] == pytest.approx(0.3, abs=1e-9)  # the sector's nearest ray is the central one
+    behind = p["camera_range"][18]  # sector centred on pi: the west boundary's face at x = 0.02
+    assert behind == pytest.approx(0.48, abs=1e-3)
+    assert p["sonar"][0] == pytest.approx(0.3, abs=1e-9)  # no noise: the cone's nearest echo
+
+
+def test_noise_is_keyed_by_seed_agent_and_tick():
+    body = '[[group]]\ncount = 2\ncontroller = "carrot"\nstarts = [[0.3, 0.3, 0.0], [0.7, 0.7, 0.0]]\n'
+    a = ArenaWorld(arena(body, robot="animat", noise="low"))
+    b = ArenaWorld(arena(body, robot="animat", noise="low"))
+    pa, pb = a.perceive(), b.perceive()
+    assert np.array_equal(pa[0]["sonar"], pb[0]["sonar"]) and np.array_equal(pa[1]["compass"], pb[1]["compass"])
+    zero = ArenaWorld(arena(body, robot="animat", noise="none")).perceive()
+    err = pa[0]["compass"] - zero[0]["compass"]
+    assert 0 < abs((err + math.pi) % (2 * math.pi) - math.pi) <= math.radians(10)
+    assert np.all(np.abs(pa[0]["sonar"] - zero[0]["sonar"]) <= 0.10 + 0.3)  # range error plus the turned cone
+
+
+def test_position_noise_has_the_paper_std():
+    body = '[[group]]\ncount = 1\ncontroller = "carrot"\nstart = [0.5, 0.5, 0.0]\n'
+    world = ArenaWorld(arena(body, noise="high"))
+    xs = []
+    for _ in range(400):
+        xs.append(world.perceive()[0]["position"] - world.pose[0, :2])
+        world.apply(np.zeros((1, 2)))
+    xs = np.array(xs)
+    assert xs.std(axis=0) == pytest.approx([0.02, 0.02], rel=0.15)
+    assert np.abs(xs.mean(axis=0)).max() < 0.004
+
+
+def test_laser_without_noise_measures_geometry():
+    world = ArenaWorld(arena('[[group]]\ncount = 1\ncontroller = "carrot"\nrobot = "scout"\nstart = [0.5, 0.4, 0.0]\n',
+                            noise="none"))  # fmt: skip
+    scan = world.perceive()[0]["laser"]
+    assert scan[0] == pytest.approx(0.98 - 0.5, abs=1e-9)  # east inner face at x = 0.98
+    assert scan[90] == pytest.approx(0.98 - 0.4, abs=1e-9)  # north
+    assert scan[180] == pytest.approx(0.5 - 0.02, abs=1e-9)  # west

@@ -1,0 +1,274 @@
+"""The arena: a continuous world of walls, zones, scheduled obstacles and
+differential-drive robots, behind the same world contract as the grid
+(world_server/contract.py).
+
+A tick is lock-step: every robot perceives the start-of-tick world (one ray
+pass for all sensors of all robots), the controllers decide, and `apply`
+validates every action and integrates the bodies for one control period.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from swarm.arena.scenario import ArenaScenario
+from world_server.drive import DiffDrive
+from world_server.raycast import NO_HIT, build_disc_index, build_segment_index, cast_rays, grid_shape
+from world_server.sensors import ZONE_KINDS, Suite
+
+ACTION_LEN = 2  # left and right wheel speeds, m/s
+REJECT_REASONS = ("not finite", "over the wheel limit", "wrong shape")
+
+
+def rect_edges(rect) -> list[tuple[float, float, float, float]]:
+    x0, y0, x1, y1 = rect
+    return [(x0, y0, x1, y0), (x1, y0, x1, y1), (x1, y1, x0, y1), (x0, y1, x0, y0)]
+
+
+class ArenaWorld:
+    kind = "arena"
+
+    def __init__(self, scenario: ArenaScenario, index_cell: float | None = None):
+        s = self.scenario = scenario
+        self.tick = 0
+        models = s.robot_models()
+        self.n = len(models)
+        self.radius = np.array([m.radius for m in models])
+        self.axle = np.array([m.axle for m in models])
+        self.max_wheel = np.array([m.max_wheel_speed for m in models])
+        self.max_speed = np.array([m.max_speed for m in models])
+        self.max_turn = np.array([m.max_turn_rate for m in models])
+        self.robot_rgb = np.array([m.colour for m in models], np.uint8).reshape(-1, 3)
+        # Geometry: wall rectangles and segments, then every obstacle's edges (switched by seg_on).
+        segs, colours, self.obstacle_segs = [], [], []
+        for w in s.walls:
+            edges = rect_edges(w.coords) if w.shape == "rect" else [w.coords]
+            segs += edges
+            colours += [w.colour] * len(edges)
+        for o in s.obstacles:
+            self.obstacle_segs.append(np.arange(len(segs), len(segs) + 4))
+            segs += rect_edges(o.rect)
+            colours += [o.colour] * 4
+        self.segs = np.array(segs, np.float64).reshape(-1, 4)
+        self.seg_rgb = np.array(colours, np.uint8).reshape(-1, 3)
+        self.seg_on = np.ones(len(self.segs), np.bool_)
+        self.extent = (0.0, 0.0, float(s.size[0]), float(s.size[1]))
+        self.cell = index_cell or default_cell(s)
+        self.nx, self.ny = grid_shape(self.extent, self.cell)
+        self.s_start, self.s_items = build_segment_index(self.segs, 0.0, 0.0, self.cell, self.nx, self.ny)
+        self.d_start = np.zeros(self.nx * self.ny + 1, np.int64)
+        self.d_items = np.zeros(4 * self.n + 16, np.int64)
+        # Bodies and sensors.
+        start = s.start_poses()
+        self.bodies = DiffDrive(start, self.radius, s.wall_rects(), s.wall_segments(), s.control_period, s.substeps)
+        self.present = np.ones(self.n, np.bool_)  # False: the agent is gone, its body stays as an obstacle
+        self._bodies_block = np.ones(self.n, np.bool_)  # every body blocks rays, present or not
+        self.suites: list[Suite] = []
+        first = 0
+        for g in s.groups:
+            self.suites.append(Suite(g.robot, np.arange(first, first + g.count), s.noise, s.seed))
+            first += g.count
+        self._obstacles_at(0)
+        # Goals and routes, tracked on ground truth for the summary.
+        self.goal = np.full((self.n, 2), np.nan)
+        self.route: list[np.ndarray | None] = [None] * self.n
+        for a, goal in enumerate(s.goals()):
+            if goal is not None:
+                self.goal[a] = goal
+        agent = 0
+        for g in s.groups:
+            for _ in range(g.count):
+                if g.route is not None:
+                    self.route[agent] = np.array(s.routes[g.route], np.float64).reshape(-1, 2)
+                    self.goal[agent] = self.route[agent][-1]
+                agent += 1
+        self.waypoint = np.zeros(self.n, np.int64)  # next route waypoint per robot
+        self.has_goal = ~np.isnan(self.goal[:, 0])
+        self.reached_tick = np.full(self.n, -1, np.int64)
+        self.dwell = np.zeros(self.n, np.int64)
+        self.finished = np.zeros(self.n, np.bool_)
+        self.path_length = np.zeros(self.n)
+        self.rejected = dict.fromkeys(REJECT_REASONS, 0)
+        self.start_pose = start.copy()
+        self.zones = np.zeros(self.n, np.int64)
+        self._update_zones()
+
+    # ------------------------------------------------------------- contract
+
+    @property
+    def pose(self) -> np.ndarray:
+        return self.bodies.pose
+
+    @property
+    def motion(self) -> np.ndarray:
+        return self.bodies.motion
+
+    @property
+    def contact(self) -> np.ndarray:
+        return self.bodies.contact
+
+    def perceive(self) -> list[dict[str, np.ndarray]]:
+        """Every robot's perception of the start-of-tick world (one ray pass)."""
+        batches = self.perceive_groups()
+        out = []
+        for batch in batches:
+            keys = list(batch)
+            n = len(batch[keys[0]]) if keys else 0
+            out += [{k: batch[k][i] for k in keys} for i in range(n)]
+        return out
+
+    def perceive_groups(self) -> list[dict[str, np.ndarray]]:
+        """Per group, its robots' readings batched (arrays with a robot axis)."""
+        rays = [suite.rays(self.tick) for suite in self.suites]
+        ranges, what = self.cast(np.concatenate([r[0] for r in rays]), np.concatenate([r[1] for r in rays]),
+                                 np.concatenate([r[2] for r in rays]))  # fmt: skip
+        rgb = self.hit_colours(what)
+        out, k = [], 0
+        for suite in self.suites:
+            n, per = len(suite.robots), suite.per_robot
+            m = n * per
+            out.append(suite.read(ranges[k : k + m].reshape(n, per), rgb[k : k + m].reshape(n, per, 3),
+                                  what[k : k + m].reshape(n, per), self, self.tick))  # fmt: skip
+            k += m
+        return out
+
+    def cast(self, robot: np.ndarray, bearing: np.ndarray, max_range: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One compiled pass over every ray; robots block each other's rays."""
+        xy = np.ascontiguousarray(self.pose[:, :2])
+        while True:
+            got = build_disc_index(xy, self.radius, self._bodies_block, 0.0, 0.0, self.cell, self.nx,
+                                   self.ny, self.d_start, self.d_items)  # fmt: skip
+            if got >= 0:
+                break
+            self.d_items = np.zeros(-got + 16, np.int64)
+        ranges = np.empty(len(robot))
+        what = np.empty(len(robot), np.int64)
+        cast_rays(self.pose, robot.astype(np.int64), bearing, max_range, self.segs, self.seg_on, self.s_start,
+                  self.s_items, xy, self.radius, self.d_start, self.d_items, 0.0, 0.0, self.cell, self.nx, self.ny,
+                  ranges, what)  # fmt: skip
+        return ranges, what
+
+    def hit_colours(self, what: np.ndarray) -> np.ndarray:
+        rgb = np.zeros((len(what), 3), np.uint8)
+        wall = what >= 0
+        rgb[wall] = self.seg_rgb[what[wall]]
+        robot = what <= -2
+        rgb[robot] = self.robot_rgb[-2 - what[robot]]
+        return rgb
+
+    def validate(self, actions: np.ndarray) -> np.ndarray:
+        """Which rows of (n, 2) wheel speeds may be acted on; the others are
+        counted by reason and their robots hold still this tick."""
+        actions = np.asarray(actions, np.float64)
+        if actions.shape != (self.n, ACTION_LEN):
+            self.rejected["wrong shape"] += self.n
+            return np.zeros(self.n, np.bool_)
+        finite = np.isfinite(actions).all(axis=1)
+        within = finite & (np.abs(np.where(finite[:, None], actions, 0.0)) <= self.max_wheel[:, None] * (1 + 1e-9)
+                           ).all(axis=1)  # fmt: skip
+        self.rejected["not finite"] += int((~finite).sum())
+        self.rejected["over the wheel limit"] += int((finite & ~within).sum())
+        return within
+
+    def apply(self, actions: np.ndarray, ok: np.ndarray | None = None) -> None:
+        """Integrate one control period from validated wheel speeds (rows with
+        ok False, finished robots and absent agents hold still)."""
+        if ok is None:
+            ok = self.validate(actions)
+        wheels = np.zeros((self.n, ACTION_LEN))
+        if np.shape(actions) == (self.n, ACTION_LEN):
+            wheels[ok] = np.asarray(actions, np.float64)[ok]
+        wheels = self._limit(wheels)
+        before = self.pose[:, :2].copy()
+        moving = ok & ~self.finished & self.present
+        self.bodies.drive(wheels, self.axle, moving)
+        self.path_length += np.hypot(*(self.pose[:, :2] - before).T)
+        self.tick += 1
+        self._obstacles_at(self.tick)
+        self._update_zones()
+        self._track_goals()
+
+    def _limit(self, wheels: np.ndarray) -> np.ndarray:
+        """The model's forward-speed and turn-rate limits scale the wheel speeds down."""
+        v = (wheels[:, 0] + wheels[:, 1]) / 2
+        w = (wheels[:, 1] - wheels[:, 0]) / self.axle
+        sv = np.where(np.abs(v) > self.max_speed, self.max_speed / np.maximum(np.abs(v), 1e-12), 1.0)
+        sw = np.where(np.abs(w) > self.max_turn, self.max_turn / np.maximum(np.abs(w), 1e-12), 1.0)
+        v, w = v * sv, w * sw
+        return np.column_stack([v - w * self.axle / 2, v + w * self.axle / 2])
+
+    def _obstacles_at(self, tick: int) -> None:
+        for k, o in enumerate(self.scenario.obstacles):
+            on = o.present(tick)
+            self.seg_on[self.obstacle_segs[k]] = on
+            self.bodies.set_obstacle(k, np.array(o.rect) if on else None)
+
+    def _update_zones(self) -> None:
+        self.zones[:] = 0
+        xy = self.pose[:, :2]
+        for z in self.scenario.zones:
+            self.zones |= np.where(z.contains(xy), 1 << ZONE_KINDS.index(z.kind), 0)
+
+    def _track_goals(self) -> None:
+        s = self.scenario
+        for a in np.flatnonzero(self.has_goal & ~self.finished):
+            x, y = self.pose[a, :2]
+            route = self.route[a]
+            if route is not None and self.waypoint[a] < len(route) - 1:
+                wx, wy = route[self.waypoint[a]]
+                if math.hypot(x - wx, y - wy) < s.goal_radius:
+                    self.waypoint[a] += 1
+                continue
+            if math.hypot(x - self.goal[a, 0], y - self.goal[a, 1]) < s.goal_radius:
+                if self.reached_tick[a] < 0:
+                    self.reached_tick[a] = self.tick
+                self.dwell[a] += 1
+                if self.dwell[a] >= s.goal_dwell:
+                    self.finished[a] = True
+
+    def done(self) -> bool:
+        if self.tick >= self.scenario.max_ticks:
+            return True
+        return bool(self.has_goal.any()) and bool(self.finished[self.has_goal].all())
+
+    def remove_agent(self, agent: int) -> None:
+        """The agent is gone: its body stops where it is and stays an obstacle."""
+        self.present[agent] = False
+
+    # -------------------------------------------------------------- summary
+
+    def robot_summaries(self, optimum: list[float]) -> list[dict[str, Any]]:
+        s = self.scenario
+        out = []
+        controllers = [g.controller for g in s.groups for _ in range(g.count)]
+        for a in range(self.n):
+            reached = bool(self.has_goal[a]) and math.hypot(*(self.pose[a, :2] - self.goal[a])) < s.goal_radius
+            lo = optimum[a]
+            lp = float(self.path_length[a])
+            out.append({
+                "agent": a, "controller": controllers[a],
+                "start": [round(float(v), 4) for v in self.start_pose[a]],
+                "goal": None if not self.has_goal[a] else [round(float(v), 4) for v in self.goal[a]],
+                "reached": reached,
+                "ticks_to_goal": int(self.reached_tick[a]) if self.reached_tick[a] >= 0 else None,
+                "path_length": round(lp, 4),
+                "optimal_length": None if not math.isfinite(lo) else round(lo, 4),
+                "path_ratio": round(lp / lo, 4) if reached and math.isfinite(lo) and lo > 0 else None,
+                "collisions": int(self.bodies.collisions[a]),
+                "distance": round(float(self.bodies.distance[a]), 4),
+                "blocked_seconds": round(float(self.bodies.blocked_seconds[a]), 3),
+                "pose": [round(float(v), 5) for v in self.pose[a]],
+            })  # fmt: skip
+        return out
+
+
+def default_cell(s: ArenaScenario) -> float:
+    """Index cell: about two robot diameters, at least 1/256 of the arena's side."""
+    r = max(g.robot.radius for g in s.groups)
+    return max(4 * r, max(s.size) / 256)
+
+
+__all__ = ["NO_HIT", "ArenaWorld", "default_cell"]

@@ -1,0 +1,142 @@
+"""Differential-drive robot bodies on pymunk: discs driven by wheel speeds.
+
+Per control period the world hands every robot its two wheel speeds (m/s,
+already validated and clamped to the model's limits).  They give a forward
+speed v = (l + r) / 2 and a turn rate w = (r - l) / axle.  Over the period's
+fixed substeps each disc is pushed (a force, so contact corrections survive
+into the next substep) towards v along its heading, and the heading turns by
+w * dt.  Discs do not spin from contacts (infinite moment): the heading is the
+robot's own, integrated here.  Walls are static boxes and segments; scheduled
+obstacles are added to and removed from the space when their time comes.
+
+Chipmunk moves bodies before it applies forces, so a robot starting from rest
+lags one substep behind its command (16 ms at 4 substeps of 64 ms).
+Everything is in a fixed order with fixed steps, so a run is deterministic.
+A stopped (lost) robot keeps its body: it becomes an obstacle that does not
+move (docs/arena.md).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+WALL_TYPE, ROBOT_TYPE = 1, 2
+BLOCKED_SHARE = 0.5  # moving at under half of the commanded speed counts as blocked
+
+
+class DiffDrive:
+    def __init__(self, pose: np.ndarray, radius: np.ndarray, rects: np.ndarray, segments: np.ndarray,
+                 period: float, substeps: int):  # fmt: skip
+        import pymunk
+        import pymunk.batch
+
+        self._pymunk, self._batch = pymunk, pymunk.batch
+        self.n = len(pose)
+        self.pose = np.array(pose, dtype=np.float64)
+        self.radius = np.asarray(radius, np.float64)
+        self.period, self.substeps = float(period), int(substeps)
+        self.dt = self.period / self.substeps
+        self.distance = np.zeros(self.n)  # travelled, per robot
+        self.collisions = np.zeros(self.n, np.int64)  # contacts begun (walls or robots)
+        self.blocked_seconds = np.zeros(self.n)
+        self.contact = np.zeros(self.n, np.bool_)  # touched anything in the last period
+        self.motion = np.zeros((self.n, 2))  # forward distance and turn of the last period
+        self.sim_seconds = 0.0
+        space = pymunk.Space()
+        space.collision_slop = 0.0005
+        for rect in rects:
+            self._add_static(space, box=rect)
+        for seg in segments:
+            self._add_static(space, segment=seg)
+        self._bodies = []
+        for i in range(self.n):
+            body = pymunk.Body(1.0, float("inf"))
+            body.position = (float(self.pose[i, 0]), float(self.pose[i, 1]))
+            disc = pymunk.Circle(body, float(self.radius[i]))
+            disc.friction = 0.0
+            disc.collision_type = ROBOT_TYPE
+            disc.robot = i
+            space.add(body, disc)
+            self._bodies.append(body)
+        space.on_collision(ROBOT_TYPE, WALL_TYPE, begin=self._begin)
+        space.on_collision(ROBOT_TYPE, ROBOT_TYPE, begin=self._begin)
+        self.space = space
+        self._obstacles: dict[int, list] = {}
+        self._force = np.zeros(2 * self.n + 2)
+        self._set = pymunk.batch.Buffer()
+        self._set.set_float_buf(self._force)
+        self._get = pymunk.batch.Buffer()
+
+    def _add_static(self, space, box=None, segment=None) -> list:
+        pm = self._pymunk
+        if box is not None:
+            x0, y0, x1, y1 = (float(v) for v in box)
+            shape = pm.Poly(space.static_body, [(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+        else:
+            x0, y0, x1, y1 = (float(v) for v in segment)
+            shape = pm.Segment(space.static_body, (x0, y0), (x1, y1), 0.002)
+        shape.friction = 0.0
+        shape.collision_type = WALL_TYPE
+        space.add(shape)
+        return [shape]
+
+    def _begin(self, arbiter, space, data) -> None:
+        for shape in arbiter.shapes:
+            if shape.collision_type == ROBOT_TYPE:
+                self.collisions[shape.robot] += 1
+                self.contact[shape.robot] = True
+
+    # ---------------------------------------------------------------- obstacles
+
+    def set_obstacle(self, key: int, rect: np.ndarray | None) -> None:
+        """Put a scheduled obstacle's box in the world (rect) or take it out (None)."""
+        if rect is None:
+            shapes = self._obstacles.pop(key, [])
+            if shapes:
+                self.space.remove(*shapes)
+        elif key not in self._obstacles:
+            self._obstacles[key] = self._add_static(self.space, box=rect)
+
+    # ------------------------------------------------------------------- motion
+
+    def _positions(self) -> np.ndarray:
+        self._get.clear()
+        fields = self._batch.BodyFields
+        self._batch.get_space_bodies(self.space, fields.POSITION | fields.VELOCITY, self._get)
+        return np.frombuffer(self._get.float_buf(), dtype=np.float64)[: 4 * self.n].reshape(self.n, 4).copy()
+
+    def drive(self, wheels: np.ndarray, axle: np.ndarray, moving: np.ndarray) -> None:
+        """One control period.  `wheels` (n, 2) left/right speeds; robots with
+        moving False hold still (lost agents, finished robots)."""
+        v = np.where(moving, (wheels[:, 0] + wheels[:, 1]) / 2, 0.0)
+        w = np.where(moving, (wheels[:, 1] - wheels[:, 0]) / axle, 0.0)
+        self.contact[:] = False
+        start = self.pose.copy()
+        forward = np.zeros(self.n)
+        state = self._positions()
+        for _ in range(self.substeps):
+            heading = self.pose[:, 2]
+            wanted = np.column_stack([v * np.cos(heading), v * np.sin(heading)])
+            self._force[: 2 * self.n] = ((wanted - state[:, 2:]) / self.dt).ravel()
+            self._batch.set_space_bodies(self.space, self._batch.BodyFields.FORCE, self._set)
+            self.space.step(self.dt)
+            after = self._positions()
+            step = after[:, :2] - state[:, :2]
+            dist = np.hypot(step[:, 0], step[:, 1])
+            self.distance += dist
+            forward += step[:, 0] * np.cos(heading) + step[:, 1] * np.sin(heading)
+            slow = (np.abs(v) > 1e-9) & (dist < BLOCKED_SHARE * np.abs(v) * self.dt)
+            self.blocked_seconds += np.where(slow, self.dt, 0.0)
+            self.pose[:, :2] = after[:, :2]
+            self.pose[:, 2] = (heading + w * self.dt) % (2 * math.pi)
+            state = after
+        self.motion[:, 0] = forward
+        self.motion[:, 1] = (self.pose[:, 2] - start[:, 2] + math.pi) % (2 * math.pi) - math.pi
+        self.sim_seconds += self.period
+
+    def place(self, i: int, pose: np.ndarray) -> None:
+        self.pose[i] = pose
+        self._bodies[i].position = (float(pose[0]), float(pose[1]))
+        self._bodies[i].velocity = (0.0, 0.0)

@@ -1,0 +1,221 @@
+"""All rays of all robots in one compiled pass, against walls and robot discs.
+
+A uniform grid over the arena indexes the wall segments once (scheduled
+obstacles are in it too, switched by a flag) and the robots' discs every tick
+(a counting sort, O(robots)).  Each ray walks the grid cells it crosses in
+order (Amanatides & Woo), tests only what those cells hold, and stops at the
+first cell that contains its nearest hit: the cost follows the rays' actual
+paths, not the size of the world.  A ray never sees its own robot's disc.
+
+Hits: `hit >= 0` is a segment index, `hit <= -2` is robot `-2 - hit`,
+`-1` is nothing within range (range reported as the ray's maximum).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+NO_HIT = -1
+
+
+def grid_shape(extent: tuple[float, float, float, float], cell: float) -> tuple[int, int]:
+    x0, y0, x1, y1 = extent
+    return max(1, math.ceil((x1 - x0) / cell)), max(1, math.ceil((y1 - y0) / cell))
+
+
+@njit(cache=True)
+def _cell_range(lo, hi, origin, cell, n):
+    a = int(math.floor((lo - origin) / cell))
+    b = int(math.floor((hi - origin) / cell))
+    return max(a, 0), min(b, n - 1)
+
+
+@njit(cache=True)
+def build_segment_index(segs, x0, y0, cell, nx, ny):
+    """CSR lists of segment indices per cell: (start (nx*ny+1,), items)."""
+    counts = np.zeros(nx * ny, np.int64)
+    for s in range(segs.shape[0]):
+        ax, ay, bx, by = segs[s, 0], segs[s, 1], segs[s, 2], segs[s, 3]
+        i0, i1 = _cell_range(min(ax, bx), max(ax, bx), x0, cell, nx)
+        j0, j1 = _cell_range(min(ay, by), max(ay, by), y0, cell, ny)
+        for j in range(j0, j1 + 1):
+            for i in range(i0, i1 + 1):
+                counts[j * nx + i] += 1
+    start = np.zeros(nx * ny + 1, np.int64)
+    for c in range(nx * ny):
+        start[c + 1] = start[c] + counts[c]
+    items = np.empty(start[-1], np.int64)
+    slot = start[:-1].copy()
+    for s in range(segs.shape[0]):
+        ax, ay, bx, by = segs[s, 0], segs[s, 1], segs[s, 2], segs[s, 3]
+        i0, i1 = _cell_range(min(ax, bx), max(ax, bx), x0, cell, nx)
+        j0, j1 = _cell_range(min(ay, by), max(ay, by), y0, cell, ny)
+        for j in range(j0, j1 + 1):
+            for i in range(i0, i1 + 1):
+                c = j * nx + i
+                items[slot[c]] = s
+                slot[c] += 1
+    return start, items
+
+
+@njit(cache=True)
+def build_disc_index(xy, radius, present, x0, y0, cell, nx, ny, start, items):
+    """Fill CSR lists of robots per cell (their bounding squares) into the
+    preallocated `start` (nx*ny+1,) and `items` (at least 4 per robot when a
+    disc is no wider than a cell; grown by the caller otherwise).  Returns the
+    number of items, or -needed when `items` is too small."""
+    ncell = nx * ny
+    for c in range(ncell + 1):
+        start[c] = 0
+    total = 0
+    for r in range(xy.shape[0]):
+        if not present[r]:
+            continue
+        i0, i1 = _cell_range(xy[r, 0] - radius[r], xy[r, 0] + radius[r], x0, cell, nx)
+        j0, j1 = _cell_range(xy[r, 1] - radius[r], xy[r, 1] + radius[r], y0, cell, ny)
+        for j in range(j0, j1 + 1):
+            for i in range(i0, i1 + 1):
+                start[j * nx + i + 1] += 1
+                total += 1
+    if total > items.shape[0]:
+        return -total
+    for c in range(ncell):
+        start[c + 1] += start[c]
+    slot = start[:-1].copy()
+    for r in range(xy.shape[0]):
+        if not present[r]:
+            continue
+        i0, i1 = _cell_range(xy[r, 0] - radius[r], xy[r, 0] + radius[r], x0, cell, nx)
+        j0, j1 = _cell_range(xy[r, 1] - radius[r], xy[r, 1] + radius[r], y0, cell, ny)
+        for j in range(j0, j1 + 1):
+            for i in range(i0, i1 + 1):
+                c = j * nx + i
+                items[slot[c]] = r
+                slot[c] += 1
+    return total
+
+
+@njit(cache=True, inline="always")
+def _hit_segment(ox, oy, dx, dy, ax, ay, bx, by):
+    ex, ey = bx - ax, by - ay
+    den = dx * ey - dy * ex
+    if abs(den) < 1e-15:
+        return np.inf
+    wx, wy = ax - ox, ay - oy
+    t = (wx * ey - wy * ex) / den
+    s = (wx * dy - wy * dx) / den
+    if t >= 0.0 and 0.0 <= s <= 1.0:
+        return t
+    return np.inf
+
+
+@njit(cache=True, inline="always")
+def _hit_disc(ox, oy, dx, dy, cx, cy, r):
+    wx, wy = cx - ox, cy - oy
+    b = wx * dx + wy * dy
+    c = wx * wx + wy * wy - r * r
+    disc = b * b - c
+    if disc < 0.0:
+        return np.inf
+    t = b - math.sqrt(disc)
+    if t < 0.0:
+        return np.inf
+    return t
+
+
+@njit(cache=True)
+def cast_one(ox, oy, dx, dy, rmax, me, segs, seg_on, s_start, s_items, xy, radius, d_start, d_items,
+             x0, y0, cell, nx, ny):  # fmt: skip
+    """Nearest hit of one ray: (distance, what)."""
+    px, py = ox - x0, oy - y0
+    cx = min(max(int(math.floor(px / cell)), 0), nx - 1)
+    cy = min(max(int(math.floor(py / cell)), 0), ny - 1)
+    if dx > 0.0:
+        step_x, t_x, dt_x = 1, ((cx + 1) * cell - px) / dx, cell / dx
+    elif dx < 0.0:
+        step_x, t_x, dt_x = -1, (cx * cell - px) / dx, -cell / dx
+    else:
+        step_x, t_x, dt_x = 0, np.inf, np.inf
+    if dy > 0.0:
+        step_y, t_y, dt_y = 1, ((cy + 1) * cell - py) / dy, cell / dy
+    elif dy < 0.0:
+        step_y, t_y, dt_y = -1, (cy * cell - py) / dy, -cell / dy
+    else:
+        step_y, t_y, dt_y = 0, np.inf, np.inf
+    best, what = np.inf, NO_HIT
+    while True:
+        c = cy * nx + cx
+        for k in range(s_start[c], s_start[c + 1]):
+            s = s_items[k]
+            if seg_on[s]:
+                t = _hit_segment(ox, oy, dx, dy, segs[s, 0], segs[s, 1], segs[s, 2], segs[s, 3])
+                if t < best:
+                    best, what = t, s
+        for k in range(d_start[c], d_start[c + 1]):
+            r = d_items[k]
+            if r != me:
+                t = _hit_disc(ox, oy, dx, dy, xy[r, 0], xy[r, 1], radius[r])
+                if t < best:
+                    best, what = t, -2 - r
+        t_exit = min(t_x, t_y)
+        if best <= t_exit or t_exit > rmax:
+            break
+        if t_x < t_y:
+            cx += step_x
+            t_x += dt_x
+            if cx < 0 or cx >= nx:
+                break
+        else:
+            cy += step_y
+            t_y += dt_y
+            if cy < 0 or cy >= ny:
+                break
+    if best > rmax:
+        return rmax, NO_HIT
+    return best, what
+
+
+@njit(cache=True)
+def cast_rays(pose, ray_robot, ray_bearing, ray_range, segs, seg_on, s_start, s_items, xy, radius,
+              d_start, d_items, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
+    """Cast every ray: ray k leaves the centre of robot ray_robot[k] at bearing
+    ray_bearing[k] from its heading and reaches at most ray_range[k]."""
+    for k in range(ray_robot.shape[0]):
+        r = ray_robot[k]
+        a = pose[r, 2] + ray_bearing[k]
+        d, w = cast_one(pose[r, 0], pose[r, 1], math.cos(a), math.sin(a), ray_range[k], r, segs, seg_on,
+                        s_start, s_items, xy, radius, d_start, d_items, x0, y0, cell, nx, ny)  # fmt: skip
+        out_range[k] = d
+        out_hit[k] = w
+
+
+def brute_force(ox: float, oy: float, angle: float, rmax: float, me: int, segs: np.ndarray, seg_on: np.ndarray,
+                xy: np.ndarray, radius: np.ndarray) -> tuple[float, int]:
+    """Every segment and disc, numpy: the reference the index is tested against."""
+    dx, dy = math.cos(angle), math.sin(angle)
+    ex, ey = segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]
+    den = dx * ey - dy * ex
+    wx, wy = segs[:, 0] - ox, segs[:, 1] - oy
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (wx * ey - wy * ex) / den
+        s = (wx * dy - wy * dx) / den
+    ok = seg_on & (np.abs(den) >= 1e-15) & (t >= 0) & (s >= 0) & (s <= 1)
+    ts = np.where(ok, t, np.inf)
+    cx, cy = xy[:, 0] - ox, xy[:, 1] - oy
+    b = cx * dx + cy * dy
+    disc = b * b - (cx * cx + cy * cy - radius**2)
+    with np.errstate(invalid="ignore"):
+        td = b - np.sqrt(disc)
+    td = np.where((disc >= 0) & (td >= 0), td, np.inf)
+    if len(td) > me >= 0:
+        td[me] = np.inf
+    best_s = int(np.argmin(ts)) if len(ts) else -1
+    best_d = int(np.argmin(td)) if len(td) else -1
+    t_s = ts[best_s] if best_s >= 0 else np.inf
+    t_d = td[best_d] if best_d >= 0 else np.inf
+    if min(t_s, t_d) > rmax:
+        return rmax, NO_HIT
+    return (float(t_s), best_s) if t_s <= t_d else (float(t_d), -2 - best_d)
