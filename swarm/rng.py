@@ -61,11 +61,18 @@ def draw_normal(seed, agent, tick, draw):
 
 @njit(cache=True)
 def fill_normal(seed, agents, tick, stream, out):
-    """out[i, j] = normal number (stream << 24) + j of agents[i] at tick: the
-    noise of one sensor for every robot in one call (streams never overlap)."""
+    """The noise of one sensor for every robot in one call: row i from agents[i]'s
+    counters (stream << 24) + j at tick (streams never overlap).  Box-Muller
+    gives two normals per pair of uniforms; both are used."""
     for i in range(out.shape[0]):
-        for j in range(out.shape[1]):
-            out[i, j] = draw_normal(seed, agents[i], tick, (stream << 24) + j)
+        for j in range(0, out.shape[1], 2):
+            base = 2 * ((stream << 24) + j)
+            u1 = 1.0 - draw_unit(seed, agents[i], tick, base)
+            u2 = draw_unit(seed, agents[i], tick, base + 1)
+            radius = np.sqrt(-2.0 * np.log(u1))
+            out[i, j] = radius * np.cos(2.0 * np.pi * u2)
+            if j + 1 < out.shape[1]:
+                out[i, j + 1] = radius * np.sin(2.0 * np.pi * u2)
 
 
 @njit(cache=True)

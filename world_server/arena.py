@@ -59,8 +59,9 @@ class ArenaWorld:
         self.cell = index_cell or default_cell(s)
         self.nx, self.ny = grid_shape(self.extent, self.cell)
         self.s_start, self.s_items = build_segment_index(self.segs, 0.0, 0.0, self.cell, self.nx, self.ny)
+        self.s_coords = np.ascontiguousarray(self.segs[self.s_items])
         self.d_start = np.zeros(self.nx * self.ny + 1, np.int64)
-        self.d_items = np.zeros(4 * self.n + 16, np.int64)
+        self._grow_discs(4 * self.n + 16)
         # Bodies and sensors.
         start = s.start_poses()
         self.bodies = DiffDrive(start, self.radius, s.wall_rects(), s.wall_segments(), s.control_period, s.substeps)
@@ -123,31 +124,39 @@ class ArenaWorld:
     def perceive_groups(self) -> list[dict[str, np.ndarray]]:
         """Per group, its robots' readings batched (arrays with a robot axis)."""
         rays = [suite.rays(self.tick) for suite in self.suites]
-        ranges, what = self.cast(np.concatenate([r[0] for r in rays]), np.concatenate([r[1] for r in rays]),
-                                 np.concatenate([r[2] for r in rays]))  # fmt: skip
-        rgb = self.hit_colours(what)
+        joined = [np.concatenate([r[k] for r in rays]) for k in range(5)] if len(rays) > 1 else list(rays[0])
+        ranges, what = self.cast(joined[0], joined[1], joined[2], (joined[3], joined[4]))
+        rgb = self.hit_colours(what) if any(s.model.sensors.camera for s in self.suites) else None
         out, k = [], 0
         for suite in self.suites:
             n, per = len(suite.robots), suite.per_robot
             m = n * per
-            out.append(suite.read(ranges[k : k + m].reshape(n, per), rgb[k : k + m].reshape(n, per, 3),
-                                  what[k : k + m].reshape(n, per), self, self.tick))  # fmt: skip
+            colours = None if rgb is None else rgb[k : k + m].reshape(n, per, 3)
+            out.append(suite.read(ranges[k : k + m].reshape(n, per), colours, what[k : k + m].reshape(n, per), self,
+                                  self.tick))  # fmt: skip
             k += m
         return out
 
-    def cast(self, robot: np.ndarray, bearing: np.ndarray, max_range: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """One compiled pass over every ray; robots block each other's rays."""
+    def _grow_discs(self, size: int) -> None:
+        self.d_items = np.zeros(size, np.int64)
+        self.d_xyr = np.zeros((size, 3))
+
+    def cast(self, robot: np.ndarray, bearing: np.ndarray, max_range: np.ndarray,
+             cos_sin: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+        """One compiled pass over every ray (robot-major); robots block each
+        other's rays.  `cos_sin` of the bearings may be given (suites cache them)."""
         xy = np.ascontiguousarray(self.pose[:, :2])
         while True:
             got = build_disc_index(xy, self.radius, self._bodies_block, 0.0, 0.0, self.cell, self.nx,
-                                   self.ny, self.d_start, self.d_items)  # fmt: skip
+                                   self.ny, self.d_start, self.d_items, self.d_xyr)  # fmt: skip
             if got >= 0:
                 break
-            self.d_items = np.zeros(-got + 16, np.int64)
+            self._grow_discs(-got + 16)
+        c, s = cos_sin if cos_sin is not None else (np.cos(bearing), np.sin(bearing))
         ranges = np.empty(len(robot))
         what = np.empty(len(robot), np.int64)
-        cast_rays(self.pose, robot.astype(np.int64), bearing, max_range, self.segs, self.seg_on, self.s_start,
-                  self.s_items, xy, self.radius, self.d_start, self.d_items, 0.0, 0.0, self.cell, self.nx, self.ny,
+        cast_rays(self.pose, robot.astype(np.int64), c, s, max_range, self.s_coords, self.s_items, self.seg_on,
+                  self.s_start, self.d_xyr, self.d_items, self.d_start, 0.0, 0.0, self.cell, self.nx, self.ny,
                   ranges, what)  # fmt: skip
         return ranges, what
 

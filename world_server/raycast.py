@@ -35,7 +35,8 @@ def _cell_range(lo, hi, origin, cell, n):
 
 @njit(cache=True)
 def build_segment_index(segs, x0, y0, cell, nx, ny):
-    """CSR lists of segment indices per cell: (start (nx*ny+1,), items)."""
+    """CSR lists of segment indices per cell: (start (nx*ny+1,), items);
+    coordinates in the same order come from segs[items]."""
     counts = np.zeros(nx * ny, np.int64)
     for s in range(segs.shape[0]):
         ax, ay, bx, by = segs[s, 0], segs[s, 1], segs[s, 2], segs[s, 3]
@@ -62,11 +63,12 @@ def build_segment_index(segs, x0, y0, cell, nx, ny):
 
 
 @njit(cache=True)
-def build_disc_index(xy, radius, present, x0, y0, cell, nx, ny, start, items):
+def build_disc_index(xy, radius, present, x0, y0, cell, nx, ny, start, items, xyr):
     """Fill CSR lists of robots per cell (their bounding squares) into the
-    preallocated `start` (nx*ny+1,) and `items` (at least 4 per robot when a
-    disc is no wider than a cell; grown by the caller otherwise).  Returns the
-    number of items, or -needed when `items` is too small."""
+    preallocated `start` (nx*ny+1,), `items` and `xyr` (centre and radius in
+    cell order; at least 4 per robot when a disc is no wider than a cell, grown
+    by the caller otherwise).  Returns the number of items, or -needed when
+    `items` is too small."""
     ncell = nx * ny
     for c in range(ncell + 1):
         start[c] = 0
@@ -94,6 +96,9 @@ def build_disc_index(xy, radius, present, x0, y0, cell, nx, ny, start, items):
             for i in range(i0, i1 + 1):
                 c = j * nx + i
                 items[slot[c]] = r
+                xyr[slot[c], 0] = xy[r, 0]
+                xyr[slot[c], 1] = xy[r, 1]
+                xyr[slot[c], 2] = radius[r]
                 slot[c] += 1
     return total
 
@@ -127,9 +132,10 @@ def _hit_disc(ox, oy, dx, dy, cx, cy, r):
 
 
 @njit(cache=True)
-def cast_one(ox, oy, dx, dy, rmax, me, segs, seg_on, s_start, s_items, xy, radius, d_start, d_items,
+def cast_one(ox, oy, dx, dy, rmax, me, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids, d_start,
              x0, y0, cell, nx, ny):  # fmt: skip
-    """Nearest hit of one ray: (distance, what)."""
+    """Nearest hit of one ray: (distance, what).  The cells' contents are kept
+    in cell order (coordinates beside ids), so a ray reads memory in sequence."""
     px, py = ox - x0, oy - y0
     cx = min(max(int(math.floor(px / cell)), 0), nx - 1)
     cy = min(max(int(math.floor(py / cell)), 0), ny - 1)
@@ -149,15 +155,14 @@ def cast_one(ox, oy, dx, dy, rmax, me, segs, seg_on, s_start, s_items, xy, radiu
     while True:
         c = cy * nx + cx
         for k in range(s_start[c], s_start[c + 1]):
-            s = s_items[k]
-            if seg_on[s]:
-                t = _hit_segment(ox, oy, dx, dy, segs[s, 0], segs[s, 1], segs[s, 2], segs[s, 3])
+            if seg_on[s_ids[k]]:
+                t = _hit_segment(ox, oy, dx, dy, s_coords[k, 0], s_coords[k, 1], s_coords[k, 2], s_coords[k, 3])
                 if t < best:
-                    best, what = t, s
+                    best, what = t, s_ids[k]
         for k in range(d_start[c], d_start[c + 1]):
-            r = d_items[k]
+            r = d_ids[k]
             if r != me:
-                t = _hit_disc(ox, oy, dx, dy, xy[r, 0], xy[r, 1], radius[r])
+                t = _hit_disc(ox, oy, dx, dy, d_xyr[k, 0], d_xyr[k, 1], d_xyr[k, 2])
                 if t < best:
                     best, what = t, -2 - r
         t_exit = min(t_x, t_y)
@@ -179,15 +184,21 @@ def cast_one(ox, oy, dx, dy, rmax, me, segs, seg_on, s_start, s_items, xy, radiu
 
 
 @njit(cache=True)
-def cast_rays(pose, ray_robot, ray_bearing, ray_range, segs, seg_on, s_start, s_items, xy, radius,
-              d_start, d_items, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
-    """Cast every ray: ray k leaves the centre of robot ray_robot[k] at bearing
-    ray_bearing[k] from its heading and reaches at most ray_range[k]."""
+def cast_rays(pose, ray_robot, ray_cos, ray_sin, ray_range, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids,
+              d_start, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
+    """Cast every ray: ray k leaves the centre of robot ray_robot[k] at the
+    bearing whose cosine and sine are ray_cos[k], ray_sin[k] (from its heading)
+    and reaches at most ray_range[k].  Rays come robot by robot, so the
+    heading's cosine and sine are computed once per robot."""
+    last, ch, sh = -1, 1.0, 0.0
     for k in range(ray_robot.shape[0]):
         r = ray_robot[k]
-        a = pose[r, 2] + ray_bearing[k]
-        d, w = cast_one(pose[r, 0], pose[r, 1], math.cos(a), math.sin(a), ray_range[k], r, segs, seg_on,
-                        s_start, s_items, xy, radius, d_start, d_items, x0, y0, cell, nx, ny)  # fmt: skip
+        if r != last:
+            last, ch, sh = r, math.cos(pose[r, 2]), math.sin(pose[r, 2])
+        dx = ch * ray_cos[k] - sh * ray_sin[k]
+        dy = sh * ray_cos[k] + ch * ray_sin[k]
+        d, w = cast_one(pose[r, 0], pose[r, 1], dx, dy, ray_range[k], r, s_coords, s_ids, seg_on, s_start,
+                        d_xyr, d_ids, d_start, x0, y0, cell, nx, ny)  # fmt: skip
         out_range[k] = d
         out_hit[k] = w
 

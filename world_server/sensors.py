@@ -107,17 +107,29 @@ class Suite:
 
     # ------------------------------------------------------------------ rays
 
-    def rays(self, tick: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(robot, bearing, range) of every ray of the group, robot-major.  The
-        sonar's bearing error turns each cone as a whole."""
+    def rays(self, tick: int) -> tuple[np.ndarray, ...]:
+        """(robot, bearing, range, cos, sin of bearing) of every ray of the group,
+        robot-major.  The sonar's bearing error turns each cone as a whole; the
+        other bearings are fixed, so their cosines are computed once."""
         n = len(self.robots)
-        bearing = np.tile(self.bearings, (n, 1))
+        if not hasattr(self, "_fixed"):
+            bearing = np.tile(self.bearings, n)
+            self._fixed = (np.repeat(self.robots, self.per_robot), bearing, np.tile(self.ranges, n),
+                           np.cos(bearing), np.sin(bearing))  # fmt: skip
         sonar = self.model.sensors.sonar
-        if sonar and "sonar" in self.blocks:
-            u = self._uniform(S_SONAR_BEARING, sonar.count, tick) * sonar.bearing_error * self.noise.factor("sonar")
-            bearing[:, self.blocks["sonar"]] += np.repeat(u, sonar.cone_rays, axis=1)
-        return (np.repeat(self.robots, self.per_robot), bearing.ravel(),
-                np.tile(self.ranges, n))  # fmt: skip
+        if not (sonar and self.noise.factor("sonar") and sonar.bearing_error):
+            return self._fixed
+        robot, bearing, ranges, c, s = self._fixed
+        u = self._uniform(S_SONAR_BEARING, sonar.count, tick) * sonar.bearing_error * self.noise.factor("sonar")
+        turned = bearing.reshape(n, self.per_robot).copy()
+        turned[:, self.blocks["sonar"]] += np.repeat(u, sonar.cone_rays, axis=1)
+        turned = turned.ravel()
+        c, s = c.copy(), s.copy()
+        b = np.zeros((n, self.per_robot), np.bool_)
+        b[:, self.blocks["sonar"]] = True
+        b = b.ravel()
+        c[b], s[b] = np.cos(turned[b]), np.sin(turned[b])
+        return robot, turned, ranges, c, s
 
     def _uniform(self, stream: int, k: int, tick: int) -> np.ndarray:
         out = np.empty((len(self.robots), k))
