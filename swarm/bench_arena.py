@@ -105,7 +105,7 @@ def bench_arena(quick: bool = False) -> dict:
         rows.append({"suite": name, **_measure(bench_world(n, suites[name]), _ticks_for(n, quick))})
         bar.update()
     walls = []
-    for obstacles in (0, 100, 400, 1600):
+    for obstacles in (0, 50, 100, 200):
         walls.append({"obstacles": obstacles,
                       **_measure(bench_world(100, LASER_BOT, obstacles=obstacles), 10 if quick else 30)})  # fmt: skip
         bar.update()
@@ -120,8 +120,10 @@ def format_arena_bench(result: dict) -> str:
     head = "| suite | robots | rays/tick | sensing ms | physics ms | ticks/s | robot-steps/s | rays/s |"
     lines = [f"swarm bench arena: {result['world']}, one core", "", head, "|---|---|---|---|---|---|---|---|"]
     for r in [*result["rows"], result["epuck100"]]:
-        lines.append(f"| {r['suite']} | {r['robots']} | {r['rays_per_tick']} | {r['sense_ms']} | {r['physics_ms']} | "
-                     f"{r['ticks_per_second']} | {r['robot_steps_per_second']:,} | {r['rays_per_second'] or 0:,} |")  # fmt: skip
+        lines.append(
+            f"| {r['suite']} | {r['robots']} | {r['rays_per_tick']} | {r['sense_ms']} | {r['physics_ms']} | "
+            f"{r['ticks_per_second']} | {r['robot_steps_per_second']:,} | {r['rays_per_second'] or 0:,} |"
+        )
     lines += ["", "Walls (100 laser robots): how sensing grows with obstacles", "",
               "| obstacles | sensing ms | rays/s | physics ms |", "|---|---|---|---|"]  # fmt: skip
     for r in result["walls"]:

@@ -8,15 +8,16 @@ import signal
 import sys
 from pathlib import Path
 
-from swarm.errors import RecordingError, raise_interrupt
 from swarm.cli_arena import add_arena_run_args, add_sense_parser, arena_overrides, cmd_sense, run_arena
+from swarm.errors import RecordingError, raise_interrupt
 from swarm.scenario import PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
 
 CONTROLLERS = ["cmarking", "marking", "ant", "carrot"]
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
-the plain marking agents and the pheromone ant baseline.
+the plain marking agents and the pheromone ant baseline, on a grid; and the
+arena, a continuous world of walls and differential-drive robots.
 
 examples:
   swarm up setup1 --agents 20 --seed 1          # world + 20 agent processes over zenoh, recorded
@@ -26,7 +27,9 @@ examples:
   swarm run maze --physics physical --record maze.rrd
   swarm run maze --controller marking --until converged --json
   swarm experiment table1 --reps 100
-  swarm bench engine | distributed | recording
+  swarm run zmaze --noise high                  # an arena: the carrot e-puck in the DFT paper's Z-maze
+  swarm sense zmaze --pose 0.2,0.5,0            # what a robot senses there
+  swarm bench engine | distributed | recording | arena
   docker compose up swarm                       # the same in containers (compose.yaml, docs/docker.md)
 """
 
@@ -87,7 +90,9 @@ def build_parser() -> argparse.ArgumentParser:
     from swarm.experiments import EXPERIMENTS
 
     names_help = "; ".join(f"{e.name}: {e.title.split(': ', 1)[1]}" for e in EXPERIMENTS.values())
-    exp.add_argument("name", choices=list(EXPERIMENTS), metavar="NAME", help=names_help)
+    names_help += "; carrot: follow the carrot in zmaze and large-maze at three noise levels (DFT paper, cases 1-2)"
+    exp.add_argument("name", choices=[*EXPERIMENTS, "carrot"], metavar="NAME", help=names_help)
+    exp.add_argument("--scenario", help="carrot only: zmaze or large-maze (default both)")
     exp.add_argument("--reps", type=_positive, help="runs per configuration (default per experiment)")
     exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
     exp.add_argument("--seed", type=_seed, default=0, help="first seed (runs use seed..seed+reps-1)")
@@ -338,8 +343,12 @@ def _scenario(args):
 
 def _grid_only(scenario, command: str) -> None:
     if is_arena(scenario):
-        raise ScenarioError("command line", "scenario", f"swarm {command} runs grid scenarios only for now: the "
-                            "distributed arena runtime is not built yet; run arena scenarios with swarm run")  # fmt: skip
+        raise ScenarioError(
+            "command line",
+            "scenario",
+            f"swarm {command} runs grid scenarios only for now: the "
+            "distributed arena runtime is not built yet; run arena scenarios with swarm run",
+        )
 
 
 def cmd_world(args) -> int:
@@ -448,6 +457,17 @@ def cmd_report(args) -> int:
 
 
 def cmd_experiment(args) -> int:
+    if args.name == "carrot":
+        from swarm.arena.experiments import run_carrot_experiment
+
+        result = run_carrot_experiment(args.scenario, args.reps, args.jobs, args.seed, args.out)
+        print(result["markdown"])
+        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
+        return 0
+    if args.scenario:
+        raise ScenarioError(
+            "command line", "--scenario", f"{args.name} uses the paper's setups; --scenario is for carrot"
+        )
     from swarm.experiments import run_experiment
 
     result = run_experiment(args.name, args.reps, args.jobs, args.seed, args.out)

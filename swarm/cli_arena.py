@@ -60,9 +60,11 @@ def print_arena_summary(summary: dict, as_json: bool) -> int:
         for r in summary["robots"][:20]:
             ratio = "n/a" if r["path_ratio"] is None else f"{r['path_ratio']:.3f}"
             lo = "n/a" if r["optimal_length"] is None else f"{r['optimal_length']:.3f}"
-            print(f"  robot {r['agent']} ({r['controller']}): {'reached' if r['reached'] else 'not reached'}"
-                  f"{'' if r['ticks_to_goal'] is None else ' at tick ' + str(r['ticks_to_goal'])}, "
-                  f"L_p {r['path_length']:.3f} m, L_o {lo} m, L_p/L_o {ratio}, collisions {r['collisions']}")  # fmt: skip
+            print(
+                f"  robot {r['agent']} ({r['controller']}): {'reached' if r['reached'] else 'not reached'}"
+                f"{'' if r['ticks_to_goal'] is None else ' at tick ' + str(r['ticks_to_goal'])}, "
+                f"L_p {r['path_length']:.3f} m, L_o {lo} m, L_p/L_o {ratio}, collisions {r['collisions']}"
+            )
         if len(summary["robots"]) > 20:
             print(f"  ... {len(summary['robots']) - 20} more robots (--json lists them all)")
     return 0 if summary["finished"] else 1

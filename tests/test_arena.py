@@ -104,7 +104,9 @@ def test_broken_arena_scenarios_name_the_field(body, where):
 
 
 def test_drawn_starts_follow_the_seed_and_keep_their_clearance():
-    text = box("[[wall]]\nrect = [0.3, 0.3, 0.7, 0.7]\n" + '[[group]]\ncount = 6\ncontroller = "carrot"\nclearance = 0.05\n')
+    text = box(
+        "[[wall]]\nrect = [0.3, 0.3, 0.7, 0.7]\n" + '[[group]]\ncount = 6\ncontroller = "carrot"\nclearance = 0.05\n'
+    )
     a = parse_scenario_text(text, "t.toml").start_poses()
     assert np.array_equal(a, parse_scenario_text(text, "t.toml").start_poses())
     assert not np.array_equal(a, parse_scenario_text(text.replace("kind", "seed = 9\nkind"), "t.toml").start_poses())
@@ -174,3 +176,25 @@ def test_cli_runs_and_senses_an_arena():
     assert reading["position"] and len(reading["ir"]) == 8
     bad = _swarm("run", "zmaze", "--agents", "2", "--start", "0.2,0.2")
     assert bad.returncode == 2 and "one-robot" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_carrot_experiment_writes_its_table(tmp_path):
+    from swarm.arena.experiments import run_carrot_experiment
+
+    result = run_carrot_experiment("zmaze", 3, 2, 0, tmp_path, progress=False)
+    assert result["runs"] == 9  # 3 pairs x none / low / high
+    assert {"runs.csv", "summary.csv", "table.md", "plot.png"} <= {p.name for p in tmp_path.iterdir()}
+    table = (tmp_path / "table.md").read_text()
+    assert "FTC-HN" in table and "paper F = 0.97" in table
+    assert [r["reached"] for r in result["summary"]] == [3, 3, 3]
+
+
+def test_large_maze_pairs_follow_the_seed_and_keep_40_mm_from_walls():
+    from swarm.arena.experiments import random_pairs
+    from swarm.arena.scenario import clearance_at
+
+    a, b = random_pairs("large-maze", 5, 7), random_pairs("large-maze", 5, 7)
+    assert a == b and a != random_pairs("large-maze", 5, 8)
+    s = load_scenario("large-maze")
+    pts = np.array([p[1:] for p in a]).reshape(-1, 2)
+    assert clearance_at(pts, s.wall_rects(), s.wall_segments()).min() >= 0.04

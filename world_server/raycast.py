@@ -28,8 +28,8 @@ def grid_shape(extent: tuple[float, float, float, float], cell: float) -> tuple[
 
 @njit(cache=True)
 def _cell_range(lo, hi, origin, cell, n):
-    a = int(math.floor((lo - origin) / cell))
-    b = int(math.floor((hi - origin) / cell))
+    a = math.floor((lo - origin) / cell)
+    b = math.floor((hi - origin) / cell)
     return max(a, 0), min(b, n - 1)
 
 
@@ -137,8 +137,8 @@ def cast_one(ox, oy, dx, dy, rmax, me, s_coords, s_ids, seg_on, s_start, d_xyr, 
     """Nearest hit of one ray: (distance, what).  The cells' contents are kept
     in cell order (coordinates beside ids), so a ray reads memory in sequence."""
     px, py = ox - x0, oy - y0
-    cx = min(max(int(math.floor(px / cell)), 0), nx - 1)
-    cy = min(max(int(math.floor(py / cell)), 0), ny - 1)
+    cx = min(max(math.floor(px / cell), 0), nx - 1)
+    cy = min(max(math.floor(py / cell), 0), ny - 1)
     if dx > 0.0:
         step_x, t_x, dt_x = 1, ((cx + 1) * cell - px) / dx, cell / dx
     elif dx < 0.0:
@@ -203,8 +203,17 @@ def cast_rays(pose, ray_robot, ray_cos, ray_sin, ray_range, s_coords, s_ids, seg
         out_hit[k] = w
 
 
-def brute_force(ox: float, oy: float, angle: float, rmax: float, me: int, segs: np.ndarray, seg_on: np.ndarray,
-                xy: np.ndarray, radius: np.ndarray) -> tuple[float, int]:
+def brute_force(
+    ox: float,
+    oy: float,
+    angle: float,
+    rmax: float,
+    me: int,
+    segs: np.ndarray,
+    seg_on: np.ndarray,
+    xy: np.ndarray,
+    radius: np.ndarray,
+) -> tuple[float, int]:
     """Every segment and disc, numpy: the reference the index is tested against."""
     dx, dy = math.cos(angle), math.sin(angle)
     ex, ey = segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]

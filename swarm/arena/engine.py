@@ -49,8 +49,8 @@ class ArenaEngine:
         self.scenario = scenario
         self.world = ArenaWorld(scenario)
         self.controllers = []
-        for a, g in enumerate(g for g in scenario.groups for _ in range(g.count)):
-            c = make_controller(g.controller)
+        for a, group in enumerate(g for g in scenario.groups for _ in range(g.count)):
+            c = make_controller(group.controller)
             c.reset(scenario.seed, a, controller_params(scenario, a))
             self.controllers.append(c)
         self.wall_seconds = 0.0

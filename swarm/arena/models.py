@@ -147,8 +147,12 @@ SCOUT = RobotModel(
     max_speed=0.6,
     max_turn_rate=90 * DEG,
     colour=(200, 120, 40),
-    sensors=Sensors(camera=Camera(sectors=360, rays_per_sector=1), laser=Laser(beams=360, range=8.0),
-                    odometry=Odometry(), compass=Compass(error=2 * DEG)),  # fmt: skip
+    sensors=Sensors(
+        camera=Camera(sectors=360, rays_per_sector=1),
+        laser=Laser(beams=360, range=8.0),
+        odometry=Odometry(),
+        compass=Compass(error=2 * DEG),
+    ),
 )
 
 MODELS = {m.name: m for m in (ANIMAT, EPUCK, SCOUT)}

@@ -125,9 +125,17 @@ class ArenaScenario:
         names = sorted({g.controller for g in self.groups})
         return names[0] if len(names) == 1 else "+".join(names)
 
-    def with_overrides(self, agents: int | None = None, controller: str | None = None, seed: int | None = None,
-                       start: tuple[float, ...] | None = None, goal: tuple[float, float] | None = None,
-                       noise: str | None = None, max_ticks: int | None = None, **_ignored) -> ArenaScenario:  # fmt: skip
+    def with_overrides(
+        self,
+        agents: int | None = None,
+        controller: str | None = None,
+        seed: int | None = None,
+        start: tuple[float, ...] | None = None,
+        goal: tuple[float, float] | None = None,
+        noise: str | None = None,
+        max_ticks: int | None = None,
+        **_ignored,
+    ) -> ArenaScenario:
         """Command-line changes; --start and --goal are for one-robot runs."""
         groups = list(self.groups)
         if agents is not None and agents != self.agents:
@@ -257,8 +265,12 @@ def parse_arena(data: dict, source: str, default_name: str) -> ArenaScenario:
     if not all(0 < v <= 10_000 for v in size):
         raise ScenarioError(source, "size", f"expected two positive sizes in metres, got {list(size)}")
     robot = _robot(data.get("robot", "epuck"), source, "robot")
-    kw: dict[str, Any] = {"name": _get(data, "name", str, source, default_name), "source": source,
-                          "size": (size[0], size[1]), "description": _get(data, "description", str, source, "")}  # fmt: skip
+    kw: dict[str, Any] = {
+        "name": _get(data, "name", str, source, default_name),
+        "source": source,
+        "size": (size[0], size[1]),
+        "description": _get(data, "description", str, source, ""),
+    }
     for key in ("seed", "substeps", "max_ticks", "goal_dwell"):
         if key in data:
             kw[key] = _get(data, key, int, source)
@@ -309,8 +321,12 @@ def _robot(value, source: str, where: str) -> RobotModel:
         kinds = {*_SENSORS, "contact", "zones"}
         if not isinstance(names, list) or not all(isinstance(n, str) and n in kinds for n in names):
             raise ScenarioError(source, f"{where}.sensors", f"expected a list of {', '.join(sorted(kinds))}")
-        sensors = replace(sensors, **{k: (getattr(sensors, k) or _SENSORS[k]()) if k in names else None
-                                      for k in _SENSORS}, contact="contact" in names, zones="zones" in names)  # fmt: skip
+        sensors = replace(
+            sensors,
+            **{k: (getattr(sensors, k) or _SENSORS[k]()) if k in names else None for k in _SENSORS},
+            contact="contact" in names,
+            zones="zones" in names,
+        )
     for key, cls in _SENSORS.items():
         if key in value:
             table = _table(value, key, source, f"{where}.{key}")
@@ -333,7 +349,7 @@ def _noise(value, source: str) -> Noise:
     level = value.get("level", "low")
     base = _noise(level, source)
     scales = []
-    for k, v in value.items():
+    for k in value:
         if k == "level":
             continue
         if k not in {*_SENSORS, "map"}:
@@ -404,8 +420,7 @@ def _group(g, robot: RobotModel, source: str, where: str) -> Group:
     if "start" in g or "starts" in g:
         raw = [g["start"]] if "start" in g else g["starts"]
         starts = tuple(
-            (p[0], p[1], p[2] if len(p) > 2 else 0.0)
-            for p in _point_list(raw, source, f"{where}.starts", (2, 3))
+            (p[0], p[1], p[2] if len(p) > 2 else 0.0) for p in _point_list(raw, source, f"{where}.starts", (2, 3))
         )
         if len(starts) != count:
             raise ScenarioError(source, f"{where}.starts", f"expected {count} poses (one per robot), got {len(starts)}")
@@ -488,7 +503,9 @@ def check_arena(s: ArenaScenario, source: str) -> None:
 def _no_unknown(section: dict, allowed: set[str], source: str, where: str) -> None:
     for key in section:
         if key not in allowed:
-            raise ScenarioError(source, f"{where}: {key}", f"unknown field; expected one of {', '.join(sorted(allowed))}")
+            raise ScenarioError(
+                source, f"{where}: {key}", f"unknown field; expected one of {', '.join(sorted(allowed))}"
+            )
 
 
 def _get(section: dict, key: str, kind, source: str, default: Any = ..., where: str | None = None):
@@ -579,8 +596,14 @@ def controller_params(s: ArenaScenario, agent: int) -> dict[str, Any]:
         "map": {"size": list(s.size), "rects": s.wall_rects().tolist(), "segments": s.wall_segments().tolist()},
         "goal": None if goal is None else list(goal),
         "route": None if group.route is None else [list(p) for p in s.routes[group.route]],
-        "robot": {"model": m.name, "radius": m.radius, "axle": m.axle, "max_wheel_speed": m.max_wheel_speed,
-                  "max_speed": m.max_speed, "max_turn_rate": m.max_turn_rate},  # fmt: skip
+        "robot": {
+            "model": m.name,
+            "radius": m.radius,
+            "axle": m.axle,
+            "max_wheel_speed": m.max_wheel_speed,
+            "max_speed": m.max_speed,
+            "max_turn_rate": m.max_turn_rate,
+        },
         "control_period": s.control_period,
         "noise": s.noise.level,
         "goal_radius": s.goal_radius,

@@ -23,8 +23,8 @@ def occupancy(size: tuple[float, float], cell: float, rects: np.ndarray, segment
     nx, ny = math.ceil(size[0] / cell - 1e-9), math.ceil(size[1] / cell - 1e-9)
     occ = np.zeros((ny, nx), np.bool_)
     for x0, y0, x1, y1 in np.asarray(rects, np.float64).reshape(-1, 4):
-        i0, i1 = max(int(math.floor(x0 / cell + 1e-9)), 0), min(math.ceil(x1 / cell - 1e-9), nx)
-        j0, j1 = max(int(math.floor(y0 / cell + 1e-9)), 0), min(math.ceil(y1 / cell - 1e-9), ny)
+        i0, i1 = max(math.floor(x0 / cell + 1e-9), 0), min(math.ceil(x1 / cell - 1e-9), nx)
+        j0, j1 = max(math.floor(y0 / cell + 1e-9), 0), min(math.ceil(y1 / cell - 1e-9), ny)
         occ[j0:j1, i0:i1] = True
     for x0, y0, x1, y1 in np.asarray(segments, np.float64).reshape(-1, 4):
         n = max(2, int(math.hypot(x1 - x0, y1 - y0) / (cell / 4)) + 2)
