@@ -3,8 +3,9 @@
 Transport, ids and retries live here, never in the controller: the runtime
 joins (the world hands out ids, so identical processes need no configuration),
 declares a liveliness token per agent, and for every observation runs the very
-compiled step the in-process engine runs, then puts the mark write on the
-marks key space and the action on its act key.
+step the in-process engine runs, then sends the actions on its act key.  What
+a family's controllers are and how their messages look is the subclass's:
+`GridAgentRuntime` (below) and `agents.arena_runtime.ArenaAgentRuntime`.
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ from agents.controllers.layout import A_MARK, MARK, MARK_NONE, controller_kind, 
 from swarm import protocol as proto
 from swarm.bus import DEFAULT_ENDPOINT, open_client
 from swarm.monitor import world_info
+
+ARENA_CONTROLLERS = ("carrot", "wander")
 
 
 class JoinRefused(RuntimeError):
@@ -39,49 +42,62 @@ def load_step():
 
 
 class AgentRuntime:
+    family = ""
+
     def __init__(self, run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
                  join_timeout: float = 60.0, idle_timeout: float = 120.0, null: bool = False,
                  rejoin_after: float = 5.0):  # fmt: skip
         self.keys = proto.Keys(run_id)
         self.controller = controller
-        self.kind = controller_kind(controller)
-        self.null = null  # benchmark floor: answer STAY without running the controller
-        self.step = None if null else load_step()  # before joining: the world observes us at once
+        self.null = null  # benchmark floor: answer without running the controller
+        self._prepare(count)  # before joining: the world observes us at once
         self.idle_timeout = idle_timeout
         self.inbox: queue.Queue = queue.Queue()
         self.session = open_client(connect, timeout=join_timeout)
         self.group = uuid.uuid4().hex  # this process: its agents' messages travel together
         # Subscribed before joining: the world starts observing an agent as soon as it sees its token.
         self._decls = [self.session.declare_subscriber(self.keys.obs(self.group), self.inbox.put)]
-        self.agents: list[int] = []  # our agents' ids, by slot (row of self.mem)
+        self.agents: list[int] = []  # our agents' ids, by slot
         self.tokens: dict[int, object] = {}  # agent id -> its liveliness token
-        self.mem = new_memory(count)
-        self.act = new_action()
-        self.seed = 0
-        self.params = np.zeros(1)
         self.rejoin_after = rejoin_after
-        for _ in range(count):
-            self.agents.append(self._join(join_timeout))
+        for slot in range(count):
+            self.agents.append(self._join(join_timeout, slot))
         self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
 
-    def _join(self, timeout: float) -> int:
+    # ------------------------------------------------------- hooks of a family
+
+    def _prepare(self, count: int) -> None:
+        """Load the controllers' code before joining."""
+
+    def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
+        """The world gave `slot` the id `agent`: start its controller afresh."""
+        raise NotImplementedError
+
+    def _parse(self, data: bytes):
+        raise NotImplementedError
+
+    def _answer(self, obs) -> int:
+        raise NotImplementedError
+
+    # -------------------------------------------------------------- transport
+
+    def _join(self, timeout: float, slot: int) -> int:
         """Ask the world for an id; returns it once our liveliness token is declared."""
         nonce = uuid.uuid4().hex
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            request = proto.join_request(nonce, self.group, controller=self.controller)
+            request = proto.join_request(nonce, self.group, family=self.family, controller=self.controller)
             for reply in self.session.get(self.keys.join, payload=request, timeout=2.0):
                 if not reply.ok:
                     continue
-                msg = proto.unpack(reply.ok.payload.to_bytes())
+                msg = proto.unpack(reply.ok.payload.to_bytes(), proto.MAX_WELCOME_BYTES)
                 if isinstance(msg, proto.Rejected):
                     continue
                 if msg.get("type") == "refused":
                     raise JoinRefused(f"the world refused this agent: {msg.get('reason')}")
                 if msg.get("type") == "welcome" and msg.get("nonce") == nonce:
                     agent = int(msg["agent"])
-                    self.seed = int(msg["seed"])
-                    self.params = np.array(msg["params"], dtype=np.float64)
+                    self._welcomed(slot, agent, msg)
                     self.tokens[agent] = self.session.liveliness().declare_token(self.keys.alive(agent))
                     return agent
             time.sleep(0.2)
@@ -104,7 +120,7 @@ class AgentRuntime:
                 batch.append(self.inbox.get_nowait())
             latest = None
             for sample in batch:
-                msg = proto.parse_obs(sample.payload.to_bytes())
+                msg = self._parse(sample.payload.to_bytes())
                 if isinstance(msg, dict):  # stop
                     return answered
                 if not isinstance(msg, proto.Rejected):
@@ -115,7 +131,7 @@ class AgentRuntime:
     def _rejoin_if_dropped(self) -> None:
         """Quiet for a while: if the world has declared some of our agents lost
         (a cut link, a stall), join again for them as new agents with fresh
-        memories.  A world that does not answer, or that simply has not
+        controllers.  A world that does not answer, or that simply has not
         started, is left alone."""
         try:
             info = world_info(self.session, self.keys)
@@ -130,11 +146,37 @@ class AgentRuntime:
             if (token := self.tokens.pop(agent, None)) is not None:
                 token.undeclare()
             try:
-                self.agents[slot] = self._join(timeout=5.0)
+                self.agents[slot] = self._join(5.0, slot)
             except TimeoutError:
                 break
-            self.mem[slot] = new_memory(1)[0]
         self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
+
+    def close(self) -> None:
+        for d in [*self._decls, *self.tokens.values()]:
+            d.undeclare()
+        self.session.close()
+
+
+class GridAgentRuntime(AgentRuntime):
+    """Grid controllers: one compiled step over flat arrays, memory per agent."""
+
+    family = proto.FAMILY_GRID
+
+    def _prepare(self, count: int) -> None:
+        self.kind = controller_kind(self.controller)
+        self.step = None if self.null else load_step()
+        self.mem = new_memory(count)
+        self.act = new_action()
+        self.seed = 0
+        self.params = np.zeros(1)
+
+    def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
+        self.seed = int(msg["seed"])
+        self.params = np.array(msg["params"], dtype=np.float64)
+        self.mem[slot] = new_memory(1)[0]
+
+    def _parse(self, data: bytes):
+        return proto.parse_obs(data)
 
     def _answer(self, obs: proto.Obs) -> int:
         """Step every agent of ours in the batch; one mark message, one action message."""
@@ -165,7 +207,12 @@ class AgentRuntime:
         self.session.put(self.keys.act(self.group), proto.actions(obs.tick, agents, acts[: len(agents)], marked))
         return len(agents)
 
-    def close(self) -> None:
-        for d in [*self._decls, *self.tokens.values()]:
-            d.undeclare()
-        self.session.close()
+
+def make_runtime(run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
+                 **kw) -> AgentRuntime:  # fmt: skip
+    """The runtime of the controller's family."""
+    if controller in ARENA_CONTROLLERS:
+        from agents.arena_runtime import ArenaAgentRuntime
+
+        return ArenaAgentRuntime(run_id, controller, connect, count, **kw)
+    return GridAgentRuntime(run_id, controller, connect, count, **kw)

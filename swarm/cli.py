@@ -8,11 +8,19 @@ import signal
 import sys
 from pathlib import Path
 
-from swarm.cli_arena import add_arena_run_args, add_sense_parser, arena_overrides, cmd_sense, run_arena
+from swarm.cli_arena import (
+    add_arena_run_args,
+    add_sense_parser,
+    arena_overrides,
+    arena_world_args,
+    cmd_sense,
+    print_arena_summary,
+    run_arena,
+)
 from swarm.errors import RecordingError, raise_interrupt
 from swarm.scenario import PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
 
-CONTROLLERS = ["cmarking", "marking", "ant", "carrot"]
+CONTROLLERS = ["cmarking", "marking", "ant", "carrot", "wander"]
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -144,7 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="run agent process(es) that join a world",
         description="Join a world over zenoh and run one controller (or K with --count).",
     )
-    agent.add_argument("--controller", choices=["cmarking", "marking", "ant"], default="cmarking")
+    agent.add_argument("--controller", choices=CONTROLLERS, default="cmarking")
     _client_args(agent)
     agent.add_argument("--count", type=_positive, default=1, metavar="K", help="independent agents in this process")
     agent.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
@@ -286,6 +294,7 @@ def _scenario_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--until", choices=["foraged", "converged", "both"], default="foraged", help="when the run ends")
     p.add_argument("--max-iterations", type=_positive, default=1_000_000, metavar="M", help="stop after M ticks")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+    add_arena_run_args(p)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -335,27 +344,16 @@ def _scenario(args):
     common = {"agents": args.agents, "controller": args.controller, "seed": args.seed}
     if is_arena(scenario):
         return scenario.with_overrides(**common, **arena_overrides(args))
-    if args.controller == "carrot":
-        raise ScenarioError("command line", "controller", "carrot drives arena robots; pick an arena scenario "
-                            "(zmaze, large-maze, ...) or a grid controller")  # fmt: skip
+    if args.controller in ("carrot", "wander"):
+        raise ScenarioError("command line", "controller", f"{args.controller} drives arena robots; pick an arena "
+                            "scenario (zmaze, large-maze, ...) or a grid controller")  # fmt: skip
     return scenario.with_overrides(**common, physics=args.physics, body_diameter=args.body_diameter)
-
-
-def _grid_only(scenario, command: str) -> None:
-    if is_arena(scenario):
-        raise ScenarioError(
-            "command line",
-            "scenario",
-            f"swarm {command} runs grid scenarios only for now: the "
-            "distributed arena runtime is not built yet; run arena scenarios with swarm run",
-        )
 
 
 def cmd_world(args) -> int:
     from world_server.server import serve
 
     scenario = _scenario(args)
-    _grid_only(scenario, "world")
     if args.until != "foraged" and scenario.controller == "ant":
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
     summary = serve(scenario, args.run_id, args.summary_file, quiet=args.quiet,
@@ -366,15 +364,15 @@ def cmd_world(args) -> int:
                     start_timeout=args.start_timeout, null=args.null,
                     state_dir=args.state_dir, persist_every=args.persist_every, mode=args.mode,
                     rate=args.rate, record=args.record, viewer=_viewer_url(args.viewer))  # fmt: skip
-    return _print_summary(summary, args.json, args.until)
+    return _print_any(summary, args.json, args.until)
 
 
 def cmd_agent(args) -> int:
-    from agents.runtime import AgentRuntime, JoinRefused
+    from agents.runtime import JoinRefused, make_runtime
     from swarm.protocol import ENDED
 
     try:
-        runtime = AgentRuntime(args.run_id, args.controller, args.connect, args.count, null=args.null)
+        runtime = make_runtime(args.run_id, args.controller, args.connect, args.count, null=args.null)
     except JoinRefused as exc:
         print(f"swarm: {exc}", file=sys.stderr)
         return 0 if ENDED in str(exc) else 2  # a late agent of a finished run has nothing to do
@@ -390,18 +388,25 @@ def cmd_up(args) -> int:
     from world_server.server import new_run_id
 
     scenario = _scenario(args)
-    _grid_only(scenario, "up")
     if args.until != "foraged" and scenario.controller == "ant":
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
     run_id = args.run_id or new_run_id()
     record = None if args.no_record else (args.record or f"runs/{run_id}.rrd")
-    summary = swarm_up(args.scenario, scenario.agents, scenario.controller, args.seed, run_id,
-                       args.listen, args.until, args.max_iterations, args.deadline,
+    arena = is_arena(scenario)
+    summary = swarm_up(args.scenario, scenario.agents, args.controller if arena else scenario.controller, args.seed,
+                       run_id, args.listen, args.until, args.max_iterations, args.deadline,
                        progress=not args.json and sys.stderr.isatty(), mode=args.mode, rate=args.rate,
-                       physics=scenario.physics, record=record, viewer=args.viewer)  # fmt: skip
+                       physics=None if arena else scenario.physics, record=record, viewer=args.viewer,
+                       world_args=arena_world_args(args))  # fmt: skip
     if summary.get("recording"):
         _point_at_recording(summary["recording"])
-    return _print_summary(summary, args.json, args.until)
+    return _print_any(summary, args.json, args.until)
+
+
+def _print_any(summary: dict, as_json: bool, until: str) -> int:
+    if summary.get("kind") == "arena":
+        return print_arena_summary(summary, as_json)
+    return _print_summary(summary, as_json, until)
 
 
 def cmd_run(args) -> int:
@@ -409,7 +414,7 @@ def cmd_run(args) -> int:
 
     scenario = _scenario(args)
     if is_arena(scenario):
-        return run_arena(args, scenario)
+        return run_arena(args, scenario, _viewer_url(args.viewer) if args.record else None)
     engine = Engine(scenario)
     recorder = None
     if args.record:
@@ -448,7 +453,7 @@ def cmd_report(args) -> int:
         print(json.dumps(result["summary"]))
     else:
         summary = result["summary"]
-        _print_summary(summary, False, summary["until"])
+        _print_any(summary, False, summary.get("until", "foraged"))
         if "rejected_messages" in summary:
             print(f"  {summary['mode']}: tick latency p50 {summary['tick_ms_p50']} ms, "
                   f"p99 {summary['tick_ms_p99']} ms, rejected messages {summary['rejected_messages']}")  # fmt: skip

@@ -38,12 +38,40 @@ def arena_overrides(args) -> dict:
     return {k: getattr(args, k, None) for k in ("start", "goal", "noise", "max_ticks")}
 
 
-def run_arena(args, scenario) -> int:
-    if getattr(args, "record", None):
-        raise ScenarioError("command line", "--record", "arena recordings are not built yet; run without --record")
+def arena_world_args(args) -> list[str]:
+    """The arena options of `swarm up`, for its world process."""
+    out = []
+    for key in ("start", "goal"):
+        if (value := getattr(args, key, None)) is not None:
+            out += [f"--{key}", ",".join(repr(v) for v in value)]
+    if getattr(args, "noise", None):
+        out += ["--noise", args.noise]
+    if getattr(args, "max_ticks", None):
+        out += ["--max-ticks", str(args.max_ticks)]
+    return out
+
+
+def run_arena(args, scenario, viewer: str | None = None) -> int:
+    from pathlib import Path
+
     from swarm.arena.engine import ArenaEngine
 
-    summary = ArenaEngine(scenario).run(progress=not args.json and sys.stderr.isatty())
+    engine = ArenaEngine(scenario)
+    recorder = None
+    if getattr(args, "record", None):
+        from swarm.recording_arena import ArenaRecorder, arena_meta
+
+        meta = arena_meta(scenario, engine.world, Path(args.record).stem, "in-process")
+        recorder = ArenaRecorder(args.record, engine.world, meta, viewer=viewer, controllers=engine.controllers)
+    summary = None
+    try:
+        summary = engine.run(progress=not args.json and sys.stderr.isatty(), recorder=recorder)
+    finally:
+        if recorder is not None:
+            recorder.close(summary)
+    if recorder is not None:
+        print(f"recording: {args.record}\n  open it:           swarm replay {args.record}   (or --web)\n"
+              f"  summary and plots: swarm report {args.record}", file=sys.stderr)  # fmt: skip
     return print_arena_summary(summary, args.json)
 
 
@@ -54,19 +82,23 @@ def print_arena_summary(summary: dict, as_json: bool) -> int:
         state = "finished" if summary["finished"] else "NOT finished"
         print(f"{summary['scenario']}: {summary['controller']} x{summary['agents']}, seed {summary['seed']}, "
               f"noise {summary['noise']}: {state} after {summary['ticks']} ticks ({summary['sim_seconds']} s "
-              f"simulated, {summary['ticks_per_second']} ticks/s)\n"
+              f"simulated, {summary.get('ticks_per_second', 'n/a')} ticks/s)\n"
               f"  reached {summary['reached']}/{summary['with_goal']}, collisions {summary['collisions']}, "
-              f"rejected actions {summary['rejected_actions']}")  # fmt: skip
+              f"rejected actions {summary.get('rejected_actions', 'n/a')}")  # fmt: skip
         for r in summary["robots"][:20]:
             ratio = "n/a" if r["path_ratio"] is None else f"{r['path_ratio']:.3f}"
             lo = "n/a" if r["optimal_length"] is None else f"{r['optimal_length']:.3f}"
+            first = "" if r["ticks_to_goal"] is None else f" (first at the goal at tick {r['ticks_to_goal']})"
             print(
-                f"  robot {r['agent']} ({r['controller']}): {'reached' if r['reached'] else 'not reached'}"
-                f"{'' if r['ticks_to_goal'] is None else ' at tick ' + str(r['ticks_to_goal'])}, "
+                f"  robot {r['agent']} ({r['controller']}): {'reached' if r['reached'] else 'not reached'}{first}, "
                 f"L_p {r['path_length']:.3f} m, L_o {lo} m, L_p/L_o {ratio}, collisions {r['collisions']}"
             )
         if len(summary["robots"]) > 20:
             print(f"  ... {len(summary['robots']) - 20} more robots (--json lists them all)")
+        if "agents_lost" in summary:
+            print(f"  distributed ({summary['mode']}): {summary['ticks_per_second']} ticks/s, rejected messages "
+                  f"{summary['rejected_messages']}, agents joined {summary['joins']}, lost {summary['agents_lost']}, "
+                  f"missed ticks {summary['missed_ticks']}")  # fmt: skip
     return 0 if summary["finished"] else 1
 
 

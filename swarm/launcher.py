@@ -23,7 +23,7 @@ from agents.controllers.dispatch import warm_up
 from swarm import protocol as proto
 from swarm.bus import open_client
 from swarm.errors import raise_interrupt
-from swarm.scenario import PhysicsParams, load_scenario
+from swarm.scenario import PhysicsParams, is_arena, load_scenario
 from world_server.grid import GridWorld
 
 
@@ -41,13 +41,16 @@ def _terminate(procs: list[subprocess.Popen], grace: float = 5.0) -> None:
 
 
 def swarm_up(
-    scenario_ref: str, agents: int, controller: str, seed: int | None, run_id: str, listen: str,
+    scenario_ref: str, agents: int, controller: str | None, seed: int | None, run_id: str, listen: str,
     until: str = "foraged", max_iterations: int = 1_000_000, deadline: float = 2.0, progress: bool = True,
     per_process: int = 1, null: bool = False, mode: str = "lockstep", rate: float = 20.0,
     physics: PhysicsParams | None = None, record: str | None = None, viewer: str | None = None,
+    world_args: list[str] | None = None,
 ) -> dict:  # fmt: skip
     """Run the swarm as processes; `per_process` agents share one agent process
-    (`swarm agent --count`), `null` runs the benchmark floor (messaging only)."""
+    (`swarm agent --count`), `null` runs the benchmark floor (messaging only).
+    `controller` None keeps the scenario's (an arena may mix controllers:
+    each group's agents run its own)."""
     if agents % per_process:
         raise ValueError(f"{agents} agents do not split into processes of {per_process}")
     # SIGTERM (docker stop, timeout, kill) must clean up like Ctrl-C does: raise so `finally` runs.
@@ -58,6 +61,7 @@ def swarm_up(
                      "--body-diameter", repr(physics.diameter)]  # fmt: skip
     if seed is not None:
         world_options += ["--seed", str(seed)]
+    world_options += world_args or []
     if record:
         world_options += ["--record", record]
     if viewer:
@@ -81,7 +85,13 @@ def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = 
         builder = subprocess.Popen([sys.executable, "-m", "agents.controllers.aot"], stdout=subprocess.DEVNULL,
                                    stderr=subprocess.PIPE, text=True)  # fmt: skip
     warm_up()  # once here, so N agents starting together find the kernels in the cache,
-    scenario = load_scenario(scenario_ref).with_overrides(agents=2)
+    scenario = load_scenario(scenario_ref)
+    if is_arena(scenario):  # the ray pass and A* (arena agents plan with it)
+        from swarm.arena.engine import ArenaEngine
+
+        ArenaEngine(scenario).step(1)
+        scenario = load_scenario("setup2")
+    scenario = scenario.with_overrides(agents=2)
     GridWorld(scenario).warm_up()  # and so does the world
     if engine:
         from swarm.engine import Engine
@@ -93,19 +103,36 @@ def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = 
     return aot.built() is not None
 
 
+def _agent_counts(scenario_ref: str, agents: int, controller: str | None) -> list[tuple[str, int]]:
+    """(controller, agents) for every kind of agent process the run needs."""
+    scenario = load_scenario(scenario_ref)
+    if controller is not None or not is_arena(scenario):
+        return [(controller or scenario.controller, agents)]
+    if len(scenario.groups) == 1:
+        return [(scenario.groups[0].controller, agents)]
+    counts: dict[str, int] = {}
+    for g in scenario.groups:
+        counts[g.controller] = counts.get(g.controller, 0) + g.count
+    return list(counts.items())
+
+
 def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null) -> dict:
     prepare(scenario_ref, progress)
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
         summary_file = Path(tmp) / "summary.json"
-        world_cmd = [*python, "world", scenario_ref, "--agents", str(agents), "--controller", controller,
-                     "--run-id", run_id, "--listen", listen, "--summary-file", str(summary_file),
-                     "--start-timeout", str(60 + 3 * agents), "--quiet", *world_options]  # fmt: skip
-        agent_cmd = [*python, "agent", "--controller", controller, "--connect", listen, "--run-id", run_id,
-                     "--count", str(per_process)]  # fmt: skip
+        world_cmd = [*python, "world", scenario_ref, "--agents", str(agents), "--run-id", run_id, "--listen", listen,
+                     "--summary-file", str(summary_file), "--start-timeout", str(60 + 3 * agents), "--quiet",
+                     *world_options]  # fmt: skip
+        if controller is not None:
+            world_cmd += ["--controller", controller]
+        agent_cmds = []
+        for name, n in _agent_counts(scenario_ref, agents, controller):
+            cmd = [*python, "agent", "--controller", name, "--connect", listen, "--run-id", run_id,
+                   "--count", str(per_process)]  # fmt: skip
+            agent_cmds += [cmd + (["--null"] if null else [])] * (n // per_process)
         if null:
             world_cmd.append("--null")
-            agent_cmd.append("--null")
         quiet = {"stdout": subprocess.DEVNULL, "start_new_session": True}
         procs: list[subprocess.Popen] = []
         session = None
@@ -115,7 +142,7 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
             session = _connect(listen, world)
             rss = {}
             if session is not None:  # None: the world is already done (e.g. it resumed a finished run)
-                procs += [subprocess.Popen(agent_cmd, **quiet) for _ in range(agents // per_process)]
+                procs += [subprocess.Popen(cmd, **quiet) for cmd in agent_cmds]
                 rss = _follow(session, proto.Keys(run_id), world, procs, agents, progress)
             world.wait()
             if not summary_file.exists():  # exit 1 with a summary is an unfinished run, not a failure
@@ -166,7 +193,7 @@ def _follow(session, keys: proto.Keys, world: subprocess.Popen, procs, agents: i
     rss: dict[int, int] = {}
     states: queue.Queue = queue.Queue()
     sub = session.declare_subscriber(keys.state, states.put)
-    bar = tqdm(desc="delivered", unit="unit", disable=not progress, leave=False)
+    bar = tqdm(desc="done", unit="", disable=not progress, leave=False)
     try:
         while world.poll() is None:
             try:
@@ -180,8 +207,8 @@ def _follow(session, keys: proto.Keys, world: subprocess.Popen, procs, agents: i
             if msg.get("tick", 0) % 50 == 1:
                 for p in procs[1:]:
                     rss[p.pid] = max(rss.get(p.pid, 0), _rss_kb(p.pid))
-            bar.total = msg.get("total")
-            bar.n = msg.get("delivered", 0)
+            bar.total = msg.get("total", msg.get("with_goal"))
+            bar.n = msg.get("delivered", msg.get("reached", 0))
             bar.set_postfix(tick=msg.get("tick"), alive=f"{msg.get('agents_alive')}/{agents}",
                             tps=msg.get("ticks_per_second"))  # fmt: skip
             bar.refresh()

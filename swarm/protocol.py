@@ -15,8 +15,8 @@ A group is one agent process (`swarm agent --count K` runs K agents): one
 message per process and tick each way, arrays as binary blocks.  `cells` are
 opaque integers handed to the agent runtime (the controller never sees them).
 Every message carries `v` (protocol version) and agent messages carry
-`family` ("grid" now; the continuous controllers to come send wheel commands
-under another family without changing this layout).
+`family`: "grid" (this module) or "arena" (swarm/protocol_arena.py: sensor
+readings out, wheel speeds back, on the same keys).
 Decoding never raises on bad input: it returns a `Rejected` reason, counted
 by the world.
 """
@@ -33,8 +33,10 @@ from agents.controllers.layout import ACT_LEN, PERC_F_LEN, PERC_LEN
 
 VERSION = 1
 FAMILY_GRID = "grid"
-FAMILIES = (FAMILY_GRID,)
+FAMILY_ARENA = "arena"
+FAMILIES = (FAMILY_GRID, FAMILY_ARENA)
 MAX_MESSAGE_BYTES = 64 * 1024
+MAX_WELCOME_BYTES = 16 * 1024 * 1024  # an arena agent's welcome carries its map
 INT64_MAX = 2**63 - 1
 ENDED = "the run has ended"  # the world's refusal to a join after the run (the agent then exits quietly)
 
@@ -76,8 +78,8 @@ def pack(message: dict) -> bytes:
     return msgpack.packb({"v": VERSION, **message}, use_bin_type=True)
 
 
-def unpack(data: bytes) -> dict | Rejected:
-    if len(data) > MAX_MESSAGE_BYTES:
+def unpack(data: bytes, limit: int = MAX_MESSAGE_BYTES) -> dict | Rejected:
+    if len(data) > limit:
         return Rejected("too large")
     try:
         message = msgpack.unpackb(data, raw=False, strict_map_key=True)
@@ -90,7 +92,7 @@ def unpack(data: bytes) -> dict | Rejected:
     return message
 
 
-def _int(message: dict, key: str, low: int = 0, high: int = INT64_MAX) -> int | Rejected:
+def int_field(message: dict, key: str, low: int = 0, high: int = INT64_MAX) -> int | Rejected:
     value = message.get(key)
     if isinstance(value, bool) or not isinstance(value, int):
         if isinstance(value, float) and not math.isfinite(value):
@@ -177,7 +179,7 @@ class Marks:
     values: np.ndarray
 
 
-def _int_list(m: dict, key: str, high: int = INT64_MAX) -> np.ndarray | Rejected:
+def int_list(m: dict, key: str, high: int = INT64_MAX) -> np.ndarray | Rejected:
     values = m.get(key)
     if not isinstance(values, list) or len(values) > 100_000:
         return Rejected(f"{key}: expected a list of integers")
@@ -196,7 +198,7 @@ def _block(m: dict, key: str, rows: int, cols: int, dtype: str) -> np.ndarray | 
     return block.astype(np.int64 if dtype == "<i8" else np.float64)
 
 
-def _first_rejection(*values):
+def first_rejection(*values):
     return next((v for v in values if isinstance(v, Rejected)), None)
 
 
@@ -209,13 +211,13 @@ def parse_obs(data: bytes) -> Obs | Rejected | dict:
         return m
     if m.get("type") != "obs":
         return Rejected("not an observation")
-    tick, agents, cells = _int(m, "tick"), _int_list(m, "agents"), _int_list(m, "cells")
-    if bad := _first_rejection(tick, agents, cells):
+    tick, agents, cells = int_field(m, "tick"), int_list(m, "agents"), int_list(m, "cells")
+    if bad := first_rejection(tick, agents, cells):
         return bad
     if len(cells) != len(agents):
         return Rejected("cells: one per agent")
     pi, pf = _block(m, "pi", len(agents), PERC_LEN, "<i8"), _block(m, "pf", len(agents), PERC_F_LEN, "<f8")
-    if bad := _first_rejection(pi, pf):
+    if bad := first_rejection(pi, pf):
         return bad
     return Obs(tick, agents, cells, pi, pf)
 
@@ -226,10 +228,10 @@ def parse_acts(data: bytes) -> Acts | Rejected:
         return m
     if m.get("type") != "act":
         return Rejected("not an action")
-    if m.get("family") not in FAMILIES:
+    if m.get("family") != FAMILY_GRID:
         return Rejected("unknown controller family")
-    tick, agents = _int(m, "tick"), _int_list(m, "agents")
-    if bad := _first_rejection(tick, agents):
+    tick, agents = int_field(m, "tick"), int_list(m, "agents")
+    if bad := first_rejection(tick, agents):
         return bad
     acts = _block(m, "acts", len(agents), ACT_LEN, "<i8")
     if isinstance(acts, Rejected):
@@ -246,9 +248,9 @@ def parse_marks(data: bytes) -> Marks | Rejected:
         return m
     if m.get("type") != "mark" or m.get("family") not in FAMILIES:
         return Rejected("not a mark write")
-    tick = _int(m, "tick")
-    agents, cells, values = _int_list(m, "agents"), _int_list(m, "cells"), _int_list(m, "values", 2**62)
-    if bad := _first_rejection(tick, agents, cells, values):
+    tick = int_field(m, "tick")
+    agents, cells, values = int_list(m, "agents"), int_list(m, "cells"), int_list(m, "values", 2**62)
+    if bad := first_rejection(tick, agents, cells, values):
         return bad
     if not len(agents) == len(cells) == len(values):
         return Rejected("agents, cells, values: one each per write")

@@ -61,8 +61,17 @@ def read_recording(path: str | Path) -> Recording:
             elif entity.startswith("metrics/") and not chunk.is_static:
                 batch = chunk.to_record_batch()
                 ticks = batch.column("tick").to_numpy()
-                values = batch.column("Scalars:scalars").flatten().to_numpy()
+                values = batch.column("Scalars:scalars")
+                if entity.startswith("metrics/robots/"):  # one scalar per robot and tick: (T, n)
+                    values = np.array([np.asarray(v.as_py(), np.float64) for v in values])
+                else:
+                    values = values.flatten().to_numpy()
                 parts.setdefault(entity.removeprefix("metrics/"), []).append((ticks, values))
+            elif entity == "world/robots" and not chunk.is_static:
+                batch = chunk.to_record_batch()
+                ticks = batch.column("tick").to_numpy()
+                xy = np.array([np.asarray(v.as_py(), np.float64) for v in batch.column("Points2D:positions")])
+                parts.setdefault("positions", []).append((ticks, xy * [1.0, -1.0]))  # logged north up
     except Exception as exc:  # rerun raises its own types for broken files
         raise RecordingError(f"{path}: damaged or not a rerun recording ({exc}). If the run was killed, "
                              "the file may be cut short; rerun it to get a complete recording.") from None  # fmt: skip
@@ -77,7 +86,7 @@ def read_recording(path: str | Path) -> Recording:
         series[name] = (ticks[order], values[order])
     rec = Recording(path, meta, printed, series)
     if printed is None:
-        ticks = rec.values("delivered")[0]
+        ticks = rec.values("reached" if meta.get("kind") == "arena" else "delivered")[0]
         upto = f"ticks 0..{int(ticks[-1])}" if len(ticks) else "no ticks"
         raise RecordingError(f"{path}: truncated: it holds {upto} but no end-of-run record (the run was "
                              "killed or is still going, or the file was cut).")  # fmt: skip
@@ -95,6 +104,10 @@ def summary_from(rec: Recording) -> dict:
     """The run summary (keys of `swarm run --json`, plus the distributed ones
     when the run was distributed), rebuilt from the recorded series."""
     m = rec.meta
+    if m.get("kind") == "arena":
+        from swarm.review_arena import arena_summary_from
+
+        return arena_summary_from(rec)
     ticks = rec.values("delivered")[0]
     delivered = int(rec.last("delivered"))
     optimal = int(rec.last("optimal_cells"))
@@ -122,6 +135,10 @@ def summary_from(rec: Recording) -> dict:
 
 
 def write_plots(rec: Recording, out: Path) -> list[Path]:
+    if rec.meta.get("kind") == "arena":
+        from swarm.review_arena import write_arena_plots
+
+        return write_arena_plots(rec, out)
     import matplotlib
 
     matplotlib.use("Agg")

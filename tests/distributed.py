@@ -9,7 +9,7 @@ import subprocess
 import sys
 import threading
 
-from world_server.server import WorldServer
+from world_server.server import make_server
 
 
 def free_endpoint() -> str:
@@ -34,10 +34,10 @@ def stop(procs: list[subprocess.Popen]) -> None:
 
 
 class ServerThread:
-    """A WorldServer running in a background thread of the test process."""
+    """A world server (of the scenario's kind) running in a background thread of the test process."""
 
     def __init__(self, scenario, run_id: str, endpoint: str, **kw):
-        self.server = WorldServer(scenario, run_id, listen=endpoint, **kw)
+        self.server = make_server(scenario, run_id, listen=endpoint, **kw)
         self.summary: dict | None = None
         self.error: BaseException | None = None
         self.finished = threading.Event()

@@ -14,7 +14,7 @@ from swarm.scenario import ScenarioError, load_scenario, parse_scenario_text
 from tests.arena_helpers import arena, box
 from world_server.arena import ArenaWorld
 
-ONE = '[[group]]\ncount = 1\ncontroller = "carrot"\nstart = [{x}, {y}, {t}]\n'
+ONE = '[[group]]\ncount = 1\ncontroller = "wander"\nstart = [{x}, {y}, {t}]\n'
 
 
 def _world(x=0.5, y=0.5, t=0.0, extra="", **kw) -> ArenaWorld:
@@ -93,6 +93,7 @@ def test_zones_are_sensed():
     ('[[group]]\ncount = 1\nrobot = "tank"\n', "group 1.robot"),
     ('[[group]]\ncount = 2\nstarts = [[0.5, 0.5]]\n', "group 1.starts"),
     ('[[group]]\ncount = 1\nroute = "tour"\n', "group 1.route"),
+    ('[[group]]\ncount = 1\ncontroller = "carrot"\nrobot = "animat"\n', "group 1.robot"),
     ('[[group]]\ncount = 1\nspeed = 3\n', "speed"),
     ('[[zone]]\nkind = "lava"\ndisc = [0.5, 0.5, 0.1]\n[[group]]\n', "zone 1.kind"),
     ("[[obstacle]]\nrect = [0.3, 0.3, 0.4, 0.4]\nappear = 5\nvanish = 5\n[[group]]\n", "obstacle 1"),
@@ -198,3 +199,39 @@ def test_large_maze_pairs_follow_the_seed_and_keep_40_mm_from_walls():
     s = load_scenario("large-maze")
     pts = np.array([p[1:] for p in a]).reshape(-1, 2)
     assert clearance_at(pts, s.wall_rects(), s.wall_segments()).min() >= 0.04
+
+
+def test_an_arena_recording_reads_back_to_the_printed_summary(tmp_path):
+    rrd = tmp_path / "arena.rrd"
+    ran = _swarm("run", "large-maze", "--agents", "3", "--seed", "2", "--max-ticks", "600", "--record", str(rrd),
+                 "--json")  # fmt: skip
+    assert ran.returncode in (0, 1), ran.stderr[-2000:]
+    printed = json.loads(ran.stdout)
+    rep = _swarm("report", str(rrd), "--out", str(tmp_path / "plots"), "--json")
+    assert rep.returncode == 0, rep.stderr[-2000:]
+    read = json.loads(rep.stdout)
+    for key in ("scenario", "kind", "agents", "seed", "noise", "ticks", "finished", "reached", "with_goal",
+                "sim_seconds", "mean_path_ratio", "collisions", "rejected_actions"):  # fmt: skip
+        assert read[key] == printed[key], key
+    keys = ("agent", "controller", "start", "goal", "reached", "ticks_to_goal", "path_length", "optimal_length",
+            "path_ratio", "collisions")  # fmt: skip
+    assert [{k: r[k] for k in keys} for r in read["robots"]] == [{k: r[k] for k in keys} for r in printed["robots"]]
+    for name in ("trajectories.png", "goals.png", "path_lengths.png"):
+        assert (tmp_path / "plots" / name).stat().st_size > 5000
+
+
+def test_the_arena_recording_holds_walls_robots_headings_and_the_plan(tmp_path):
+    from rerun.chunk import RrdReader
+
+    from swarm.recording_arena import ArenaRecorder, arena_meta
+
+    s = load_scenario("zmaze").with_overrides(max_ticks=50)
+    engine = ArenaEngine(s)
+    rec = ArenaRecorder(tmp_path / "z.rrd", engine.world, arena_meta(s, engine.world, "z", "in-process"),
+                        controllers=engine.controllers)  # fmt: skip
+    engine.run(recorder=rec)
+    rec.close(engine.summary())
+    entities = {c.entity_path.lstrip("/") for c in RrdReader(tmp_path / "z.rrd").stream()}
+    for e in ("world/walls", "world/zones", "world/goals", "world/robots", "world/headings", "world/trajectories",
+              "world/plans/0", "metrics/reached", "metrics/robots/path_length", "run/meta", "run/summary"):  # fmt: skip
+        assert e in entities, e

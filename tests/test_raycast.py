@@ -5,10 +5,10 @@ import math
 import numpy as np
 import pytest
 
+from swarm.arena.models import IR_DISTANCE, IR_VALUE
 from tests.arena_helpers import arena
 from world_server.arena import ArenaWorld
 from world_server.raycast import NO_HIT, brute_force
-from world_server.sensors import IR_DISTANCE, IR_VALUE
 
 
 def _random_world(seed: int, robots: int, obstacles: int, cell: float | None = None) -> ArenaWorld:
@@ -21,7 +21,7 @@ def _random_world(seed: int, robots: int, obstacles: int, cell: float | None = N
     for _ in range(5):  # diagonal segments too
         a = rng.uniform(0.5, 9.5, 4)
         walls += f"[[wall]]\nsegment = [{a[0]}, {a[1]}, {a[2]}, {a[3]}]\n"
-    body = walls + f'[[group]]\ncount = {robots}\ncontroller = "carrot"\nrobot = "scout"\nclearance = 0.0\n'
+    body = walls + f'[[group]]\ncount = {robots}\ncontroller = "wander"\nrobot = "scout"\nclearance = 0.0\n'
     return ArenaWorld(arena(body, w=10.0, h=10.0), index_cell=cell)
 
 
@@ -54,7 +54,7 @@ def test_rays_never_see_their_own_robot_and_robots_block_each_other():
 
 
 def _one(body_extra: str, start: str, robot: str = "epuck", noise: str = "none") -> dict:
-    body = body_extra + f'[[group]]\ncount = 1\ncontroller = "carrot"\nstart = {start}\n'
+    body = body_extra + f'[[group]]\ncount = 1\ncontroller = "wander"\nstart = {start}\n'
     return ArenaWorld(arena(body, robot=robot, noise=noise)).perceive()[0]
 
 
@@ -78,7 +78,7 @@ def test_camera_sector_sees_the_coloured_wall_ahead_and_its_grey_level():
 
 
 def test_noise_is_keyed_by_seed_agent_and_tick():
-    body = '[[group]]\ncount = 2\ncontroller = "carrot"\nstarts = [[0.3, 0.3, 0.0], [0.7, 0.7, 0.0]]\n'
+    body = '[[group]]\ncount = 2\ncontroller = "wander"\nstarts = [[0.3, 0.3, 0.0], [0.7, 0.7, 0.0]]\n'
     a = ArenaWorld(arena(body, robot="animat", noise="low"))
     b = ArenaWorld(arena(body, robot="animat", noise="low"))
     pa, pb = a.perceive(), b.perceive()
@@ -102,7 +102,7 @@ def test_position_noise_has_the_paper_std():
 
 
 def test_laser_without_noise_measures_geometry():
-    world = ArenaWorld(arena('[[group]]\ncount = 1\ncontroller = "carrot"\nrobot = "scout"\nstart = [0.5, 0.4, 0.0]\n',
+    world = ArenaWorld(arena('[[group]]\ncount = 1\ncontroller = "wander"\nrobot = "scout"\nstart = [0.5, 0.4, 0.0]\n',
                             noise="none"))  # fmt: skip
     scan = world.perceive()[0]["laser"]
     assert scan[0] == pytest.approx(0.98 - 0.5, abs=1e-9)  # east inner face at x = 0.98

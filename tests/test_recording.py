@@ -127,11 +127,13 @@ def _chromium() -> str | None:
 
 
 @pytest.mark.skipif(_chromium() is None, reason="Debian's chromium is not installed (make test installs it)")
-def test_the_web_viewer_is_served_and_loads_in_a_headless_browser(tmp_path):
+@pytest.mark.parametrize("run", [("maze", "--agents", "4", "--seed", "1"), ("large-maze", "--agents", "3")],
+                         ids=["grid", "arena"])  # fmt: skip
+def test_the_web_viewer_is_served_and_loads_in_a_headless_browser(tmp_path, run):
     from playwright.sync_api import sync_playwright
 
     rrd = tmp_path / "web.rrd"
-    assert _swarm("run", "maze", "--agents", "4", "--seed", "1", "--record", str(rrd)).returncode == 0
+    assert _swarm("run", *run, "--record", str(rrd)).returncode in (0, 1)
     web, grpc = (int(free_endpoint().rsplit(":", 1)[1]) for _ in range(2))
     proc = subprocess.Popen([*SWARM, "replay", str(rrd), "--web", "--port", str(web), "--grpc-port", str(grpc)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip

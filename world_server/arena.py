@@ -93,6 +93,7 @@ class ArenaWorld:
         self.finished = np.zeros(self.n, np.bool_)
         self.path_length = np.zeros(self.n)
         self.rejected = dict.fromkeys(REJECT_REASONS, 0)
+        self.optimum: list[float] | None = None  # L_o per robot, computed once by the summary
         self.start_pose = start.copy()
         self.zones = np.zeros(self.n, np.int64)
         self._update_zones()
@@ -167,6 +168,17 @@ class ArenaWorld:
         robot = what <= -2
         rgb[robot] = self.robot_rgb[-2 - what[robot]]
         return rgb
+
+    def judge(self, agent: int, wheels: np.ndarray) -> str | None:
+        """Why one robot's wheel speeds cannot be acted on, or None."""
+        wheels = np.asarray(wheels, np.float64)
+        if wheels.shape != (ACTION_LEN,):
+            return "wrong shape"
+        if not np.isfinite(wheels).all():
+            return "not finite"
+        if (np.abs(wheels) > self.max_wheel[agent] * (1 + 1e-9)).any():
+            return "over the wheel limit"
+        return None
 
     def validate(self, actions: np.ndarray) -> np.ndarray:
         """Which rows of (n, 2) wheel speeds may be acted on; the others are
@@ -254,7 +266,9 @@ class ArenaWorld:
         out = []
         controllers = [g.controller for g in s.groups for _ in range(g.count)]
         for a in range(self.n):
-            reached = bool(self.has_goal[a]) and math.hypot(*(self.pose[a, :2] - self.goal[a])) < s.goal_radius
+            # reached: it dwelt at its goal (a robot pushed off it afterwards keeps that), or ends within the radius
+            near = math.hypot(*(self.pose[a, :2] - self.goal[a])) < s.goal_radius
+            reached = bool(self.has_goal[a]) and (bool(self.finished[a]) or near)
             lo = optimum[a]
             lp = float(self.path_length[a])
             out.append({

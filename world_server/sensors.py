@@ -15,17 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm.arena.models import RobotModel
+from swarm.arena.models import IR_DISTANCE, IR_VALUE, RobotModel
 from swarm.rng import fill_normal, fill_uniform
 
 # Noise streams, one per kind of draw.
 S_SONAR_BEARING, S_SONAR_RANGE, S_IR, S_LASER, S_ODOMETRY, S_COMPASS, S_POSITION = range(1, 8)
 
-# IR response: reading against distance from the rim (m), piecewise linear, 0 beyond
-# the last point.  The shape of the e-puck calibration curves used by Webots (4095 at
-# contact, about 67 at 7 cm); the DFT controller only uses log(1 + p/50) of it.
-IR_DISTANCE = np.array([0.0, 0.005, 0.01, 0.015, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07])
-IR_VALUE = np.array([4095.0, 2133.0, 1465.0, 601.0, 383.0, 234.0, 158.0, 120.0, 104.0, 67.0])
 
 ZONE_KINDS = ("goal", "ingesting", "digesting", "dangerous", "start", "place")
 NOISE_LEVELS = ("none", "low", "high")

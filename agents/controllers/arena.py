@@ -17,7 +17,12 @@ from typing import Any, Protocol
 
 import numpy as np
 
-REGISTRY = {"carrot": "agents.controllers.carrot:CarrotController"}
+REGISTRY = {
+    "carrot": "agents.controllers.carrot:CarrotController",
+    "wander": "agents.controllers.wander:WanderController",
+}
+# What a controller needs its robot to sense (checked when a scenario is loaded).
+REQUIRES = {"carrot": ("position", "compass"), "wander": ()}
 
 
 class ArenaController(Protocol):

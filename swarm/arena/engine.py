@@ -60,20 +60,26 @@ class ArenaEngine:
     def tick(self) -> int:
         return self.world.tick
 
-    def step(self, n: int = 1) -> int:
-        """Up to n ticks (fewer once the run is done); returns ticks run."""
+    def step(self, n: int = 1, recorder=None) -> int:
+        """Up to n ticks (fewer once the run is done); returns ticks run.  A
+        `recorder` (swarm.recording_arena.ArenaRecorder) takes every tick."""
         w = self.world
         started = time.perf_counter()
         ran = 0
         while ran < n and not w.done():
+            t0 = time.perf_counter()
             for a, (c, p) in enumerate(zip(self.controllers, w.perceive(), strict=True)):
                 self.actions[a] = c.step(p)
             w.apply(self.actions)
+            if recorder is not None:
+                recorder.capture(
+                    w.tick - 1, tick_ms=(time.perf_counter() - t0) * 1000, rejected=sum(w.rejected.values())
+                )
             ran += 1
         self.wall_seconds += time.perf_counter() - started
         return ran
 
-    def run(self, progress: bool = False, chunk: int = 50) -> dict[str, Any]:
+    def run(self, progress: bool = False, chunk: int = 50, recorder=None) -> dict[str, Any]:
         bar = None
         if progress:
             from tqdm import tqdm
@@ -81,7 +87,7 @@ class ArenaEngine:
             bar = tqdm(total=self.scenario.max_ticks, unit="tick", desc=self.scenario.name, leave=False)
         try:
             while not self.world.done():
-                ran = self.step(chunk)
+                ran = self.step(chunk, recorder)
                 if bar is not None:
                     bar.update(ran)
         finally:
@@ -95,7 +101,9 @@ class ArenaEngine:
 
 def arena_summary(world: ArenaWorld, wall_seconds: float, runtime: str) -> dict[str, Any]:
     s = world.scenario
-    robots = world.robot_summaries(optimal_lengths(s, world.start_pose))
+    if world.optimum is None:
+        world.optimum = optimal_lengths(s, world.start_pose)  # A* once per run: the starts do not change
+    robots = world.robot_summaries(world.optimum)
     goals = [r for r in robots if r["goal"] is not None]
     ratios = [r["path_ratio"] for r in robots if r["path_ratio"] is not None]
     return {

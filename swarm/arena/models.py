@@ -12,7 +12,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+import numpy as np
+
 DEG = math.pi / 180.0
+# IR response: reading against distance from the rim (m), piecewise linear, 0 when the
+# ray meets nothing within range.  The shape of the e-puck calibration curves Webots
+# uses (4095 at contact, about 67 at 7 cm); the DFT controller only uses log(1 + p/50).
+IR_DISTANCE = np.array([0.0, 0.005, 0.01, 0.015, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07])
+IR_VALUE = np.array([4095.0, 2133.0, 1465.0, 601.0, 383.0, 234.0, 158.0, 120.0, 104.0, 67.0])
 SENSOR_KINDS = ("camera", "sonar", "ir", "laser", "odometry", "compass", "position", "contact", "zones")
 
 

@@ -42,7 +42,7 @@ from swarm.arena.models import (
 from swarm.scenario import ScenarioError
 from world_server.sensors import NOISE_LEVELS, ZONE_KINDS, Noise
 
-ARENA_CONTROLLERS = ("carrot",)
+ARENA_CONTROLLERS = ("carrot", "wander")
 START_STREAM = 0x53544152  # keeps start-pose draws apart from every other use of the seed
 MAX_DRAWS = 10_000
 Colour = tuple[int, int, int]
@@ -478,6 +478,13 @@ def check_arena(s: ArenaScenario, source: str) -> None:
                                 "wheel speed and turn rate")  # fmt: skip
         if g.count < 1:
             raise ScenarioError(source, f"group {gi + 1}.count", f"expected at least 1, got {g.count}")
+        from agents.controllers.arena import REQUIRES
+
+        missing = [k for k in REQUIRES.get(g.controller, ()) if not getattr(m.sensors, k)]
+        if missing:
+            raise ScenarioError(source, f"group {gi + 1}.robot", f"{g.controller} needs the {' and '.join(missing)} "
+                                f"sensor(s), which the {m.name} lacks; add them: robot = {{ model = \"{m.name}\", "
+                                f"sensors = [...] }}")  # fmt: skip
         if g.route is not None and g.route not in s.routes:
             raise ScenarioError(source, f"group {gi + 1}.route", f"no route {g.route!r} in [routes]; have "
                                 f"{', '.join(s.routes) or 'none'}")  # fmt: skip

@@ -1,0 +1,43 @@
+"""Arena agent processes: K controller objects, wheel speeds back to the world.
+
+Each agent's controller is reset with what the world's welcome gives it (the
+seed, its id, and its params: the map it is given, its goal or route, its
+body), exactly as the in-process engine resets it, so lock-step runs equal
+in-process runs pose for pose.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from agents.controllers.arena import make_controller
+from agents.runtime import AgentRuntime
+from swarm import protocol as proto
+from swarm import protocol_arena as arena_proto
+
+
+class ArenaAgentRuntime(AgentRuntime):
+    family = proto.FAMILY_ARENA
+
+    def _prepare(self, count: int) -> None:
+        self.brains: list = [None] * count
+
+    def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
+        brain = make_controller(msg.get("controller", self.controller))
+        brain.reset(int(msg["seed"]), agent, msg["params"])
+        self.brains[slot] = brain
+
+    def _parse(self, data: bytes):
+        return arena_proto.parse_obs(data)
+
+    def _answer(self, obs: arena_proto.ArenaObs) -> int:
+        agents, wheels = [], []
+        for agent, reading in zip(obs.agents.tolist(), obs.perceptions, strict=True):
+            slot = self.slot_of.get(agent)
+            if slot is None:
+                continue
+            agents.append(agent)
+            wheels.append(np.zeros(2) if self.null else self.brains[slot].step(reading))
+        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 2))
+        self.session.put(self.keys.act(self.group), payload)
+        return len(agents)

@@ -1,0 +1,110 @@
+"""The arena family of the wire protocol (keys and framing: swarm/protocol.py).
+
+    obs/<group>   world -> agent process: for one tick, every agent's sensor
+                  readings, each array as [dtype, shape, little-endian bytes]
+    act/<group>   agent process -> world: their wheel speeds (K x 2 float64, m/s)
+
+Decoding never raises on bad input: it returns a `Rejected` reason.  Wheel
+speeds are not judged here: the world checks every agent's pair (finite,
+within its robot's limits) and counts what it refuses by reason.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from swarm.protocol import FAMILY_ARENA, Rejected, first_rejection, int_field, int_list, pack, unpack
+
+MAX_OBS_BYTES = 64 * 1024 * 1024  # observations come from the world; 100 animats take ~100 KB
+DTYPES = {"<f8": np.float64, "<i8": np.int64, "|u1": np.uint8, "|b1": np.bool_}
+MAX_SENSORS, MAX_DIMS = 32, 4
+
+
+@dataclass(frozen=True)
+class ArenaObs:
+    tick: int
+    agents: np.ndarray  # (K,)
+    perceptions: list[dict[str, np.ndarray]]
+
+
+@dataclass(frozen=True)
+class ArenaActs:
+    tick: int
+    agents: np.ndarray  # (K,)
+    wheels: np.ndarray  # (K, 2), not yet judged
+
+
+def _encode(value) -> list:
+    a = np.asarray(value)
+    kind = {np.dtype(np.float64): "<f8", np.dtype(np.int64): "<i8", np.dtype(np.uint8): "|u1",
+            np.dtype(np.bool_): "|b1"}.get(a.dtype)  # fmt: skip
+    if kind is None:
+        a, kind = a.astype(np.float64), "<f8"
+    return [kind, list(a.shape), np.ascontiguousarray(a, dtype=DTYPES[kind]).astype(kind).tobytes()]
+
+
+def observations(tick: int, agents, perceptions: list[dict[str, np.ndarray]]) -> bytes:
+    return pack({"type": "obs", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
+                 "perceptions": [{k: _encode(v) for k, v in p.items()} for p in perceptions]})  # fmt: skip
+
+
+def actions(tick: int, agents, wheels: np.ndarray) -> bytes:
+    return pack({"type": "act", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
+                 "wheels": np.asarray(wheels, np.float64).astype("<f8").tobytes()})  # fmt: skip
+
+
+def _decode(entry) -> np.ndarray | Rejected:
+    if not (isinstance(entry, list) and len(entry) == 3 and entry[0] in DTYPES and isinstance(entry[2], bytes)):
+        return Rejected("perception: expected [dtype, shape, bytes]")
+    kind, shape, raw = entry
+    if not (isinstance(shape, list) and len(shape) <= MAX_DIMS
+            and all(isinstance(n, int) and not isinstance(n, bool) and 0 <= n <= 1 << 20 for n in shape)):  # fmt: skip
+        return Rejected("perception: bad shape")
+    if int(np.prod(shape, dtype=np.int64)) * np.dtype(kind).itemsize != len(raw):
+        return Rejected("perception: shape and bytes disagree")
+    return np.frombuffer(raw, dtype=kind).reshape(shape).astype(DTYPES[kind])
+
+
+def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
+    """A batch of readings, or the raw dict of a `stop` message."""
+    m = unpack(data, MAX_OBS_BYTES)
+    if isinstance(m, Rejected):
+        return m
+    if m.get("type") == "stop":
+        return m
+    if m.get("type") != "obs" or m.get("family") != FAMILY_ARENA:
+        return Rejected("not an arena observation")
+    tick, agents = int_field(m, "tick"), int_list(m, "agents")
+    if bad := first_rejection(tick, agents):
+        return bad
+    raw = m.get("perceptions")
+    if not isinstance(raw, list) or len(raw) != len(agents):
+        return Rejected("perceptions: one per agent")
+    perceptions = []
+    for p in raw:
+        if not isinstance(p, dict) or len(p) > MAX_SENSORS or not all(isinstance(k, str) for k in p):
+            return Rejected("perceptions: expected a map of sensor readings")
+        decoded = {k: _decode(v) for k, v in p.items()}
+        if bad := first_rejection(*decoded.values()):
+            return bad
+        perceptions.append(decoded)
+    return ArenaObs(tick, agents, perceptions)
+
+
+def parse_acts(data: bytes) -> ArenaActs | Rejected:
+    m = unpack(data)
+    if isinstance(m, Rejected):
+        return m
+    if m.get("type") != "act":
+        return Rejected("not an action")
+    if m.get("family") != FAMILY_ARENA:
+        return Rejected("unknown controller family")
+    tick, agents = int_field(m, "tick"), int_list(m, "agents")
+    if bad := first_rejection(tick, agents):
+        return bad
+    raw = m.get("wheels")
+    if not isinstance(raw, bytes) or len(raw) != 16 * len(agents):
+        return Rejected(f"wheels: expected {len(agents)}x2 binary float64")
+    return ArenaActs(tick, agents, np.frombuffer(raw, dtype="<f8").reshape(len(agents), 2).astype(np.float64))

@@ -1,0 +1,141 @@
+"""The arena over zenoh: a real router, real agent processes, lock-step equal
+to the in-process engine pose for pose, bad traffic counted and refused."""
+
+import numpy as np
+import pytest
+
+from swarm import protocol as proto
+from swarm import protocol_arena as arena_proto
+from swarm.arena.engine import ArenaEngine
+from swarm.bus import open_client
+from swarm.review import read_recording, summary_from
+from swarm.scenario import load_scenario, parse_scenario_text
+from tests.arena_helpers import box
+from tests.distributed import ServerThread, free_endpoint, start_agents, stop
+
+
+def _distributed(scenario, run_id, procs_for, attack=None, **kw):
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, run_id, endpoint, deadline=20.0, **kw).start()
+    procs = [p for controller, n, count in procs_for for p in start_agents(endpoint, run_id, controller, n, count)]
+    try:
+        if attack is not None:
+            attack(endpoint, proto.Keys(run_id))
+        summary = world.join(timeout=240)
+        for p in procs:
+            p.wait(timeout=30)
+            assert p.returncode == 0, p.stderr.read().decode()[-2000:]
+        return summary, world.server.world
+    finally:
+        stop(procs)
+        world.close()
+
+
+@pytest.mark.parametrize(("ref", "agents", "seed", "noise", "count"), [
+    ("zmaze", 1, 0, "high", 1),
+    ("large-maze", 4, 3, "low", 2),
+])  # fmt: skip
+def test_lockstep_arena_equals_in_process_bit_for_bit(ref, agents, seed, noise, count, tmp_path):
+    scenario = load_scenario(ref).with_overrides(agents=agents, seed=seed, noise=noise, max_ticks=400)
+    engine = ArenaEngine(scenario)
+    expected = engine.run()
+    rrd = tmp_path / "run.rrd"
+    summary, world = _distributed(scenario, f"arena-{ref}-{seed}", [("carrot", agents // count, count)],
+                                  record=str(rrd))  # fmt: skip
+    np.testing.assert_array_equal(world.pose, engine.world.pose)
+    np.testing.assert_array_equal(world.path_length, engine.world.path_length)
+    assert summary["ticks"] == expected["ticks"] and summary["robots"] == expected["robots"]
+    assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
+    read = summary_from(read_recording(rrd))  # the distributed recording rebuilds the same run
+    assert read["ticks"] == summary["ticks"] and read["reached"] == summary["reached"]
+    assert [r["path_length"] for r in read["robots"]] == [r["path_length"] for r in summary["robots"]]
+
+
+MIXED = box(
+    '[[group]]\ncount = 2\ncontroller = "carrot"\nstarts = [[0.2, 0.2, 0.0], [0.2, 0.8, 0.0]]\n'
+    'goals = [[0.8, 0.8], [0.8, 0.2]]\n'
+    '[[group]]\ncount = 2\ncontroller = "wander"\nrobot = "animat"\nclearance = 0.05\n',
+    w=3.0, h=3.0, noise="low", max_ticks=300,
+)  # fmt: skip
+
+
+def test_mixed_controllers_and_robots_equal_in_process():
+    scenario = parse_scenario_text(MIXED, "mixed.toml")
+    engine = ArenaEngine(scenario)
+    engine.run()
+    _, world = _distributed(scenario, "arena-mixed", [("carrot", 2, 1), ("wander", 1, 2)])
+    np.testing.assert_array_equal(world.pose, engine.world.pose)
+    assert engine.world.bodies.distance[2:].min() > 0.5  # the wanderers went places
+
+
+def test_bad_arena_traffic_is_counted_and_never_acted_on():
+    scenario = load_scenario("zmaze").with_overrides(max_ticks=60, noise="none")
+    engine = ArenaEngine(scenario)
+    engine.run()
+
+    def attack(endpoint, keys):
+        s = open_client(endpoint)
+        try:
+            s.put(keys.act("intruder"), b"\x00\xffgarbage")
+            s.put(keys.act("intruder"), proto.pack({"type": "act", "family": "arena", "tick": 0}))
+            s.put(keys.act("intruder"), arena_proto.actions(0, [0], np.array([[0.1, 0.1]])))  # another's agent
+            s.put(keys.act("intruder"), arena_proto.actions(0, [7], np.array([[0.1, 0.1]])))  # unknown agent
+            s.put(keys.act("intruder"), proto.pack({"type": "act", "family": "arena", "tick": 0, "agents": [0],
+                                                    "wheels": b"short"}))  # fmt: skip
+            s.put(keys.act("intruder"), proto.actions(0, [0], np.zeros((1, 7), np.int64), [False]))  # grid family
+        finally:
+            s.close()
+
+    summary, world = _distributed(scenario, "arena-attack", [("carrot", 1, 1)], attack=attack)
+    np.testing.assert_array_equal(world.pose, engine.world.pose)
+    assert summary["rejected_messages"] >= 5 and summary["agents_lost"] == 0
+    reasons = summary["rejected_by_reason"]
+    assert any("not msgpack" in r for r in reasons) and any("wheels" in r for r in reasons)
+    assert any("another process" in r or "unknown agent" in r for r in reasons)  # before or after it joined
+    assert any("unknown controller family" in r for r in reasons)
+
+
+def test_nan_and_huge_wheel_speeds_from_an_agent_are_refused():
+    """A hand-made agent process sends NaN, then 50 m/s: both are counted and the robot never moves."""
+    import threading
+    import time
+    import uuid
+
+    scenario = load_scenario("zmaze").with_overrides(max_ticks=4, noise="none")
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "arena-nan", endpoint, deadline=1.0, max_misses=10).start()
+    s = open_client(endpoint)
+    group, nonce = uuid.uuid4().hex, uuid.uuid4().hex
+    got: list = []
+    sub = s.declare_subscriber(proto.Keys("arena-nan").obs(group), lambda smp: got.append(smp.payload.to_bytes()))
+    try:
+        keys = proto.Keys("arena-nan")
+        for _ in range(50):
+            request = proto.join_request(nonce, group, family="arena", controller="carrot")
+            replies = list(s.get(keys.join, payload=request, timeout=2.0))
+            if replies and replies[0].ok:
+                break
+            time.sleep(0.1)
+        agent = proto.unpack(replies[0].ok.payload.to_bytes(), proto.MAX_WELCOME_BYTES)["agent"]
+        token = s.liveliness().declare_token(keys.alive(agent))
+        start = world.server.world.pose.copy()
+        answered = set()
+        stop_at = time.monotonic() + 30
+        while not world.finished.is_set() and time.monotonic() < stop_at:
+            for raw in list(got):
+                obs = arena_proto.parse_obs(raw)
+                if isinstance(obs, arena_proto.ArenaObs) and obs.tick not in answered:
+                    answered.add(obs.tick)
+                    bad = [np.nan, 0.1] if obs.tick % 2 == 0 else [50.0, 50.0]
+                    s.put(keys.act(group), arena_proto.actions(obs.tick, [agent], np.array([bad])))
+            time.sleep(0.01)
+        summary = world.join(timeout=30)
+        token.undeclare()
+        np.testing.assert_array_equal(world.server.world.pose, start)
+        reasons = summary["rejected_by_reason"]
+        assert reasons.get("act: not finite", 0) >= 1 and reasons.get("act: over the wheel limit", 0) >= 1
+    finally:
+        sub.undeclare()
+        s.close()
+        world.close()
+        threading.Event().wait(0.1)

@@ -1,0 +1,108 @@
+"""The arena's world process: world_server.server bound to the arena.
+
+Each tick the world casts every robot's rays once (ArenaWorld.perceive), sends
+each agent process its agents' readings, and integrates one control period
+from the wheel speeds that came back.  An agent that is late, silent, or whose
+wheel speeds are refused holds still that tick.  A lost agent's body stays
+where it stopped, an obstacle to the others; a newcomer taking the slot over
+drives that body on from there with a fresh controller.  Agents join the
+slots of the scenario group whose controller they run, so one scenario can
+mix controllers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from swarm import protocol as proto
+from swarm import protocol_arena as arena_proto
+from swarm.arena.engine import arena_summary
+from swarm.arena.scenario import controller_params
+from world_server.arena import ArenaWorld
+from world_server.server import FREE, LOST, WorldServer
+
+
+class ArenaServer(WorldServer):
+    family = proto.FAMILY_ARENA
+
+    def _make_world(self) -> None:
+        s = self.scenario
+        self.world = ArenaWorld(s)
+        self.world.perceive()  # compile the ray pass now, not in the first tick's deadline
+        self.controllers = np.array([g.controller for g in s.groups for _ in range(g.count)])
+        self.wheels = np.zeros((self.world.n, 2))
+        self.ok = np.zeros(self.world.n, np.bool_)
+        self.readings: list[dict[str, np.ndarray]] = []
+
+    def _open_recorder(self, path, viewer: str | None):
+        from swarm.recording_arena import ArenaRecorder, arena_meta
+
+        return ArenaRecorder(path, self.world, arena_meta(self.scenario, self.world, self.keys.run, self.mode),
+                             viewer=viewer)  # fmt: skip
+
+    # ------------------------------------------------------------------ joins
+
+    def _join_refusal(self, request: dict) -> str | None:
+        if request.get("family") != self.family or request.get("controller") not in set(self.controllers):
+            wanted = ", ".join(sorted(set(self.controllers)))
+            return f"this arena's robots run {wanted}, not {request.get('controller')!r}"
+        return None
+
+    def _free_slots(self, request: dict) -> np.ndarray:
+        free = (self.slots == FREE) | (self.slots == LOST)
+        return np.flatnonzero(free & (self.controllers == request.get("controller")))
+
+    def _welcome(self, agent: int) -> dict:
+        return {"family": self.family, "controller": str(self.controllers[agent]),
+                "params": controller_params(self.scenario, agent)}  # fmt: skip
+
+    def _reuse(self, agent: int) -> None:
+        self.world.present[agent] = True
+
+    def _remove(self, agent: int) -> None:
+        self.world.remove_agent(agent)
+
+    # ------------------------------------------------------------------ ticks
+
+    def _begin_tick(self) -> None:
+        self.ok[:] = False
+        self.wheels[:] = 0.0
+        if not self.null:
+            self.readings = self.world.perceive()
+
+    def _observe(self, tick: int, agents: np.ndarray) -> bytes:
+        readings = [{} for _ in agents] if self.null else [self.readings[a] for a in agents]
+        return arena_proto.observations(tick, agents, readings)
+
+    def _on_act(self, sample) -> None:
+        received = self._receive(sample, arena_proto.parse_acts, "act")
+        if received is None:
+            return
+        msg, group = received
+        for a, wheels in zip(msg.agents.tolist(), msg.wheels, strict=True):
+            if not self._acting(a, group, msg.tick):
+                continue
+            if (reason := self.world.judge(a, wheels)) is not None:
+                self.stats.reject(f"act: {reason}")
+            else:
+                self.wheels[a] = wheels
+                self.ok[a] = True
+                self.acted[a] = True
+
+    def _resolve(self, tick: int) -> None:
+        self.world.apply(self.wheels, self.ok)
+
+    def done(self) -> bool:
+        return self.world.done()
+
+    # ---------------------------------------------------------------- summary
+
+    def progress_fields(self) -> dict:
+        w = self.world
+        return {"reached": int(w.finished.sum()), "with_goal": int(w.has_goal.sum())}
+
+    def summary_fields(self) -> dict:
+        out = arena_summary(self.world, 0.0, "distributed")
+        for key in ("wall_seconds", "ticks_per_second"):  # the runtime's own, below
+            out.pop(key)
+        return {**out, "until": self.until}
