@@ -513,7 +513,7 @@ def cmd_monitor(args) -> int:
 
     summary = monitor(args.connect, args.run_id, progress=not args.json and sys.stderr.isatty(),
                       log_every=args.log_every, start_timeout=args.start_timeout)  # fmt: skip
-    return _print_summary(summary, args.json, summary.get("until", "foraged"))
+    return _print_any(summary, args.json, summary.get("until", "foraged"))
 
 
 def cmd_status(args) -> int:
@@ -545,7 +545,7 @@ def cmd_router(args) -> int:
 def cmd_prepare(args) -> int:
     from swarm.launcher import prepare
 
-    aot_built = prepare(progress=True, engine=True)
+    aot_built = prepare(progress=True, engine=True, arena=True)
     print(f"swarm: kernels compiled; agents' ahead-of-time step: {'built' if aot_built else 'MISSING (JIT fallback)'}")
     return 0 if aot_built or not args.require_aot else 1
 

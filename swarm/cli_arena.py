@@ -59,9 +59,9 @@ def run_arena(args, scenario, viewer: str | None = None) -> int:
     engine = ArenaEngine(scenario)
     recorder = None
     if getattr(args, "record", None):
-        from swarm.recording_arena import ArenaRecorder, arena_meta
+        from swarm.recording_arena import ArenaRecorder
 
-        meta = arena_meta(scenario, engine.world, Path(args.record).stem, "in-process")
+        meta = {"run_id": Path(args.record).stem, "runtime": "in-process"}
         recorder = ArenaRecorder(args.record, engine.world, meta, viewer=viewer, controllers=engine.controllers)
     summary = None
     try:
@@ -80,11 +80,14 @@ def print_arena_summary(summary: dict, as_json: bool) -> int:
         print(json.dumps(summary))
     else:
         state = "finished" if summary["finished"] else "NOT finished"
-        print(f"{summary['scenario']}: {summary['controller']} x{summary['agents']}, seed {summary['seed']}, "
-              f"noise {summary['noise']}: {state} after {summary['ticks']} ticks ({summary['sim_seconds']} s "
-              f"simulated, {summary.get('ticks_per_second', 'n/a')} ticks/s)\n"
-              f"  reached {summary['reached']}/{summary['with_goal']}, collisions {summary['collisions']}, "
-              f"rejected actions {summary.get('rejected_actions', 'n/a')}")  # fmt: skip
+        goals = f"reached {summary['reached']}/{summary['with_goal']}, " if summary["with_goal"] else ""
+        print(
+            f"{summary['scenario']}: {summary['controller']} x{summary['agents']}, seed {summary['seed']}, "
+            f"noise {summary['noise']}: {state} after {summary['ticks']} ticks ({summary['sim_seconds']} s "
+            f"simulated, {summary.get('ticks_per_second', 'n/a')} ticks/s)\n"
+            f"  {goals}collisions {summary['collisions']}, "
+            f"rejected actions {summary.get('rejected_actions', 'n/a')}"
+        )
         for r in summary["robots"][:20]:
             ratio = "n/a" if r["path_ratio"] is None else f"{r['path_ratio']:.3f}"
             lo = "n/a" if r["optimal_length"] is None else f"{r['optimal_length']:.3f}"

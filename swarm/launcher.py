@@ -72,10 +72,11 @@ def swarm_up(
         signal.signal(signal.SIGTERM, previous)
 
 
-def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = False) -> bool:
+def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = False, arena: bool = False) -> bool:
     """Compile everything a run needs before it starts: the agents' ahead-of-time
     step (in a subprocess, in parallel), the controller and world kernels, and
-    with `engine` the in-process engine loop.  Returns whether the
+    with `engine` the in-process engine loop; the arena's ray pass, drive and
+    A* for an arena scenario or with `arena`.  Returns whether the
     ahead-of-time build exists.  Container images run it at build time."""
     builder = None
     if aot.built() is None:  # agent processes run this build without numba (~35 MB instead of ~150)
@@ -86,10 +87,11 @@ def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = 
                                    stderr=subprocess.PIPE, text=True)  # fmt: skip
     warm_up()  # once here, so N agents starting together find the kernels in the cache,
     scenario = load_scenario(scenario_ref)
-    if is_arena(scenario):  # the ray pass and A* (arena agents plan with it)
+    if arena or is_arena(scenario):  # the ray pass and A* (arena agents plan with it)
         from swarm.arena.engine import ArenaEngine
 
-        ArenaEngine(scenario).step(1)
+        ArenaEngine(scenario if is_arena(scenario) else load_scenario("zmaze")).step(1)
+    if is_arena(scenario):
         scenario = load_scenario("setup2")
     scenario = scenario.with_overrides(agents=2)
     GridWorld(scenario).warm_up()  # and so does the world

@@ -41,24 +41,35 @@ def flip(xy: np.ndarray) -> np.ndarray:
 
 
 def arena_meta(scenario, world, run_id: str, runtime: str) -> dict:
+    """What a reader needs to interpret the recording: taken at the first tick
+    recorded, when the robots that start the run are in the world (a robot
+    that joins later has no start or L_o here, and no row in `swarm report`)."""
     from swarm.arena.engine import optimal_lengths
 
-    if world.optimum is None:
-        world.optimum = optimal_lengths(scenario, world.start_pose)
+    inside = np.flatnonzero(world.in_world).tolist()
+    for a, lo in enumerate(
+        optimal_lengths(scenario, world.start_pose, [a for a in inside if world.optimum[a] is None])
+    ):
+        if lo is not None:
+            world.optimum[a] = lo
     return {"kind": "arena", "run_id": run_id, "runtime": runtime, "scenario": scenario.describe(),
             "name": scenario.name, "controller": scenario.controller, "agents": scenario.agents,
             "seed": scenario.seed, "noise": scenario.noise.level, "control_period": scenario.control_period,
             "goal_radius": scenario.goal_radius, "max_ticks": scenario.max_ticks,
             "controllers": [g.controller for g in scenario.groups for _ in range(g.count)],
-            "starts": world.start_pose.round(6).tolist(),
+            "starts": [world.start_pose[a].round(6).tolist() if a in inside else None for a in range(world.n)],
             "walls": [{"shape": w.shape, "coords": list(w.coords), "colour": list(w.colour)} for w in scenario.walls],
+            "obstacles": [{"rect": list(o.rect), "colour": list(o.colour), "name": o.name, "zone": o.zone,
+                           "appear": o.appear, "vanish": o.vanish} for o in scenario.obstacles],
             "goals": [None if not world.has_goal[a] else world.goal[a].round(6).tolist() for a in range(world.n)],
-            "optimal_lengths": [v if math.isfinite(v) else None for v in world.optimum]}  # fmt: skip
+            "optimal_lengths": [v if v is not None and math.isfinite(v) else None for v in world.optimum]}  # fmt: skip
 
 
 class ArenaRecorder:
     def __init__(self, path, world, meta: dict, viewer: str | None = None, flush_every: int = 256,
                  controllers=None):  # fmt: skip
+        """`meta`: run_id and runtime; the rest (arena_meta) is taken at the
+        first tick, when the robots that start the run are in the world."""
         import rerun as rr
         import rerun.blueprint as rrb
 
@@ -80,7 +91,8 @@ class ArenaRecorder:
             collapse_panels=True,
         )
         self.rec.set_sinks(*sinks, default_blueprint=blueprint)
-        self.meta = {"format": FORMAT_VERSION, **meta, "versions": software_versions()}
+        self._meta_given = meta
+        self.meta: dict = {}
         n = world.n
         group = np.concatenate([np.full(g.count, k) for k, g in enumerate(world.scenario.groups)])
         self.colours = np.array([GROUP_COLOURS[k % len(GROUP_COLOURS)] for k in group], np.uint8).reshape(n, 3)
@@ -91,10 +103,13 @@ class ArenaRecorder:
         self._paths: list[np.ndarray] = [world.pose[:, None, :2].astype(np.float32)]  # (n, T, 2) pieces
         self._obstacles_on: tuple | None = None
         self._plans_logged: set[int] = set()
-        self._log_static()
+        self._static_done = False
 
     def _log_static(self) -> None:
         rr, rec, w, s = self.rr, self.rec, self.world, self.world.scenario
+        self._static_done = True
+        built = arena_meta(s, w, self._meta_given.get("run_id", "run"), self._meta_given.get("runtime", "in-process"))
+        self.meta = {"format": FORMAT_VERSION, **built, **self._meta_given, "versions": software_versions()}
         rec.log("run/meta", rr.AnyValues(meta=json.dumps(self.meta)), rr.TextDocument(json.dumps(self.meta, indent=1)),
                 static=True)  # fmt: skip
         strips, colours = [], []
@@ -137,7 +152,7 @@ class ArenaRecorder:
                 ),
                 static=True,
             )
-        goals = np.flatnonzero(w.has_goal)
+        goals = np.flatnonzero(w.has_goal & w.in_world)
         if len(goals):
             rec.log(
                 "world/goals",
@@ -157,6 +172,8 @@ class ArenaRecorder:
 
     def capture(self, tick: int, present: np.ndarray | None = None, tick_ms: float = 0.0, rejected: int = 0) -> None:
         w = self.world
+        if not self._static_done:
+            self._log_static()
         self._ticks.append(tick)
         self._pose.append(w.pose.astype(np.float32).copy())
         in_goal = np.zeros(w.n)
@@ -181,14 +198,15 @@ class ArenaRecorder:
             self.flush()
 
     def _log_obstacles(self, tick: int, on: tuple) -> None:
+        """The boxes present now (resources among them, labelled by name)."""
         rr = self.rr
-        rects = np.array([o.rect for o, here in zip(self.world.scenario.obstacles, on, strict=True) if here]).reshape(
-            -1, 4
-        )
+        here = [o for o, present in zip(self.world.scenario.obstacles, on, strict=True) if present]
+        rects = np.array([o.rect for o in here]).reshape(-1, 4)
         self.rec.set_time("tick", sequence=tick)
-        self.rec.log("world/obstacles", rr.Boxes2D(centers=flip((rects[:, :2] + rects[:, 2:]) / 2),
-                                                   half_sizes=(rects[:, 2:] - rects[:, :2]) / 2,
-                                                   colors=[(90, 90, 90)] * len(rects), draw_order=1.5))  # fmt: skip
+        self.rec.log("world/obstacles", rr.Boxes2D(
+            centers=flip((rects[:, :2] + rects[:, 2:]) / 2), half_sizes=(rects[:, 2:] - rects[:, :2]) / 2,
+            colors=[o.colour for o in here], labels=[o.name or "obstacle" for o in here], draw_order=1.5,
+        ))  # fmt: skip
 
     def _log_plans(self, tick: int) -> None:
         for a, c in enumerate(self.controllers):
@@ -243,6 +261,8 @@ class ArenaRecorder:
                                                       draw_order=4.0))  # fmt: skip
 
     def close(self, summary: dict | None = None) -> None:
+        if not self._static_done:
+            self._log_static()
         self.flush()
         if summary is not None:
             self.rec.log("run/summary", self.rr.AnyValues(summary=json.dumps(summary)), static=True)

@@ -45,7 +45,10 @@ def arena_summary_from(rec) -> dict:
         "noise": m["noise"],
         "runtime": m["runtime"],
         "ticks": int(ticks[-1]) + 1 if len(ticks) else 0,
-        "finished": bool(goals) and all(r["reached"] for r in goals),
+        # with goals: all reached; without: the run went its full length (as the in-process summary)
+        "finished": all(r["reached"] for r in goals)
+        if goals
+        else bool(len(ticks)) and int(ticks[-1]) + 1 >= m["max_ticks"],
         "reached": sum(r["reached"] for r in goals),
         "with_goal": len(goals),
         "sim_seconds": round((int(ticks[-1]) + 1 if len(ticks) else 0) * m["control_period"], 3),
@@ -97,6 +100,12 @@ def write_arena_plots(rec, out: Path) -> list[Path]:
             ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, color=colour, lw=0))
         else:
             ax.plot([x0, x1], [y0, y1], color=colour, lw=2)
+    for o in m.get("obstacles", []):
+        x0, y0, x1, y1 = o["rect"]
+        ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, facecolor=np.array(o["colour"]) / 255,
+                                   edgecolor="k", lw=0.5, alpha=0.9))  # fmt: skip
+        if o["zone"]:
+            ax.annotate(o["name"], ((x0 + x1) / 2, y1), ha="center", va="bottom", fontsize=7)
     _, xy = rec.values("positions")
     if len(xy):
         for a in range(xy.shape[1]):

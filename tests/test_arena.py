@@ -155,7 +155,7 @@ def test_arena_runs_are_deterministic_bit_for_bit():
 
 def test_several_robots_share_a_maze():
     text = load_scenario("large-maze")
-    s = text.with_overrides(agents=4, seed=5)  # drawn starts, the scenario's goal for all
+    s = text.with_overrides(agents=4, seed=5)  # drawn starts, a drawn goal each
     e = ArenaEngine(s)
     e.step(1500)
     assert e.world.bodies.distance.min() > 0.3
@@ -223,11 +223,11 @@ def test_an_arena_recording_reads_back_to_the_printed_summary(tmp_path):
 def test_the_arena_recording_holds_walls_robots_headings_and_the_plan(tmp_path):
     from rerun.chunk import RrdReader
 
-    from swarm.recording_arena import ArenaRecorder, arena_meta
+    from swarm.recording_arena import ArenaRecorder
 
     s = load_scenario("zmaze").with_overrides(max_ticks=50)
     engine = ArenaEngine(s)
-    rec = ArenaRecorder(tmp_path / "z.rrd", engine.world, arena_meta(s, engine.world, "z", "in-process"),
+    rec = ArenaRecorder(tmp_path / "z.rrd", engine.world, {"run_id": "z", "runtime": "in-process"},
                         controllers=engine.controllers)  # fmt: skip
     engine.run(recorder=rec)
     rec.close(engine.summary())
@@ -235,3 +235,15 @@ def test_the_arena_recording_holds_walls_robots_headings_and_the_plan(tmp_path):
     for e in ("world/walls", "world/zones", "world/goals", "world/robots", "world/headings", "world/trajectories",
               "world/plans/0", "metrics/reached", "metrics/robots/path_length", "run/meta", "run/summary"):  # fmt: skip
         assert e in entities, e
+
+
+def test_more_robots_than_goals_get_a_drawn_goal_each():
+    from swarm.arena.scenario import clearance_at
+
+    s = load_scenario("zmaze").with_overrides(agents=5, seed=3)
+    goals = np.array(s.goals())
+    assert np.array_equal(goals, np.array(load_scenario("zmaze").with_overrides(agents=5, seed=3).goals()))
+    gaps = np.hypot(*(goals[:, None] - goals[None]).transpose(2, 0, 1)) + np.eye(5)
+    assert gaps.min() >= 2 * s.goal_radius
+    assert clearance_at(goals, s.wall_rects(), s.wall_segments()).min() >= 0.037 + 0.04
+    assert ArenaEngine(s).run()["reached"] >= 4

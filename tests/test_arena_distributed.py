@@ -118,7 +118,6 @@ def test_nan_and_huge_wheel_speeds_from_an_agent_are_refused():
             time.sleep(0.1)
         agent = proto.unpack(replies[0].ok.payload.to_bytes(), proto.MAX_WELCOME_BYTES)["agent"]
         token = s.liveliness().declare_token(keys.alive(agent))
-        start = world.server.world.pose.copy()
         answered = set()
         stop_at = time.monotonic() + 30
         while not world.finished.is_set() and time.monotonic() < stop_at:
@@ -131,7 +130,9 @@ def test_nan_and_huge_wheel_speeds_from_an_agent_are_refused():
             time.sleep(0.01)
         summary = world.join(timeout=30)
         token.undeclare()
-        np.testing.assert_array_equal(world.server.world.pose, start)
+        w = world.server.world
+        assert w.in_world[agent]
+        np.testing.assert_array_equal(w.pose[agent], w.start_pose[agent])  # it entered and never moved
         reasons = summary["rejected_by_reason"]
         assert reasons.get("act: not finite", 0) >= 1 and reasons.get("act: over the wheel limit", 0) >= 1
     finally:
@@ -139,3 +140,55 @@ def test_nan_and_huge_wheel_speeds_from_an_agent_are_refused():
         s.close()
         world.close()
         threading.Event().wait(0.1)
+
+
+def test_a_killed_agents_body_stays_put_and_a_newcomer_drives_it_on():
+    import time
+
+    from world_server.server import LOST
+
+    scenario = load_scenario("large-maze").with_overrides(agents=3, seed=4, max_ticks=1500)
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "arena-kill", endpoint, deadline=2.0, max_misses=2).start()
+    procs = start_agents(endpoint, "arena-kill", "carrot", 3)
+    try:
+        server = world.server
+        deadline = time.monotonic() + 120
+        while server.tick < 60 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        procs[0].kill()  # kill -9
+        while not (server.slots == LOST).any() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        lost = int(np.flatnonzero(server.slots == LOST)[0])
+        held = server.world.pose[lost].copy()
+        tick = server.tick
+        while server.tick < tick + 20 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        np.testing.assert_array_equal(server.world.pose[lost], held)  # stopped, an obstacle where it stood
+        procs += start_agents(endpoint, "arena-kill", "carrot", 1)  # a newcomer takes the slot over
+        summary = world.join(timeout=240)
+        assert summary["agents_lost"] == 1 and summary["joins"] == 4
+        assert np.hypot(*(server.world.pose[lost, :2] - held[:2])) > 0.05  # driven on from there
+    finally:
+        stop(procs)
+        world.close()
+
+
+def test_real_time_arena_run_reaches_its_goal():
+    scenario = load_scenario("zmaze").with_overrides(noise="none")
+    summary, _ = _distributed(scenario, "arena-rt", [("carrot", 1, 1)], mode="realtime", rate=100.0)
+    assert summary["mode"] == "realtime" and summary["robots"][0]["reached"]
+
+
+def test_swarm_up_runs_an_arena_and_equals_swarm_run():
+    import json
+    import subprocess
+    import sys
+
+    args = ["zmaze", "--noise", "high", "--seed", "5", "--json"]
+    ran = subprocess.run([sys.executable, "-m", "swarm", "run", *args], capture_output=True, text=True, timeout=300)
+    up = subprocess.run([sys.executable, "-m", "swarm", "up", *args, "--no-record", "--listen", free_endpoint()],
+                        capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert up.returncode == 0, up.stderr[-2000:]
+    a, b = json.loads(ran.stdout), json.loads(up.stdout)
+    assert a["robots"] == b["robots"] and a["ticks"] == b["ticks"] and b["rejected_messages"] == 0

@@ -98,6 +98,22 @@ def test_compose_up_swarm_runs_to_the_end_and_records(compose):
     print(f"docker compose up swarm (images built): {took:.1f} s")
 
 
+def test_compose_runs_an_arena_with_the_carrot_controller(compose):
+    """SCENARIO=zmaze CONTROLLER=carrot docker compose up swarm: 64 slots, the 2 agents that join drive."""
+    run_id = f"arena{uuid.uuid4().hex[:6]}"
+    compose.env.update(RUN_ID=run_id, SCENARIO="zmaze", CONTROLLER="carrot", SEED="1", AGENTS="2")
+    compose.env.pop("MAX_AGENTS", None)
+    try:
+        compose("up", "--scale", "agent=2", "swarm", timeout=600)
+        log = compose("logs", "--no-color", "swarm").stdout
+        assert compose.exit_code("swarm") == 0, log
+        assert "zmaze: carrot x2, seed 1, noise low: finished" in log and "reached 2/2" in log, log
+    finally:
+        compose.env["CONTROLLER"] = "cmarking"
+        for recording in (ROOT / "runs").glob(f"{run_id}-*.rrd"):
+            recording.unlink()
+
+
 def test_scaling_a_running_world_from_3_to_5_agents(compose):
     run_id = f"scale{uuid.uuid4().hex[:6]}"
     compose.env.update(RUN_ID=run_id, SCENARIO="setup1", SEED="1", AGENTS="3", MAX_AGENTS="5")

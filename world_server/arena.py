@@ -16,7 +16,7 @@ import numpy as np
 
 from swarm.arena.scenario import ArenaScenario
 from world_server.drive import DiffDrive
-from world_server.raycast import NO_HIT, build_disc_index, build_segment_index, cast_rays, grid_shape
+from world_server.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
 from world_server.sensors import ZONE_KINDS, Suite
 
 ACTION_LEN = 2  # left and right wheel speeds, m/s
@@ -31,7 +31,9 @@ def rect_edges(rect) -> list[tuple[float, float, float, float]]:
 class ArenaWorld:
     kind = "arena"
 
-    def __init__(self, scenario: ArenaScenario, index_cell: float | None = None):
+    def __init__(self, scenario: ArenaScenario, index_cell: float | None = None, parked: bool = False):
+        """`parked`: no robot is in the world yet; each comes in with `enter`
+        (the world server's agents, as they join).  Else all start now."""
         s = self.scenario = scenario
         self.tick = 0
         models = s.robot_models()
@@ -43,18 +45,19 @@ class ArenaWorld:
         self.max_turn = np.array([m.max_turn_rate for m in models])
         self.robot_rgb = np.array([m.colour for m in models], np.uint8).reshape(-1, 3)
         # Geometry: wall rectangles and segments, then every obstacle's edges (switched by seg_on).
-        segs, colours, self.obstacle_segs = [], [], []
+        segs, colours, self.obstacle_segs, self.obstacle_layer = [], [], [], []
         for w in s.walls:
             edges = rect_edges(w.coords) if w.shape == "rect" else [w.coords]
             segs += edges
             colours += [w.colour] * len(edges)
         for o in s.obstacles:
             self.obstacle_segs.append(np.arange(len(segs), len(segs) + 4))
+            self.obstacle_layer.append(SOLID if o.solid else MARK)
             segs += rect_edges(o.rect)
             colours += [o.colour] * 4
         self.segs = np.array(segs, np.float64).reshape(-1, 4)
         self.seg_rgb = np.array(colours, np.uint8).reshape(-1, 3)
-        self.seg_on = np.ones(len(self.segs), np.bool_)
+        self.seg_on = np.full(len(self.segs), SOLID, np.uint8)  # layer bits; 0 while an obstacle is away
         self.extent = (0.0, 0.0, float(s.size[0]), float(s.size[1]))
         self.cell = index_cell or default_cell(s)
         self.nx, self.ny = grid_shape(self.extent, self.cell)
@@ -62,11 +65,14 @@ class ArenaWorld:
         self.s_coords = np.ascontiguousarray(self.segs[self.s_items])
         self.d_start = np.zeros(self.nx * self.ny + 1, np.int64)
         self._grow_discs(4 * self.n + 16)
-        # Bodies and sensors.
-        start = s.start_poses()
-        self.bodies = DiffDrive(start, self.radius, s.wall_rects(), s.wall_segments(), s.control_period, s.substeps)
+        # Bodies and sensors.  A parked robot waits outside the arena, touching nothing.
+        self.in_world = np.full(self.n, not parked)
+        start = np.column_stack([-10.0 - 4 * self.radius.max() * np.arange(self.n), np.full(self.n, -10.0),
+                                 np.zeros(self.n)]) if parked else s.start_poses()  # fmt: skip
+        self.bodies = DiffDrive(start, self.radius, s.wall_rects(), s.wall_segments(), s.control_period, s.substeps,
+                                self.in_world)  # fmt: skip
         self.present = np.ones(self.n, np.bool_)  # False: the agent is gone, its body stays as an obstacle
-        self._bodies_block = np.ones(self.n, np.bool_)  # every body blocks rays, present or not
+        self._bodies_block = self.in_world  # every body in the world blocks rays, present or not
         self.suites: list[Suite] = []
         first = 0
         for g in s.groups:
@@ -93,7 +99,7 @@ class ArenaWorld:
         self.finished = np.zeros(self.n, np.bool_)
         self.path_length = np.zeros(self.n)
         self.rejected = dict.fromkeys(REJECT_REASONS, 0)
-        self.optimum: list[float] | None = None  # L_o per robot, computed once by the summary
+        self.optimum: list[float | None] = [None] * self.n  # L_o per robot, computed once by the summary
         self.start_pose = start.copy()
         self.zones = np.zeros(self.n, np.int64)
         self._update_zones()
@@ -125,8 +131,8 @@ class ArenaWorld:
     def perceive_groups(self) -> list[dict[str, np.ndarray]]:
         """Per group, its robots' readings batched (arrays with a robot axis)."""
         rays = [suite.rays(self.tick) for suite in self.suites]
-        joined = [np.concatenate([r[k] for r in rays]) for k in range(5)] if len(rays) > 1 else list(rays[0])
-        ranges, what = self.cast(joined[0], joined[1], joined[2], (joined[3], joined[4]))
+        joined = [np.concatenate([r[k] for r in rays]) for k in range(6)] if len(rays) > 1 else list(rays[0])
+        ranges, what = self.cast(joined[0], joined[1], joined[2], (joined[3], joined[4]), joined[5])
         rgb = self.hit_colours(what) if any(s.model.sensors.camera for s in self.suites) else None
         out, k = [], 0
         for suite in self.suites:
@@ -143,9 +149,11 @@ class ArenaWorld:
         self.d_xyr = np.zeros((size, 3))
 
     def cast(self, robot: np.ndarray, bearing: np.ndarray, max_range: np.ndarray,
-             cos_sin: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+             cos_sin: tuple[np.ndarray, np.ndarray] | None = None,
+             mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
         """One compiled pass over every ray (robot-major); robots block each
-        other's rays.  `cos_sin` of the bearings may be given (suites cache them)."""
+        other's rays.  `cos_sin` of the bearings may be given (suites cache
+        them); `mask` says which layers each ray sees (default: all)."""
         xy = np.ascontiguousarray(self.pose[:, :2])
         while True:
             got = build_disc_index(xy, self.radius, self._bodies_block, 0.0, 0.0, self.cell, self.nx,
@@ -154,9 +162,11 @@ class ArenaWorld:
                 break
             self._grow_discs(-got + 16)
         c, s = cos_sin if cos_sin is not None else (np.cos(bearing), np.sin(bearing))
+        if mask is None:
+            mask = np.full(len(robot), SOLID | MARK, np.uint8)
         ranges = np.empty(len(robot))
         what = np.empty(len(robot), np.int64)
-        cast_rays(self.pose, robot.astype(np.int64), c, s, max_range, self.s_coords, self.s_items, self.seg_on,
+        cast_rays(self.pose, robot.astype(np.int64), c, s, max_range, mask, self.s_coords, self.s_items, self.seg_on,
                   self.s_start, self.d_xyr, self.d_items, self.d_start, 0.0, 0.0, self.cell, self.nx, self.ny,
                   ranges, what)  # fmt: skip
         return ranges, what
@@ -204,8 +214,8 @@ class ArenaWorld:
             wheels[ok] = np.asarray(actions, np.float64)[ok]
         wheels = self._limit(wheels)
         before = self.pose[:, :2].copy()
-        moving = ok & ~self.finished & self.present
-        self.bodies.drive(wheels, self.axle, moving)
+        moving = ok & ~self.finished & self.present & self.in_world
+        self.bodies.drive(wheels, self.axle, moving, pinned=~self.present & self.in_world)
         self.path_length += np.hypot(*(self.pose[:, :2] - before).T)
         self.tick += 1
         self._obstacles_at(self.tick)
@@ -224,18 +234,23 @@ class ArenaWorld:
     def _obstacles_at(self, tick: int) -> None:
         for k, o in enumerate(self.scenario.obstacles):
             on = o.present(tick)
-            self.seg_on[self.obstacle_segs[k]] = on
-            self.bodies.set_obstacle(k, np.array(o.rect) if on else None)
+            self.seg_on[self.obstacle_segs[k]] = self.obstacle_layer[k] if on else 0
+            if o.solid:
+                self.bodies.set_obstacle(k, np.array(o.rect) if on else None)
 
     def _update_zones(self) -> None:
         self.zones[:] = 0
         xy = self.pose[:, :2]
         for z in self.scenario.zones:
             self.zones |= np.where(z.contains(xy), 1 << ZONE_KINDS.index(z.kind), 0)
+        for o in self.scenario.obstacles:  # resources: usable within their reach while present
+            if o.zone is not None and o.present(self.tick):
+                near = np.hypot(xy[:, 0] - o.centre[0], xy[:, 1] - o.centre[1]) <= o.reach
+                self.zones |= np.where(near, 1 << ZONE_KINDS.index(o.zone), 0)
 
     def _track_goals(self) -> None:
         s = self.scenario
-        for a in np.flatnonzero(self.has_goal & ~self.finished):
+        for a in np.flatnonzero(self.has_goal & ~self.finished & self.in_world):
             x, y = self.pose[a, :2]
             route = self.route[a]
             if route is not None and self.waypoint[a] < len(route) - 1:
@@ -253,7 +268,22 @@ class ArenaWorld:
     def done(self) -> bool:
         if self.tick >= self.scenario.max_ticks:
             return True
-        return bool(self.has_goal.any()) and bool(self.finished[self.has_goal].all())
+        goals = self.has_goal & self.in_world
+        return bool(goals.any()) and bool(self.finished[goals].all())
+
+    def enter(self, agents) -> None:
+        """Parked robots come in: at their given starts, or drawn (in this
+        order) clear of the walls and of every robot already in the world."""
+        agents = [int(a) for a in agents if not self.in_world[a]]
+        if not agents:
+            return
+        inside = np.flatnonzero(self.in_world)
+        poses = self.scenario.place(agents, self.pose[inside, :2], self.radius[inside], self.tick)
+        for a, pose in zip(agents, poses, strict=True):
+            self.bodies.enter(a, pose)
+            self.start_pose[a] = pose
+            self.in_world[a] = True
+        self._update_zones()
 
     def remove_agent(self, agent: int) -> None:
         """The agent is gone: its body stops where it is and stays an obstacle."""
@@ -261,15 +291,16 @@ class ArenaWorld:
 
     # -------------------------------------------------------------- summary
 
-    def robot_summaries(self, optimum: list[float]) -> list[dict[str, Any]]:
+    def robot_summaries(self, optimum: list[float | None]) -> list[dict[str, Any]]:
+        """One row per robot that has been in the world."""
         s = self.scenario
         out = []
         controllers = [g.controller for g in s.groups for _ in range(g.count)]
-        for a in range(self.n):
+        for a in np.flatnonzero(self.in_world).tolist():
             # reached: it dwelt at its goal (a robot pushed off it afterwards keeps that), or ends within the radius
             near = math.hypot(*(self.pose[a, :2] - self.goal[a])) < s.goal_radius
             reached = bool(self.has_goal[a]) and (bool(self.finished[a]) or near)
-            lo = optimum[a]
+            lo = math.inf if optimum[a] is None else optimum[a]
             lp = float(self.path_length[a])
             out.append({
                 "agent": a, "controller": controllers[a],

@@ -19,7 +19,7 @@ from swarm import protocol_arena as arena_proto
 from swarm.arena.engine import arena_summary
 from swarm.arena.scenario import controller_params
 from world_server.arena import ArenaWorld
-from world_server.server import FREE, LOST, WorldServer
+from world_server.server import ACTIVE, FREE, LOST, WorldServer
 
 
 class ArenaServer(WorldServer):
@@ -27,18 +27,17 @@ class ArenaServer(WorldServer):
 
     def _make_world(self) -> None:
         s = self.scenario
-        self.world = ArenaWorld(s)
-        self.world.perceive()  # compile the ray pass now, not in the first tick's deadline
+        ArenaWorld(s).perceive()  # compile the ray pass now, not in the first tick's deadline
+        self.world = ArenaWorld(s, parked=True)  # robots come in as their agents join
         self.controllers = np.array([g.controller for g in s.groups for _ in range(g.count)])
         self.wheels = np.zeros((self.world.n, 2))
         self.ok = np.zeros(self.world.n, np.bool_)
         self.readings: list[dict[str, np.ndarray]] = []
 
     def _open_recorder(self, path, viewer: str | None):
-        from swarm.recording_arena import ArenaRecorder, arena_meta
+        from swarm.recording_arena import ArenaRecorder
 
-        return ArenaRecorder(path, self.world, arena_meta(self.scenario, self.world, self.keys.run, self.mode),
-                             viewer=viewer)  # fmt: skip
+        return ArenaRecorder(path, self.world, {"run_id": self.keys.run, "runtime": self.mode}, viewer=viewer)
 
     # ------------------------------------------------------------------ joins
 
@@ -56,6 +55,11 @@ class ArenaServer(WorldServer):
         return {"family": self.family, "controller": str(self.controllers[agent]),
                 "params": controller_params(self.scenario, agent)}  # fmt: skip
 
+    def _starting(self) -> None:
+        """The robots that start the run come in together, in id order: the
+        same draws as the in-process engine when every agent starts it."""
+        self.world.enter(np.flatnonzero(self.slots == ACTIVE))
+
     def _reuse(self, agent: int) -> None:
         self.world.present[agent] = True
 
@@ -65,6 +69,7 @@ class ArenaServer(WorldServer):
     # ------------------------------------------------------------------ ticks
 
     def _begin_tick(self) -> None:
+        self.world.enter(np.flatnonzero(self.slots == ACTIVE))  # late joiners come in beside the others
         self.ok[:] = False
         self.wheels[:] = 0.0
         if not self.null:

@@ -28,7 +28,7 @@ BLOCKED_SHARE = 0.5  # moving at under half of the commanded speed counts as blo
 
 class DiffDrive:
     def __init__(self, pose: np.ndarray, radius: np.ndarray, rects: np.ndarray, segments: np.ndarray,
-                 period: float, substeps: int):  # fmt: skip
+                 period: float, substeps: int, in_world: np.ndarray | None = None):  # fmt: skip
         import pymunk
         import pymunk.batch
 
@@ -50,7 +50,7 @@ class DiffDrive:
             self._add_static(space, box=rect)
         for seg in segments:
             self._add_static(space, segment=seg)
-        self._bodies = []
+        self._bodies, self._discs = [], []
         for i in range(self.n):
             body = pymunk.Body(1.0, float("inf"))
             body.position = (float(self.pose[i, 0]), float(self.pose[i, 1]))
@@ -58,8 +58,11 @@ class DiffDrive:
             disc.friction = 0.0
             disc.collision_type = ROBOT_TYPE
             disc.robot = i
+            if in_world is not None and not in_world[i]:
+                disc.filter = pymunk.ShapeFilter(categories=0, mask=0)  # parked: touches nothing
             space.add(body, disc)
             self._bodies.append(body)
+            self._discs.append(disc)
         space.on_collision(ROBOT_TYPE, WALL_TYPE, begin=self._begin)
         space.on_collision(ROBOT_TYPE, ROBOT_TYPE, begin=self._begin)
         self.space = space
@@ -107,14 +110,16 @@ class DiffDrive:
         self._batch.get_space_bodies(self.space, fields.POSITION | fields.VELOCITY, self._get)
         return np.frombuffer(self._get.float_buf(), dtype=np.float64)[: 4 * self.n].reshape(self.n, 4).copy()
 
-    def drive(self, wheels: np.ndarray, axle: np.ndarray, moving: np.ndarray) -> None:
+    def drive(self, wheels: np.ndarray, axle: np.ndarray, moving: np.ndarray, pinned: np.ndarray | None = None) -> None:
         """One control period.  `wheels` (n, 2) left/right speeds; robots with
-        moving False hold still (lost agents, finished robots)."""
+        moving False hold still (finished robots, refused actions); `pinned`
+        robots (lost agents) do not even yield to a push: an obstacle."""
         v = np.where(moving, (wheels[:, 0] + wheels[:, 1]) / 2, 0.0)
         w = np.where(moving, (wheels[:, 1] - wheels[:, 0]) / axle, 0.0)
         self.contact[:] = False
         start = self.pose.copy()
         forward = np.zeros(self.n)
+        pinned_at = {} if pinned is None else {int(i): self.pose[i, :2].copy() for i in np.flatnonzero(pinned)}
         state = self._positions()
         for _ in range(self.substeps):
             heading = self.pose[:, 2]
@@ -122,6 +127,9 @@ class DiffDrive:
             self._force[: 2 * self.n] = ((wanted - state[:, 2:]) / self.dt).ravel()
             self._batch.set_space_bodies(self.space, self._batch.BodyFields.FORCE, self._set)
             self.space.step(self.dt)
+            for i in pinned_at:
+                self._bodies[i].position = (float(pinned_at[i][0]), float(pinned_at[i][1]))
+                self._bodies[i].velocity = (0.0, 0.0)
             after = self._positions()
             step = after[:, :2] - state[:, :2]
             dist = np.hypot(step[:, 0], step[:, 1])
@@ -135,6 +143,11 @@ class DiffDrive:
         self.motion[:, 0] = forward
         self.motion[:, 1] = (self.pose[:, 2] - start[:, 2] + math.pi) % (2 * math.pi) - math.pi
         self.sim_seconds += self.period
+
+    def enter(self, i: int, pose: np.ndarray) -> None:
+        """A parked robot comes into the world at `pose`."""
+        self.place(i, pose)
+        self._discs[i].filter = self._pymunk.ShapeFilter()
 
     def place(self, i: int, pose: np.ndarray) -> None:
         self.pose[i] = pose

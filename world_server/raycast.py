@@ -7,6 +7,11 @@ order (Amanatides & Woo), tests only what those cells hold, and stops at the
 first cell that contains its nearest hit: the cost follows the rays' actual
 paths, not the size of the world.  A ray never sees its own robot's disc.
 
+Segments belong to layers: SOLID (walls, boxes: every sensor sees them) and
+MARK (coloured marks that only cameras see, like the BG paper's dangerous
+areas, which the animat sees and drives across).  `seg_on[s]` holds the layer
+bits of segment s (0: not in the world now) and a ray sees what its mask shares.
+
 Hits: `hit >= 0` is a segment index, `hit <= -2` is robot `-2 - hit`,
 `-1` is nothing within range (range reported as the ray's maximum).
 """
@@ -19,6 +24,7 @@ import numpy as np
 from numba import njit
 
 NO_HIT = -1
+SOLID, MARK = 1, 2
 
 
 def grid_shape(extent: tuple[float, float, float, float], cell: float) -> tuple[int, int]:
@@ -132,7 +138,7 @@ def _hit_disc(ox, oy, dx, dy, cx, cy, r):
 
 
 @njit(cache=True)
-def cast_one(ox, oy, dx, dy, rmax, me, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids, d_start,
+def cast_one(ox, oy, dx, dy, rmax, me, mask, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids, d_start,
              x0, y0, cell, nx, ny):  # fmt: skip
     """Nearest hit of one ray: (distance, what).  The cells' contents are kept
     in cell order (coordinates beside ids), so a ray reads memory in sequence."""
@@ -155,7 +161,7 @@ def cast_one(ox, oy, dx, dy, rmax, me, s_coords, s_ids, seg_on, s_start, d_xyr, 
     while True:
         c = cy * nx + cx
         for k in range(s_start[c], s_start[c + 1]):
-            if seg_on[s_ids[k]]:
+            if seg_on[s_ids[k]] & mask:
                 t = _hit_segment(ox, oy, dx, dy, s_coords[k, 0], s_coords[k, 1], s_coords[k, 2], s_coords[k, 3])
                 if t < best:
                     best, what = t, s_ids[k]
@@ -184,11 +190,11 @@ def cast_one(ox, oy, dx, dy, rmax, me, s_coords, s_ids, seg_on, s_start, d_xyr, 
 
 
 @njit(cache=True)
-def cast_rays(pose, ray_robot, ray_cos, ray_sin, ray_range, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids,
+def cast_rays(pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids,
               d_start, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
     """Cast every ray: ray k leaves the centre of robot ray_robot[k] at the
     bearing whose cosine and sine are ray_cos[k], ray_sin[k] (from its heading)
-    and reaches at most ray_range[k].  Rays come robot by robot, so the
+    and reaches at most ray_range[k], seeing the layers of ray_mask[k].  Rays come robot by robot, so the
     heading's cosine and sine are computed once per robot."""
     last, ch, sh = -1, 1.0, 0.0
     for k in range(ray_robot.shape[0]):
@@ -197,7 +203,7 @@ def cast_rays(pose, ray_robot, ray_cos, ray_sin, ray_range, s_coords, s_ids, seg
             last, ch, sh = r, math.cos(pose[r, 2]), math.sin(pose[r, 2])
         dx = ch * ray_cos[k] - sh * ray_sin[k]
         dy = sh * ray_cos[k] + ch * ray_sin[k]
-        d, w = cast_one(pose[r, 0], pose[r, 1], dx, dy, ray_range[k], r, s_coords, s_ids, seg_on, s_start,
+        d, w = cast_one(pose[r, 0], pose[r, 1], dx, dy, ray_range[k], r, ray_mask[k], s_coords, s_ids, seg_on, s_start,
                         d_xyr, d_ids, d_start, x0, y0, cell, nx, ny)  # fmt: skip
         out_range[k] = d
         out_hit[k] = w
@@ -213,6 +219,7 @@ def brute_force(
     seg_on: np.ndarray,
     xy: np.ndarray,
     radius: np.ndarray,
+    mask: int = SOLID | MARK,
 ) -> tuple[float, int]:
     """Every segment and disc, numpy: the reference the index is tested against."""
     dx, dy = math.cos(angle), math.sin(angle)
@@ -222,7 +229,7 @@ def brute_force(
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (wx * ey - wy * ex) / den
         s = (wx * dy - wy * dx) / den
-    ok = seg_on & (np.abs(den) >= 1e-15) & (t >= 0) & (s >= 0) & (s <= 1)
+    ok = ((seg_on & mask) != 0) & (np.abs(den) >= 1e-15) & (t >= 0) & (s >= 0) & (s <= 1)
     ts = np.where(ok, t, np.inf)
     cx, cy = xy[:, 0] - ox, xy[:, 1] - oy
     b = cx * dx + cy * dy

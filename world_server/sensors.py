@@ -17,6 +17,7 @@ import numpy as np
 
 from swarm.arena.models import IR_DISTANCE, IR_VALUE, RobotModel
 from swarm.rng import fill_normal, fill_uniform
+from world_server.raycast import MARK, SOLID
 
 # Noise streams, one per kind of draw.
 S_SONAR_BEARING, S_SONAR_RANGE, S_IR, S_LASER, S_ODOMETRY, S_COMPASS, S_POSITION = range(1, 8)
@@ -67,7 +68,7 @@ class Suite:
     def __init__(self, model: RobotModel, robots: np.ndarray, noise: Noise, seed: int):
         self.model, self.robots, self.noise, self.seed = model, np.asarray(robots, np.int64), noise, seed
         s = model.sensors
-        bearings, ranges, offsets = [], [], []
+        bearings, ranges, offsets, masks = [], [], [], []
         self.blocks: dict[str, slice] = {}
 
         def add(name: str, b: np.ndarray, rng: float, offset: float = 0.0) -> None:
@@ -75,6 +76,7 @@ class Suite:
             bearings.append(np.asarray(b, np.float64))
             ranges.append(np.full(len(b), rng + offset))
             offsets.append(np.full(len(b), offset))
+            masks.append(np.full(len(b), SOLID | MARK if name == "camera" else SOLID, np.uint8))
             self.blocks[name] = slice(start, start + len(b))
 
         if s.camera:
@@ -98,23 +100,31 @@ class Suite:
         self.bearings = np.concatenate(bearings) if bearings else np.zeros(0)
         self.ranges = np.concatenate(ranges) if ranges else np.zeros(0)
         self.offsets = np.concatenate(offsets) if offsets else np.zeros(0)
+        self.masks = np.concatenate(masks) if masks else np.zeros(0, np.uint8)
         self.per_robot = len(self.bearings)
 
     # ------------------------------------------------------------------ rays
 
     def rays(self, tick: int) -> tuple[np.ndarray, ...]:
-        """(robot, bearing, range, cos, sin of bearing) of every ray of the group,
-        robot-major.  The sonar's bearing error turns each cone as a whole; the
+        """(robot, bearing, range, cos, sin of bearing, layer mask) of every ray
+        of the group, robot-major (cameras see marks, range sensors only
+        solids).  The sonar's bearing error turns each cone as a whole; the
         other bearings are fixed, so their cosines are computed once."""
         n = len(self.robots)
         if not hasattr(self, "_fixed"):
             bearing = np.tile(self.bearings, n)
-            self._fixed = (np.repeat(self.robots, self.per_robot), bearing, np.tile(self.ranges, n),
-                           np.cos(bearing), np.sin(bearing))  # fmt: skip
+            self._fixed = (
+                np.repeat(self.robots, self.per_robot),
+                bearing,
+                np.tile(self.ranges, n),
+                np.cos(bearing),
+                np.sin(bearing),
+                np.tile(self.masks, n),
+            )
         sonar = self.model.sensors.sonar
         if not (sonar and self.noise.factor("sonar") and sonar.bearing_error):
             return self._fixed
-        robot, bearing, ranges, c, s = self._fixed
+        robot, bearing, ranges, c, s, masks = self._fixed
         u = self._uniform(S_SONAR_BEARING, sonar.count, tick) * sonar.bearing_error * self.noise.factor("sonar")
         turned = bearing.reshape(n, self.per_robot).copy()
         turned[:, self.blocks["sonar"]] += np.repeat(u, sonar.cone_rays, axis=1)
@@ -124,7 +134,7 @@ class Suite:
         b[:, self.blocks["sonar"]] = True
         b = b.ravel()
         c[b], s[b] = np.cos(turned[b]), np.sin(turned[b])
-        return robot, turned, ranges, c, s
+        return robot, turned, ranges, c, s, masks
 
     def _uniform(self, stream: int, k: int, tick: int) -> np.ndarray:
         out = np.empty((len(self.robots), k))

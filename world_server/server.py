@@ -164,6 +164,9 @@ class WorldServer:
     def _remove(self, agent: int) -> None:
         """An agent is lost during the run."""
 
+    def _starting(self) -> None:
+        """The agents that start the run have joined; the first tick is next."""
+
     def _begin_tick(self) -> None:
         """Before the tick's observations go out."""
 
@@ -390,6 +393,7 @@ class WorldServer:
     def run(self) -> dict:
         if not (self.resumed and self.done()):  # a finished run resumed has nothing left to do
             self.wait_for_agents()
+        self._starting()
         self.started = time.monotonic()
         while not self.done() and self.tick < self.max_iterations:
             if not (self.slots == ACTIVE).any():

@@ -28,13 +28,18 @@ def _planner(size: tuple[float, float], walls: tuple) -> Planner:
     return Planner(size, rects, segments, cell, OPTIMUM_CLEARANCE)
 
 
-def optimal_lengths(s: ArenaScenario, starts: np.ndarray) -> list[float]:
+def optimal_lengths(s: ArenaScenario, starts: np.ndarray, which=None) -> list[float | None]:
     """L_o per robot: A* (1 cm, 4 cm clearance) from its true start through its
-    route or to its goal; inf when there is none or no path keeps the clearance."""
+    route or to its goal; inf when there is none or no path keeps the clearance.
+    Only robots in `which` (default all); None for the others."""
     planner = _planner(s.size, s.walls)
     routes = [s.routes[g.route] if g.route else None for g in s.groups for _ in range(g.count)]
-    out = []
+    which = set(range(len(starts))) if which is None else set(which)
+    out: list[float | None] = []
     for a, goal in enumerate(s.goals()):
+        if a not in which:
+            out.append(None)
+            continue
         targets = routes[a] or ([goal] if goal is not None else [])
         here, total = (float(starts[a, 0]), float(starts[a, 1])), 0.0 if targets else math.inf
         for t in targets:
@@ -101,8 +106,11 @@ class ArenaEngine:
 
 def arena_summary(world: ArenaWorld, wall_seconds: float, runtime: str) -> dict[str, Any]:
     s = world.scenario
-    if world.optimum is None:
-        world.optimum = optimal_lengths(s, world.start_pose)  # A* once per run: the starts do not change
+    missing = [a for a in np.flatnonzero(world.in_world).tolist() if world.optimum[a] is None]
+    if missing:  # A* once per robot: its start does not change once it is in
+        for a, lo in enumerate(optimal_lengths(s, world.start_pose, missing)):
+            if lo is not None:
+                world.optimum[a] = lo
     robots = world.robot_summaries(world.optimum)
     goals = [r for r in robots if r["goal"] is not None]
     ratios = [r["path_ratio"] for r in robots if r["path_ratio"] is not None]
@@ -110,13 +118,14 @@ def arena_summary(world: ArenaWorld, wall_seconds: float, runtime: str) -> dict[
         "scenario": s.name,
         "kind": "arena",
         "controller": s.controller,
-        "agents": s.agents,
+        "agents": len(robots),
         "seed": s.seed,
         "noise": s.noise.level,
         "runtime": runtime,
         "ticks": world.tick,
         "iterations": world.tick,
-        "finished": bool(goals) and all(r["reached"] for r in goals),
+        # with goals: all reached; without (explorers, survival): the run went its full length
+        "finished": all(r["reached"] for r in goals) if goals else world.tick >= s.max_ticks,
         "reached": sum(r["reached"] for r in goals),
         "with_goal": len(goals),
         "sim_seconds": round(world.tick * s.control_period, 3),

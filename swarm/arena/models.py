@@ -145,7 +145,8 @@ EPUCK = RobotModel(
 )
 
 # A mobile base with a 360-degree laser scanner and a panoramic colour camera
-# (Tapus et al. 2006 used two back-to-back laser scanners and an omnidirectional camera).
+# (Tapus et al. 2006 used two back-to-back laser scanners and an omnidirectional camera),
+# and a position sensor so a controller can drive a prescribed tour.
 SCOUT = RobotModel(
     name="scout",
     radius=0.20,
@@ -159,6 +160,7 @@ SCOUT = RobotModel(
         laser=Laser(beams=360, range=8.0),
         odometry=Odometry(),
         compass=Compass(error=2 * DEG),
+        position=Position(),  # for driving a prescribed tour, as the paper's robot was driven; not a map input
     ),
 )
 

@@ -44,6 +44,7 @@ from world_server.sensors import NOISE_LEVELS, ZONE_KINDS, Noise
 
 ARENA_CONTROLLERS = ("carrot", "wander")
 START_STREAM = 0x53544152  # keeps start-pose draws apart from every other use of the seed
+GOAL_STREAM = 0x474F414C
 MAX_DRAWS = 10_000
 Colour = tuple[int, int, int]
 GREY = (128, 128, 128)
@@ -74,14 +75,30 @@ class Zone:
 
 @dataclass(frozen=True)
 class Obstacle:
+    """A box present from tick `appear` until `vanish`.  A resource is one too:
+    it carries a zone of its kind, a disc of radius `reach` round its centre,
+    usable while it is present; a non-solid box is a mark only cameras see."""
+
     rect: tuple[float, float, float, float]
     appear: int = 0
     vanish: int | None = None  # tick at which it goes; None: stays
     colour: Colour = GREY
     name: str = ""
+    solid: bool = True
+    zone: str | None = None
+    reach: float = 0.7
 
     def present(self, tick: int) -> bool:
         return tick >= self.appear and (self.vanish is None or tick < self.vanish)
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        return ((self.rect[0] + self.rect[2]) / 2, (self.rect[1] + self.rect[3]) / 2)
+
+
+# The BG paper's resources: 50 x 50 cm squares, usable within 70 cm of their centre.
+RESOURCE_GREY = {"ingesting": 127, "digesting": 255, "dangerous": 31}
+RESOURCE_SIZE, RESOURCE_REACH = 0.5, 0.7
 
 
 @dataclass(frozen=True)
@@ -92,6 +109,7 @@ class Group:
     starts: tuple[tuple[float, float, float], ...] | None = None  # None: drawn with `clearance`
     clearance: float = 0.04
     goals: tuple[tuple[float, float], ...] | None = None  # one per robot, or one for all
+    draw_goals: bool = False  # a goal per robot, drawn from (seed, agent) with the clearance
     route: str | None = None
 
 
@@ -144,8 +162,9 @@ class ArenaScenario:
                                     "change the counts in the file")  # fmt: skip
             g = groups[0]
             starts = g.starts if g.starts and len(g.starts) == agents else None  # else drawn
-            goals = g.goals if g.goals and len(g.goals) in (1, agents) else None
-            groups[0] = replace(g, count=agents, starts=starts, goals=goals)
+            # one robot's goal does not become a shared one: more robots get a goal each, drawn
+            draw = g.draw_goals or (g.goals is not None and len(g.goals) != agents)
+            groups[0] = replace(g, count=agents, starts=starts, goals=None if draw else g.goals, draw_goals=draw)
         if controller is not None:
             _check_controller(controller, "command line", "controller")
             groups = [replace(g, controller=controller) for g in groups]
@@ -158,7 +177,7 @@ class ArenaScenario:
                 theta = start[2] if len(start) > 2 else (g.starts[0][2] if g.starts else 0.0)
                 g = replace(g, starts=((float(start[0]), float(start[1]), float(theta)),))
             if goal is not None:
-                g = replace(g, goals=((float(goal[0]), float(goal[1])),), route=None)
+                g = replace(g, goals=((float(goal[0]), float(goal[1])),), route=None, draw_goals=False)
             groups[0] = g
         new = replace(
             self,
@@ -192,22 +211,33 @@ class ArenaScenario:
         """Every robot's start pose: given, or drawn from (seed, agent) with the
         group's clearance from walls, obstacles present at tick 0 and the robots
         placed before it."""
-        poses: list[tuple[float, float, float]] = []
-        radii: list[float] = []
-        agent = 0
-        for gi, g in enumerate(self.groups):
-            for k in range(g.count):
-                if g.starts is not None:
-                    poses.append(g.starts[k])
-                else:
-                    poses.append(self._draw_pose(agent, g.robot.radius + g.clearance, poses, radii, f"group {gi + 1}"))
-                radii.append(g.robot.radius)
-                agent += 1
+        return self.place(range(self.agents), np.zeros((0, 2)), np.zeros(0), 0)
+
+    def place(self, agents, occupied: np.ndarray, occupied_radius: np.ndarray, tick: int) -> np.ndarray:
+        """Start poses for `agents` (in this order) entering at `tick` beside robots
+        already at `occupied` (x, y) with these radii: the given starts, or drawn."""
+        groups = [(gi, g) for gi, g in enumerate(self.groups) for _ in range(g.count)]
+        first = {}
+        for k, (gi, _) in enumerate(groups):
+            first.setdefault(gi, k)
+        placed = [tuple(p) for p in np.asarray(occupied, np.float64).reshape(-1, 2)]
+        radii = [float(r) for r in occupied_radius]
+        poses = []
+        for agent in agents:
+            gi, g = groups[agent]
+            if g.starts is not None:
+                pose = g.starts[agent - first[gi]]
+            else:
+                pose = self._draw_pose(agent, g.robot.radius + g.clearance, placed, radii, f"group {gi + 1}", tick)
+            poses.append(pose)
+            placed.append(pose[:2])
+            radii.append(g.robot.radius)
         return np.array(poses, np.float64).reshape(-1, 3)
 
-    def _draw_pose(self, agent: int, clearance: float, placed, radii, where: str) -> tuple[float, float, float]:
+    def _draw_pose(self, agent: int, clearance: float, placed, radii, where: str,
+                   tick: int = 0) -> tuple[float, float, float]:  # fmt: skip
         rng = np.random.default_rng([self.seed, START_STREAM, agent])
-        blocks = self.blocking_rects(0)
+        blocks = self.blocking_rects(tick)
         segs = self.wall_segments()
         w, h = self.size
         for _ in range(MAX_DRAWS):
@@ -218,21 +248,49 @@ class ArenaScenario:
             if any(math.hypot(x - p[0], y - p[1]) < clearance + r for p, r in zip(placed, radii, strict=True)):
                 continue
             return (float(x), float(y), float(theta))
-        raise ScenarioError(self.source, f"{where}: starts", f"no free place with clearance {clearance:g} m in "
-                            f"{MAX_DRAWS} draws; give starts or fewer robots")  # fmt: skip
+        raise ScenarioError(self.source, f"{where}: starts", f"no free place with clearance {clearance:g} m for robot "
+                            f"{agent} in {MAX_DRAWS} draws; give starts or fewer robots (--agents)")  # fmt: skip
 
     def blocking_rects(self, tick: int) -> np.ndarray:
         """Wall rectangles plus the obstacles present at `tick`."""
         rects = [w.coords for w in self.walls if w.shape == "rect"]
-        rects += [o.rect for o in self.obstacles if o.present(tick)]
+        rects += [o.rect for o in self.obstacles if o.present(tick) and o.solid]
         return np.array(rects, np.float64).reshape(-1, 4)
 
     def goals(self) -> list[tuple[float, float] | None]:
+        """Every robot's goal (None: it has none).  Drawn goals keep the group's
+        clearance from walls and twice the goal radius from the goals drawn
+        before them, so robots do not crowd one spot; each comes from
+        (seed, agent), so it does not depend on who else is in the run."""
+        if "_goals" in self.__dict__:
+            return self.__dict__["_goals"]
         out: list[tuple[float, float] | None] = []
-        for g in self.groups:
+        drawn: list[tuple[float, float]] = []
+        agent = 0
+        for gi, g in enumerate(self.groups):
             for k in range(g.count):
-                out.append(None if g.goals is None else g.goals[k if len(g.goals) > 1 else 0])
+                if g.draw_goals:
+                    goal = self._draw_goal(agent, g.robot.radius + g.clearance, drawn, f"group {gi + 1}")
+                    drawn.append(goal)
+                    out.append(goal)
+                else:
+                    out.append(None if g.goals is None else g.goals[k if len(g.goals) > 1 else 0])
+                agent += 1
+        self.__dict__["_goals"] = out  # frozen: cached beside the fields, not through them
         return out
+
+    def _draw_goal(self, agent: int, clearance: float, drawn, where: str) -> tuple[float, float]:
+        rng = np.random.default_rng([self.seed, GOAL_STREAM, agent])
+        blocks, segs = self.blocking_rects(0), self.wall_segments()
+        w, h = self.size
+        for _ in range(MAX_DRAWS):
+            x, y = rng.uniform(clearance, w - clearance), rng.uniform(clearance, h - clearance)
+            if clearance_at(np.array([[x, y]]), blocks, segs)[0] < clearance:
+                continue
+            if all(math.hypot(x - gx, y - gy) >= 2 * self.goal_radius for gx, gy in drawn):
+                return (float(x), float(y))
+        raise ScenarioError(self.source, f"{where}: goals", f"no free place for goal {agent} in {MAX_DRAWS} draws; "
+                            "give goals or fewer robots")  # fmt: skip
 
 
 def clearance_at(xy: np.ndarray, rects: np.ndarray, segs: np.ndarray) -> np.ndarray:
@@ -253,8 +311,27 @@ def clearance_at(xy: np.ndarray, rects: np.ndarray, segs: np.ndarray) -> np.ndar
 
 # --------------------------------------------------------------------- parsing
 
-_TOP = {"kind", "name", "description", "seed", "size", "robot", "noise", "control_period", "substeps", "max_ticks",
-        "goal_radius", "goal_dwell", "wall", "zone", "obstacle", "group", "routes", *ARENA_CONTROLLERS}  # fmt: skip
+_TOP = {
+    "kind",
+    "name",
+    "description",
+    "seed",
+    "size",
+    "robot",
+    "noise",
+    "control_period",
+    "substeps",
+    "max_ticks",
+    "goal_radius",
+    "goal_dwell",
+    "wall",
+    "zone",
+    "obstacle",
+    "resource",
+    "group",
+    "routes",
+    *ARENA_CONTROLLERS,
+}
 _SENSORS = {"camera": Camera, "sonar": Sonar, "ir": IR, "laser": Laser, "odometry": Odometry, "compass": Compass,
             "position": Position}  # fmt: skip
 
@@ -280,8 +357,9 @@ def parse_arena(data: dict, source: str, default_name: str) -> ArenaScenario:
     kw["noise"] = _noise(data.get("noise", "low"), source)
     kw["walls"] = tuple(_wall(w, source, f"wall {i + 1}") for i, w in enumerate(_list(data, "wall", source)))
     kw["zones"] = tuple(_zone(z, source, f"zone {i + 1}") for i, z in enumerate(_list(data, "zone", source)))
-    kw["obstacles"] = tuple(_obstacle(o, source, f"obstacle {i + 1}")
-                            for i, o in enumerate(_list(data, "obstacle", source)))  # fmt: skip
+    obstacles = [_obstacle(o, source, f"obstacle {i + 1}") for i, o in enumerate(_list(data, "obstacle", source))]
+    obstacles += [_resource(r, source, f"resource {i + 1}") for i, r in enumerate(_list(data, "resource", source))]
+    kw["obstacles"] = tuple(obstacles)  # resources are obstacles that carry a zone
     routes = data.get("routes", {})
     if not isinstance(routes, dict):
         raise ScenarioError(source, "routes", "expected a [routes] table of name = [[x, y], ...]")
@@ -407,6 +485,30 @@ def _obstacle(o, source: str, where: str) -> Obstacle:
                     o.get("name", ""))  # fmt: skip
 
 
+def _resource(r, source: str, where: str) -> Obstacle:
+    if not isinstance(r, dict):
+        raise ScenarioError(source, where, "expected a [[resource]] table")
+    _no_unknown(r, {"kind", "centre", "size", "reach", "appear", "vanish", "colour", "name"}, source,
+                f"[[resource]] ({where})")  # fmt: skip
+    kind = _get(r, "kind", str, source, None, f"{where}.kind")
+    if kind not in RESOURCE_GREY:
+        raise ScenarioError(source, f"{where}.kind", f"unknown {kind!r}; expected one of {', '.join(RESOURCE_GREY)}")
+    cx, cy = _numbers(r, "centre", source, f"{where}.centre", 2)
+    size = float(_get(r, "size", (int, float), source, RESOURCE_SIZE, f"{where}.size"))
+    reach = float(_get(r, "reach", (int, float), source, RESOURCE_REACH, f"{where}.reach"))
+    if not (0 < size <= 10 and 0 < reach <= 100):
+        raise ScenarioError(source, where, f"expected a size of 0-10 m and a reach of 0-100 m, got {size}, {reach}")
+    appear = _get(r, "appear", int, source, 0, f"{where}.appear")
+    vanish = _get(r, "vanish", int, source, None, f"{where}.vanish")
+    if appear < 0 or (vanish is not None and vanish <= appear):
+        raise ScenarioError(source, where, f"expected 0 <= appear < vanish (ticks), got {appear}, {vanish}")
+    colour = _colour(r.get("colour", RESOURCE_GREY[kind]), source, f"{where}.colour")
+    half = size / 2
+    return Obstacle((cx - half, cy - half, cx + half, cy + half), appear, vanish, colour,
+                    _get(r, "name", str, source, kind, f"{where}.name"), solid=kind != "dangerous", zone=kind,
+                    reach=reach)  # fmt: skip
+
+
 def _group(g, robot: RobotModel, source: str, where: str) -> Group:
     if not isinstance(g, dict):
         raise ScenarioError(source, where, "expected a [[group]] table")
@@ -424,15 +526,15 @@ def _group(g, robot: RobotModel, source: str, where: str) -> Group:
         )
         if len(starts) != count:
             raise ScenarioError(source, f"{where}.starts", f"expected {count} poses (one per robot), got {len(starts)}")
-    goals = None
-    if "goal" in g or "goals" in g:
+    goals, draw_goals = None, g.get("goals") == "drawn"  # goals = "drawn": one each, from the seed
+    if not draw_goals and ("goal" in g or "goals" in g):
         raw = [g["goal"]] if "goal" in g else g["goals"]
         goals = tuple(_point_list(raw, source, f"{where}.goals", 2))
         if len(goals) not in (1, count):
             raise ScenarioError(source, f"{where}.goals", f"expected 1 or {count} goals, got {len(goals)}")
     clearance = float(_get(g, "clearance", (int, float), source, 0.04, f"{where}.clearance"))
-    return Group(count, controller, model, starts, clearance, goals,  # type: ignore[arg-type]
-                 _get(g, "route", str, source, None, f"{where}.route"))  # fmt: skip
+    route = _get(g, "route", str, source, None, f"{where}.route")
+    return Group(count, controller, model, starts, clearance, goals, draw_goals=draw_goals, route=route)  # type: ignore[arg-type]
 
 
 # ------------------------------------------------------------------ validation

@@ -4,8 +4,10 @@ The carrot p_c is the path point nearest to the look-ahead point p_look, k_look
 straight ahead of the robot; the steering angle is phi = k_fic * (phi_c - phi_h),
 phi_c the bearing of the carrot, phi_h the heading.  The paper leaves three
 things open; our choices (docs/arena.md):
-- the search for p_c runs forward from the last carrot over `window` points, so
-  the carrot never jumps back to an earlier stretch that passes close by;
+- the search for p_c runs forward from the last carrot to the first local
+  minimum of the distance (at most `window` points on), so the carrot never
+  jumps back to an earlier stretch, nor across a fold to a later stretch that
+  passes close by (a route into a room and out again);
 - phi is the turn rate (rad/s) and the forward speed is speed * max(0, cos(error)),
   so the robot turns on the spot when the carrot is behind it;
 - the wheel speeds keep their ratio when one would exceed the wheel limit.
@@ -31,7 +33,9 @@ class CarrotFollower:
     def carrot(self, x: float, y: float, heading: float) -> np.ndarray:
         look = np.array([x + self.k_look * math.cos(heading), y + self.k_look * math.sin(heading)])
         ahead = self.path[self.index : self.index + self.window]
-        self.index += int(np.argmin(((ahead - look) ** 2).sum(axis=1)))
+        d = ((ahead - look) ** 2).sum(axis=1)
+        rising = np.flatnonzero(d[1:] > d[:-1])  # the first point after which the distance grows
+        self.index += int(rising[0]) if len(rising) else len(d) - 1
         return self.path[self.index]
 
     def wheels(self, x: float, y: float, heading: float, axle: float, max_wheel: float) -> tuple[float, float]:
