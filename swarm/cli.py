@@ -530,8 +530,9 @@ def cmd_status(args) -> int:
         print(f"router at {args.connect}: up")
     else:
         state = "ended" if info.get("ended") else "running"
-        print(f"run {args.run_id}: {state} at tick {info['iterations']}, delivered {info['delivered']}/"
-              f"{info['total']}, {info['agents_alive']} agents alive")  # fmt: skip
+        done = (f"reached {info['reached']}/{info['with_goal']}" if info.get("kind") == "arena"
+                else f"delivered {info['delivered']}/{info['total']}")  # fmt: skip
+        print(f"run {args.run_id}: {state} at tick {info['iterations']}, {done}, {info['agents_alive']} agents alive")
     return 0
 
 

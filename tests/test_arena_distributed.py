@@ -192,3 +192,18 @@ def test_swarm_up_runs_an_arena_and_equals_swarm_run():
     assert up.returncode == 0, up.stderr[-2000:]
     a, b = json.loads(ran.stdout), json.loads(up.stdout)
     assert a["robots"] == b["robots"] and a["ticks"] == b["ticks"] and b["rejected_messages"] == 0
+
+
+def test_swarm_status_answers_for_an_arena_world():
+    import subprocess
+    import sys
+
+    endpoint = free_endpoint()
+    world = ServerThread(load_scenario("zmaze"), "arena-status", endpoint, start_timeout=5.0).start()
+    try:
+        out = subprocess.run([sys.executable, "-m", "swarm", "status", "--connect", endpoint, "--run-id",
+                              "arena-status"], capture_output=True, text=True, timeout=60)  # fmt: skip
+        assert out.returncode == 0 and "reached 0/0" in out.stdout and "Traceback" not in out.stderr, out.stderr
+    finally:
+        world.finished.wait(10)  # no agent comes: the world gives up waiting
+        world.close()

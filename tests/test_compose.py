@@ -104,9 +104,11 @@ def test_compose_runs_an_arena_with_the_carrot_controller(compose):
     compose.env.update(RUN_ID=run_id, SCENARIO="zmaze", CONTROLLER="carrot", SEED="1", AGENTS="2")
     compose.env.pop("MAX_AGENTS", None)
     try:
-        compose("up", "--scale", "agent=2", "swarm", timeout=600)
+        up = compose("up", "--scale", "agent=2", "swarm", timeout=600, check=False)
+        world_log = compose("logs", "--no-color", "world").stdout
+        assert up.returncode == 0, up.stdout[-2000:] + up.stderr[-2000:] + world_log[-3000:]
         log = compose("logs", "--no-color", "swarm").stdout
-        assert compose.exit_code("swarm") == 0, log
+        assert compose.exit_code("swarm") == 0, up.stdout[-3000:] + up.stderr[-3000:] + log
         assert "zmaze: carrot x2, seed 1, noise low: finished" in log and "reached 2/2" in log, log
     finally:
         compose.env["CONTROLLER"] = "cmarking"

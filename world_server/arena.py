@@ -132,7 +132,14 @@ class ArenaWorld:
         """Per group, its robots' readings batched (arrays with a robot axis)."""
         rays = [suite.rays(self.tick) for suite in self.suites]
         joined = [np.concatenate([r[k] for r in rays]) for k in range(6)] if len(rays) > 1 else list(rays[0])
-        ranges, what = self.cast(joined[0], joined[1], joined[2], (joined[3], joined[4]), joined[5])
+        if self.in_world.all():
+            ranges, what = self.cast(joined[0], joined[1], joined[2], (joined[3], joined[4]), joined[5])
+        else:  # parked robots sense nothing: only the rays of robots in the world are cast
+            ranges, what = joined[2].copy(), np.full(len(joined[0]), NO_HIT, np.int64)
+            keep = self.in_world[joined[0]]
+            if keep.any():
+                ranges[keep], what[keep] = self.cast(*(part[keep] for part in joined[:3]),
+                                                     (joined[3][keep], joined[4][keep]), joined[5][keep])  # fmt: skip
         rgb = self.hit_colours(what) if any(s.model.sensors.camera for s in self.suites) else None
         out, k = [], 0
         for suite in self.suites:

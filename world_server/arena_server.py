@@ -27,8 +27,8 @@ class ArenaServer(WorldServer):
 
     def _make_world(self) -> None:
         s = self.scenario
-        ArenaWorld(s).perceive()  # compile the ray pass now, not in the first tick's deadline
         self.world = ArenaWorld(s, parked=True)  # robots come in as their agents join
+        self.world.cast(np.zeros(1, np.int64), np.zeros(1), np.ones(1))  # compile the ray pass now, not in a deadline
         self.controllers = np.array([g.controller for g in s.groups for _ in range(g.count)])
         self.wheels = np.zeros((self.world.n, 2))
         self.ok = np.zeros(self.world.n, np.bool_)

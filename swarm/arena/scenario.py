@@ -45,6 +45,7 @@ from world_server.sensors import NOISE_LEVELS, ZONE_KINDS, Noise
 ARENA_CONTROLLERS = ("carrot", "wander")
 START_STREAM = 0x53544152  # keeps start-pose draws apart from every other use of the seed
 GOAL_STREAM = 0x474F414C
+SPACED_DRAWS = 200
 MAX_DRAWS = 10_000
 Colour = tuple[int, int, int]
 GREY = (128, 128, 128)
@@ -259,9 +260,9 @@ class ArenaScenario:
 
     def goals(self) -> list[tuple[float, float] | None]:
         """Every robot's goal (None: it has none).  Drawn goals keep the group's
-        clearance from walls and twice the goal radius from the goals drawn
-        before them, so robots do not crowd one spot; each comes from
-        (seed, agent), so it does not depend on who else is in the run."""
+        clearance from walls and, where there is room, twice the goal radius
+        from the goals of lower ids, so robots do not crowd one spot; each comes
+        from (seed, agent) and the goals before it, never from who joined when."""
         if "_goals" in self.__dict__:
             return self.__dict__["_goals"]
         out: list[tuple[float, float] | None] = []
@@ -280,17 +281,19 @@ class ArenaScenario:
         return out
 
     def _draw_goal(self, agent: int, clearance: float, drawn, where: str) -> tuple[float, float]:
+        """Apart from the goals before it when there is room (SPACED_DRAWS tries), else
+        anywhere clear of the walls: a world of many slots never fails for it."""
         rng = np.random.default_rng([self.seed, GOAL_STREAM, agent])
         blocks, segs = self.blocking_rects(0), self.wall_segments()
         w, h = self.size
-        for _ in range(MAX_DRAWS):
+        for attempt in range(MAX_DRAWS):
             x, y = rng.uniform(clearance, w - clearance), rng.uniform(clearance, h - clearance)
             if clearance_at(np.array([[x, y]]), blocks, segs)[0] < clearance:
                 continue
-            if all(math.hypot(x - gx, y - gy) >= 2 * self.goal_radius for gx, gy in drawn):
+            if attempt >= SPACED_DRAWS or all(math.hypot(x - gx, y - gy) >= 2 * self.goal_radius for gx, gy in drawn):
                 return (float(x), float(y))
-        raise ScenarioError(self.source, f"{where}: goals", f"no free place for goal {agent} in {MAX_DRAWS} draws; "
-                            "give goals or fewer robots")  # fmt: skip
+        raise ScenarioError(self.source, f"{where}: goals", f"no place {clearance:g} m clear of the walls for goal "
+                            f"{agent} in {MAX_DRAWS} draws; give goals")  # fmt: skip
 
 
 def clearance_at(xy: np.ndarray, rects: np.ndarray, segs: np.ndarray) -> np.ndarray:
