@@ -222,17 +222,26 @@ def parse_obs(data: bytes) -> Obs | Rejected | dict:
     return Obs(tick, agents, cells, pi, pf)
 
 
-def parse_acts(data: bytes) -> Acts | Rejected:
+def act_header(data: bytes, family: str) -> tuple[dict, int, np.ndarray] | Rejected:
+    """What every family's action message shares: (message, tick, agents)."""
     m = unpack(data)
     if isinstance(m, Rejected):
         return m
     if m.get("type") != "act":
         return Rejected("not an action")
-    if m.get("family") != FAMILY_GRID:
+    if m.get("family") != family:
         return Rejected("unknown controller family")
     tick, agents = int_field(m, "tick"), int_list(m, "agents")
     if bad := first_rejection(tick, agents):
         return bad
+    return m, tick, agents  # type: ignore[return-value]
+
+
+def parse_acts(data: bytes) -> Acts | Rejected:
+    header = act_header(data, FAMILY_GRID)
+    if isinstance(header, Rejected):
+        return header
+    m, tick, agents = header
     acts = _block(m, "acts", len(agents), ACT_LEN, "<i8")
     if isinstance(acts, Rejected):
         return acts

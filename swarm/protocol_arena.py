@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm.protocol import FAMILY_ARENA, Rejected, first_rejection, int_field, int_list, pack, unpack
+from swarm.protocol import FAMILY_ARENA, Rejected, act_header, first_rejection, int_field, int_list, pack, unpack
 
 MAX_OBS_BYTES = 64 * 1024 * 1024  # observations come from the world; 100 animats take ~100 KB
 DTYPES = {"<f8": np.float64, "<i8": np.int64, "|u1": np.uint8, "|b1": np.bool_}
@@ -94,16 +94,10 @@ def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
 
 
 def parse_acts(data: bytes) -> ArenaActs | Rejected:
-    m = unpack(data)
-    if isinstance(m, Rejected):
-        return m
-    if m.get("type") != "act":
-        return Rejected("not an action")
-    if m.get("family") != FAMILY_ARENA:
-        return Rejected("unknown controller family")
-    tick, agents = int_field(m, "tick"), int_list(m, "agents")
-    if bad := first_rejection(tick, agents):
-        return bad
+    header = act_header(data, FAMILY_ARENA)
+    if isinstance(header, Rejected):
+        return header
+    m, tick, agents = header
     raw = m.get("wheels")
     if not isinstance(raw, bytes) or len(raw) != 16 * len(agents):
         return Rejected(f"wheels: expected {len(agents)}x2 binary float64")

@@ -134,26 +134,33 @@ def summary_from(rec: Recording) -> dict:
 # ---------------------------------------------------------------------- plots
 
 
-def write_plots(rec: Recording, out: Path) -> list[Path]:
-    if rec.meta.get("kind") == "arena":
-        from swarm.review_arena import write_arena_plots
-
-        return write_arena_plots(rec, out)
+def plot_writer(out: Path):
+    """(pyplot, save(fig, name), the list of files saved) for plots into `out`."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     out.mkdir(parents=True, exist_ok=True)
-    title = f"{rec.meta['name']}: {rec.meta['controller']} x{rec.meta['agents']}, seed {rec.meta['seed']}"
-    written = []
+    written: list[Path] = []
 
-    def save(fig, name):
+    def save(fig, name: str) -> None:
         path = out / name
         fig.tight_layout()
         fig.savefig(path, dpi=120)
         plt.close(fig)
         written.append(path)
+
+    return plt, save, written
+
+
+def write_plots(rec: Recording, out: Path) -> list[Path]:
+    if rec.meta.get("kind") == "arena":
+        from swarm.review_arena import write_arena_plots
+
+        return write_arena_plots(rec, out)
+    plt, save, written = plot_writer(out)
+    title = f"{rec.meta['name']}: {rec.meta['controller']} x{rec.meta['agents']}, seed {rec.meta['seed']}"
 
     fig, ax = plt.subplots(figsize=(6, 3.5))
     ax.plot(*rec.values("delivered"), label="delivered")

@@ -75,22 +75,11 @@ def arena_summary_from(rec) -> dict:
 
 
 def write_arena_plots(rec, out: Path) -> list[Path]:
-    import matplotlib
+    from swarm.review import plot_writer
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    out.mkdir(parents=True, exist_ok=True)
+    plt, save, written = plot_writer(out)
     m = rec.meta
     title = f"{m['name']}: {m['controller']} x{m['agents']}, seed {m['seed']}, noise {m['noise']}"
-    written = []
-
-    def save(fig, name):
-        path = out / name
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        written.append(path)
 
     fig, ax = plt.subplots(figsize=(6, 6))
     for wall in m.get("walls", []):

@@ -237,24 +237,24 @@ def parse_scenario_text(text: str, source: str = "<string>"):
 
         return parse_arena(data, source, Path(source).stem)
     data.pop("kind", None)
-    _no_unknown(data, _TOP_KEYS, source, "top level")
+    no_unknown(data, _TOP_KEYS, source, "top level")
     has_map, has_gen = "map" in data, "generator" in data
     if has_map == has_gen:
         raise ScenarioError(source, "map/generator", "give exactly one of [map] (ascii = ...) or [generator]")
     kw: dict[str, Any] = {"name": Path(source).stem, "source": source}
     if "name" in data:
-        kw["name"] = _typed(data, "name", str, source)
+        kw["name"] = typed(data, "name", str, source)
     for key in ("seed", "agents", "q_max", "quantity"):
         if key in data:
-            kw[key] = _typed(data, key, int, source)
+            kw[key] = typed(data, key, int, source)
     if "controller" in data:
-        kw["controller"] = _typed(data, "controller", str, source)
+        kw["controller"] = typed(data, "controller", str, source)
     if has_map:
         section = _section(data, "map", source)
-        _no_unknown(section, {"ascii"}, source, "[map]")
+        no_unknown(section, {"ascii"}, source, "[map]")
         if "ascii" not in section:
             raise ScenarioError(source, "map.ascii", "missing: a multi-line string of # . B R")
-        rows = _typed(section, "ascii", str, source, "map.ascii")
+        rows = typed(section, "ascii", str, source, "map.ascii")
         lines = [ln.rstrip() for ln in rows.splitlines()]
         while lines and not lines[0]:
             lines.pop(0)
@@ -265,32 +265,32 @@ def parse_scenario_text(text: str, source: str = "<string>"):
     else:
         section = _section(data, "generator", source)
         keys = {"width", "height", "obstacle_density", "resources"}
-        _no_unknown(section, keys, source, "[generator]")
+        no_unknown(section, keys, source, "[generator]")
         for key in keys:
             if key not in section:
                 raise ScenarioError(source, f"generator.{key}", "missing")
         kw["generator"] = Generator(
-            width=_typed(section, "width", int, source, "generator.width"),
-            height=_typed(section, "height", int, source, "generator.height"),
+            width=typed(section, "width", int, source, "generator.width"),
+            height=typed(section, "height", int, source, "generator.height"),
             obstacle_density=float(
-                _typed(section, "obstacle_density", (int, float), source, "generator.obstacle_density")
+                typed(section, "obstacle_density", (int, float), source, "generator.obstacle_density")
             ),
-            resources=_typed(section, "resources", int, source, "generator.resources"),
+            resources=typed(section, "resources", int, source, "generator.resources"),
         )
     if "ant" in data:
         section = _section(data, "ant", source)
-        _no_unknown(section, set(AntParams.__dataclass_fields__), source, "[ant]")
-        kw["ant"] = AntParams(**{k: float(_typed(section, k, (int, float), source, f"ant.{k}")) for k in section})
+        no_unknown(section, set(AntParams.__dataclass_fields__), source, "[ant]")
+        kw["ant"] = AntParams(**{k: float(typed(section, k, (int, float), source, f"ant.{k}")) for k in section})
     if "cmarking" in data:
         section = _section(data, "cmarking", source)
-        _no_unknown(section, set(CMarkingParams.__dataclass_fields__), source, "[cmarking]")
-        kw["cmarking"] = CMarkingParams(**{k: _typed(section, k, int, source, f"cmarking.{k}") for k in section})
+        no_unknown(section, set(CMarkingParams.__dataclass_fields__), source, "[cmarking]")
+        kw["cmarking"] = CMarkingParams(**{k: typed(section, k, int, source, f"cmarking.{k}") for k in section})
     if "physics" in data:
         section = _section(data, "physics", source)
-        _no_unknown(section, set(PhysicsParams.__dataclass_fields__), source, "[physics]")
+        no_unknown(section, set(PhysicsParams.__dataclass_fields__), source, "[physics]")
         kw["physics"] = PhysicsParams(**{
-            k: _typed(section, k, str, source, "physics.mode") if k == "mode"
-            else float(_typed(section, k, (int, float), source, f"physics.{k}"))
+            k: typed(section, k, str, source, "physics.mode") if k == "mode"
+            else float(typed(section, k, (int, float), source, f"physics.{k}"))
             for k in section
         })  # fmt: skip
     scenario = Scenario(**kw)
@@ -316,7 +316,7 @@ def _section(data: dict, key: str, source: str) -> dict:
     return value
 
 
-def _no_unknown(section: dict, allowed: set[str], source: str, where: str) -> None:
+def no_unknown(section: dict, allowed: set[str], source: str, where: str) -> None:
     for key in section:
         if key not in allowed:
             raise ScenarioError(
@@ -326,7 +326,7 @@ def _no_unknown(section: dict, allowed: set[str], source: str, where: str) -> No
             )
 
 
-def _typed(section: dict, key: str, kind, source: str, where: str | None = None):
+def typed(section: dict, key: str, kind, source: str, where: str | None = None):
     value = section[key]
     kinds = kind if isinstance(kind, tuple) else (kind,)
     if isinstance(value, bool) or not isinstance(value, kinds):

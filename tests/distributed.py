@@ -70,3 +70,26 @@ class ServerThread:
         self.closing.set()
         self.thread.join(10)
         self.server.close()
+
+
+def run_world(scenario, run_id: str, agents: list[tuple[str, int, int]], attack=None, deadline: float = 10.0,
+              **kw) -> tuple[dict, object]:  # fmt: skip
+    """A world in a thread and its agent processes, `agents` as (controller,
+    processes, agents per process); `attack(endpoint, keys)` runs once they are
+    started.  Returns the summary and the world, once every process exited 0."""
+    from swarm import protocol as proto
+
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, run_id, endpoint, deadline=deadline, **kw).start()
+    procs = [p for controller, n, count in agents for p in start_agents(endpoint, run_id, controller, n, count)]
+    try:
+        if attack is not None:
+            attack(endpoint, proto.Keys(run_id))
+        summary = world.join(timeout=240)
+        for p in procs:
+            p.wait(timeout=30)
+            assert p.returncode == 0, p.stderr.read().decode()[-2000:]
+        return summary, world.server.world
+    finally:
+        stop(procs)
+        world.close()

@@ -11,24 +11,11 @@ from swarm.bus import open_client
 from swarm.review import read_recording, summary_from
 from swarm.scenario import load_scenario, parse_scenario_text
 from tests.arena_helpers import box
-from tests.distributed import ServerThread, free_endpoint, start_agents, stop
+from tests.distributed import ServerThread, free_endpoint, run_world, start_agents, stop
 
 
 def _distributed(scenario, run_id, procs_for, attack=None, **kw):
-    endpoint = free_endpoint()
-    world = ServerThread(scenario, run_id, endpoint, deadline=20.0, **kw).start()
-    procs = [p for controller, n, count in procs_for for p in start_agents(endpoint, run_id, controller, n, count)]
-    try:
-        if attack is not None:
-            attack(endpoint, proto.Keys(run_id))
-        summary = world.join(timeout=240)
-        for p in procs:
-            p.wait(timeout=30)
-            assert p.returncode == 0, p.stderr.read().decode()[-2000:]
-        return summary, world.server.world
-    finally:
-        stop(procs)
-        world.close()
+    return run_world(scenario, run_id, procs_for, attack, deadline=20.0, **kw)
 
 
 @pytest.mark.parametrize(("ref", "agents", "seed", "noise", "count"), [

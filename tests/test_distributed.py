@@ -10,26 +10,12 @@ from swarm import protocol as proto
 from swarm.bus import open_client
 from swarm.engine import Engine
 from swarm.scenario import load_scenario
-from tests.distributed import ServerThread, free_endpoint, start_agents, stop
+from tests.distributed import ServerThread, free_endpoint, run_world, start_agents, stop
 from world_server.grid import L_MARK
 
 
 def _run_distributed(scenario, run_id, count=1, attack=None):
-    endpoint = free_endpoint()
-    world = ServerThread(scenario, run_id, endpoint, deadline=10.0).start()
-    n_procs = scenario.agents // count
-    procs = start_agents(endpoint, run_id, scenario.controller, n_procs, count)
-    try:
-        if attack is not None:
-            attack(endpoint, proto.Keys(run_id))
-        summary = world.join(timeout=240)
-        for p in procs:
-            p.wait(timeout=30)
-            assert p.returncode == 0, p.stderr.read().decode()[-2000:]
-        return summary, world.server.world
-    finally:
-        stop(procs)
-        world.close()
+    return run_world(scenario, run_id, [(scenario.controller, scenario.agents // count, count)], attack)
 
 
 @pytest.mark.parametrize(

@@ -40,72 +40,63 @@ def _cell_range(lo, hi, origin, cell, n):
 
 
 @njit(cache=True)
-def build_segment_index(segs, x0, y0, cell, nx, ny):
-    """CSR lists of segment indices per cell: (start (nx*ny+1,), items);
-    coordinates in the same order come from segs[items]."""
-    counts = np.zeros(nx * ny, np.int64)
-    for s in range(segs.shape[0]):
-        ax, ay, bx, by = segs[s, 0], segs[s, 1], segs[s, 2], segs[s, 3]
-        i0, i1 = _cell_range(min(ax, bx), max(ax, bx), x0, cell, nx)
-        j0, j1 = _cell_range(min(ay, by), max(ay, by), y0, cell, ny)
-        for j in range(j0, j1 + 1):
-            for i in range(i0, i1 + 1):
-                counts[j * nx + i] += 1
-    start = np.zeros(nx * ny + 1, np.int64)
+def fill_cells(boxes, use, x0, y0, cell, nx, ny, start, items):
+    """CSR lists of the boxes (x_min, y_min, x_max, y_max) that touch each cell,
+    for boxes with `use` set, into `start` (nx*ny+1,) and `items`.  Returns the
+    number of items, or -needed when `items` is too small (nothing is filled)."""
+    for c in range(nx * ny + 1):
+        start[c] = 0
+    total = 0
+    for b in range(boxes.shape[0]):
+        if use[b]:
+            i0, i1 = _cell_range(boxes[b, 0], boxes[b, 2], x0, cell, nx)
+            j0, j1 = _cell_range(boxes[b, 1], boxes[b, 3], y0, cell, ny)
+            for j in range(j0, j1 + 1):
+                for i in range(i0, i1 + 1):
+                    start[j * nx + i + 1] += 1
+                    total += 1
+    if total > items.shape[0]:
+        return -total
     for c in range(nx * ny):
-        start[c + 1] = start[c] + counts[c]
-    items = np.empty(start[-1], np.int64)
+        start[c + 1] += start[c]
     slot = start[:-1].copy()
-    for s in range(segs.shape[0]):
-        ax, ay, bx, by = segs[s, 0], segs[s, 1], segs[s, 2], segs[s, 3]
-        i0, i1 = _cell_range(min(ax, bx), max(ax, bx), x0, cell, nx)
-        j0, j1 = _cell_range(min(ay, by), max(ay, by), y0, cell, ny)
-        for j in range(j0, j1 + 1):
-            for i in range(i0, i1 + 1):
-                c = j * nx + i
-                items[slot[c]] = s
-                slot[c] += 1
+    for b in range(boxes.shape[0]):
+        if use[b]:
+            i0, i1 = _cell_range(boxes[b, 0], boxes[b, 2], x0, cell, nx)
+            j0, j1 = _cell_range(boxes[b, 1], boxes[b, 3], y0, cell, ny)
+            for j in range(j0, j1 + 1):
+                for i in range(i0, i1 + 1):
+                    c = j * nx + i
+                    items[slot[c]] = b
+                    slot[c] += 1
+    return total
+
+
+def build_segment_index(segs: np.ndarray, x0: float, y0: float, cell: float, nx: int, ny: int):
+    """CSR lists of segment indices per cell (a segment's thin bounding box,
+    exact for the axis-aligned edges of rectangles): (start, items);
+    coordinates in the same order come from segs[items]."""
+    boxes = np.column_stack([np.minimum(segs[:, 0], segs[:, 2]), np.minimum(segs[:, 1], segs[:, 3]),
+                             np.maximum(segs[:, 0], segs[:, 2]), np.maximum(segs[:, 1], segs[:, 3])])  # fmt: skip
+    use = np.ones(len(segs), np.bool_)
+    start = np.zeros(nx * ny + 1, np.int64)
+    needed = -fill_cells(boxes, use, x0, y0, cell, nx, ny, start, np.zeros(0, np.int64))
+    items = np.zeros(max(needed, 0), np.int64)
+    fill_cells(boxes, use, x0, y0, cell, nx, ny, start, items)
     return start, items
 
 
-@njit(cache=True)
-def build_disc_index(xy, radius, present, x0, y0, cell, nx, ny, start, items, xyr):
-    """Fill CSR lists of robots per cell (their bounding squares) into the
-    preallocated `start` (nx*ny+1,), `items` and `xyr` (centre and radius in
-    cell order; at least 4 per robot when a disc is no wider than a cell, grown
-    by the caller otherwise).  Returns the number of items, or -needed when
-    `items` is too small."""
-    ncell = nx * ny
-    for c in range(ncell + 1):
-        start[c] = 0
-    total = 0
-    for r in range(xy.shape[0]):
-        if not present[r]:
-            continue
-        i0, i1 = _cell_range(xy[r, 0] - radius[r], xy[r, 0] + radius[r], x0, cell, nx)
-        j0, j1 = _cell_range(xy[r, 1] - radius[r], xy[r, 1] + radius[r], y0, cell, ny)
-        for j in range(j0, j1 + 1):
-            for i in range(i0, i1 + 1):
-                start[j * nx + i + 1] += 1
-                total += 1
-    if total > items.shape[0]:
-        return -total
-    for c in range(ncell):
-        start[c + 1] += start[c]
-    slot = start[:-1].copy()
-    for r in range(xy.shape[0]):
-        if not present[r]:
-            continue
-        i0, i1 = _cell_range(xy[r, 0] - radius[r], xy[r, 0] + radius[r], x0, cell, nx)
-        j0, j1 = _cell_range(xy[r, 1] - radius[r], xy[r, 1] + radius[r], y0, cell, ny)
-        for j in range(j0, j1 + 1):
-            for i in range(i0, i1 + 1):
-                c = j * nx + i
-                items[slot[c]] = r
-                xyr[slot[c], 0] = xy[r, 0]
-                xyr[slot[c], 1] = xy[r, 1]
-                xyr[slot[c], 2] = radius[r]
-                slot[c] += 1
+def build_disc_index(xy, radius, present, x0, y0, cell, nx, ny, start, items, xyr) -> int:
+    """CSR lists of robots per cell (their bounding squares) into the
+    preallocated `start`, `items` and `xyr` (centre and radius in cell order,
+    so a ray reads memory in sequence).  Returns the number of items, or
+    -needed when `items` is too small."""
+    boxes = np.column_stack([xy[:, 0] - radius, xy[:, 1] - radius, xy[:, 0] + radius, xy[:, 1] + radius])
+    total = fill_cells(boxes, present, x0, y0, cell, nx, ny, start, items)
+    if total > 0:
+        picked = items[:total]
+        xyr[:total, :2] = xy[picked]
+        xyr[:total, 2] = radius[picked]
     return total
 
 

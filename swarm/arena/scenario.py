@@ -39,7 +39,7 @@ from swarm.arena.models import (
     RobotModel,
     Sonar,
 )
-from swarm.scenario import ScenarioError
+from swarm.scenario import ScenarioError, no_unknown, typed
 from world_server.sensors import NOISE_LEVELS, ZONE_KINDS, Noise
 
 ARENA_CONTROLLERS = ("carrot", "wander")
@@ -340,7 +340,7 @@ _SENSORS = {"camera": Camera, "sonar": Sonar, "ir": IR, "laser": Laser, "odometr
 
 
 def parse_arena(data: dict, source: str, default_name: str) -> ArenaScenario:
-    _no_unknown(data, _TOP, source, "top level")
+    no_unknown(data, _TOP, source, "top level")
     size = _numbers(data, "size", source, "size", 2)
     if not all(0 < v <= 10_000 for v in size):
         raise ScenarioError(source, "size", f"expected two positive sizes in metres, got {list(size)}")
@@ -387,7 +387,7 @@ def _robot(value, source: str, where: str) -> RobotModel:
         raise ScenarioError(source, where, "expected a model name or a [robot] table")
     allowed = {"model", "name", "radius", "axle", "max_wheel_speed", "max_speed", "max_turn_rate", "colour",
                "sensors", *_SENSORS}  # fmt: skip
-    _no_unknown(value, allowed, source, f"[{where}]")
+    no_unknown(value, allowed, source, f"[{where}]")
     model = _robot(value.get("model", "epuck"), source, f"{where}.model")
     changes: dict[str, Any] = {"name": _get(value, "name", str, source, model.name, f"{where}.name")}
     for key in ("radius", "axle", "max_wheel_speed", "max_speed", "max_turn_rate"):
@@ -411,7 +411,7 @@ def _robot(value, source: str, where: str) -> RobotModel:
     for key, cls in _SENSORS.items():
         if key in value:
             table = _table(value, key, source, f"{where}.{key}")
-            _no_unknown(table, {f.name for f in fields(cls)}, source, f"[{where}.{key}]")
+            no_unknown(table, {f.name for f in fields(cls)}, source, f"[{where}.{key}]")
             base = getattr(sensors, key) or cls()
             typed = {k: tuple(float(x) for x in v) if isinstance(v, list) else
                      (int(v) if isinstance(getattr(base, k), int) and not isinstance(getattr(base, k), bool)
@@ -443,7 +443,7 @@ def _noise(value, source: str) -> Noise:
 def _wall(w, source: str, where: str) -> Wall:
     if not isinstance(w, dict):
         raise ScenarioError(source, where, "expected a [[wall]] table")
-    _no_unknown(w, {"rect", "segment", "colour", "name"}, source, f"[[wall]] ({where})")
+    no_unknown(w, {"rect", "segment", "colour", "name"}, source, f"[[wall]] ({where})")
     if ("rect" in w) == ("segment" in w):
         raise ScenarioError(source, where, "give exactly one of rect = [x0, y0, x1, y1] or segment = [x0, y0, x1, y1]")
     shape = "rect" if "rect" in w else "segment"
@@ -459,7 +459,7 @@ def _wall(w, source: str, where: str) -> Wall:
 def _zone(z, source: str, where: str) -> Zone:
     if not isinstance(z, dict):
         raise ScenarioError(source, where, "expected a [[zone]] table")
-    _no_unknown(z, {"kind", "rect", "disc", "name"}, source, f"[[zone]] ({where})")
+    no_unknown(z, {"kind", "rect", "disc", "name"}, source, f"[[zone]] ({where})")
     kind = _get(z, "kind", str, source, None, f"{where}.kind")
     if kind not in ZONE_KINDS:
         raise ScenarioError(source, f"{where}.kind", f"unknown {kind!r}; expected one of {', '.join(ZONE_KINDS)}")
@@ -477,7 +477,7 @@ def _zone(z, source: str, where: str) -> Zone:
 def _obstacle(o, source: str, where: str) -> Obstacle:
     if not isinstance(o, dict):
         raise ScenarioError(source, where, "expected an [[obstacle]] table")
-    _no_unknown(o, {"rect", "appear", "vanish", "colour", "name"}, source, f"[[obstacle]] ({where})")
+    no_unknown(o, {"rect", "appear", "vanish", "colour", "name"}, source, f"[[obstacle]] ({where})")
     rect = _rect(_numbers(o, "rect", source, f"{where}.rect", 4), source, f"{where}.rect")
     appear = _get(o, "appear", int, source, 0, f"{where}.appear")
     vanish = _get(o, "vanish", int, source, None, f"{where}.vanish")
@@ -491,7 +491,7 @@ def _obstacle(o, source: str, where: str) -> Obstacle:
 def _resource(r, source: str, where: str) -> Obstacle:
     if not isinstance(r, dict):
         raise ScenarioError(source, where, "expected a [[resource]] table")
-    _no_unknown(r, {"kind", "centre", "size", "reach", "appear", "vanish", "colour", "name"}, source,
+    no_unknown(r, {"kind", "centre", "size", "reach", "appear", "vanish", "colour", "name"}, source,
                 f"[[resource]] ({where})")  # fmt: skip
     kind = _get(r, "kind", str, source, None, f"{where}.kind")
     if kind not in RESOURCE_GREY:
@@ -515,7 +515,7 @@ def _resource(r, source: str, where: str) -> Obstacle:
 def _group(g, robot: RobotModel, source: str, where: str) -> Group:
     if not isinstance(g, dict):
         raise ScenarioError(source, where, "expected a [[group]] table")
-    _no_unknown(g, {"count", "controller", "robot", "start", "starts", "clearance", "goal", "goals", "route"},
+    no_unknown(g, {"count", "controller", "robot", "start", "starts", "clearance", "goal", "goals", "route"},
                 source, f"[[group]] ({where})")  # fmt: skip
     count = _get(g, "count", int, source, 1, f"{where}.count")
     controller = _get(g, "controller", str, source, "carrot", f"{where}.controller")
@@ -593,17 +593,15 @@ def check_arena(s: ArenaScenario, source: str) -> None:
         if g.route is not None and g.route not in s.routes:
             raise ScenarioError(source, f"group {gi + 1}.route", f"no route {g.route!r} in [routes]; have "
                                 f"{', '.join(s.routes) or 'none'}")  # fmt: skip
+        for name, points in (("starts", g.starts or ()), ("goals", g.goals or ())):
+            for k, p in enumerate(points):
+                if not inside(p[0], p[1]):
+                    raise ScenarioError(source, f"group {gi + 1}.{name}[{k + 1}]", f"({p[0]:g}, {p[1]:g}) is "
+                                        "outside the arena")  # fmt: skip
         for k, p in enumerate(g.starts or ()):
-            if not inside(p[0], p[1]):
-                raise ScenarioError(source, f"group {gi + 1}.starts[{k + 1}]", f"({p[0]:g}, {p[1]:g}) is outside "
-                                    "the arena")  # fmt: skip
             if clearance_at(np.array([p[:2]]), rects, segs)[0] < m.radius * 0.999:
                 raise ScenarioError(source, f"group {gi + 1}.starts[{k + 1}]", f"({p[0]:g}, {p[1]:g}) is inside "
                                     f"or within a body radius ({m.radius:g} m) of a wall")  # fmt: skip
-        for k, p in enumerate(g.goals or ()):
-            if not inside(p[0], p[1]):
-                raise ScenarioError(source, f"group {gi + 1}.goals[{k + 1}]", f"({p[0]:g}, {p[1]:g}) is outside "
-                                    "the arena")  # fmt: skip
     for name, route in s.routes.items():
         if len(route) < 1 or not all(inside(x, y) for x, y in route):
             raise ScenarioError(source, f"routes.{name}", "expected at least one waypoint, all inside the arena")
@@ -612,25 +610,13 @@ def check_arena(s: ArenaScenario, source: str) -> None:
 # --------------------------------------------------------------------- helpers
 
 
-def _no_unknown(section: dict, allowed: set[str], source: str, where: str) -> None:
-    for key in section:
-        if key not in allowed:
-            raise ScenarioError(
-                source, f"{where}: {key}", f"unknown field; expected one of {', '.join(sorted(allowed))}"
-            )
-
-
 def _get(section: dict, key: str, kind, source: str, default: Any = ..., where: str | None = None):
+    """The typed value of an optional field (missing: `default`, or an error when there is none)."""
     if key not in section:
         if default is ...:
             raise ScenarioError(source, where or key, "missing")
         return default
-    value = section[key]
-    kinds = kind if isinstance(kind, tuple) else (kind,)
-    if isinstance(value, bool) or not isinstance(value, kinds):
-        names = " or ".join(k.__name__ for k in kinds)
-        raise ScenarioError(source, where or key, f"expected {names}, got {value!r}")
-    return value
+    return typed(section, key, kind, source, where)
 
 
 def _table(section: dict, key: str, source: str, where: str | None = None) -> dict:
