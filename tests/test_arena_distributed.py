@@ -194,3 +194,62 @@ def test_swarm_status_answers_for_an_arena_world():
     finally:
         world.finished.wait(10)  # no agent comes: the world gives up waiting
         world.close()
+
+
+def test_kill_9_the_arena_world_and_restart_it_resumes_from_disk(tmp_path):
+    import json
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from world_server import persist
+
+    endpoint = free_endpoint()
+    state = tmp_path / "aresume.arena.npz"
+    summary_file = tmp_path / "summary.json"
+    world_cmd = [sys.executable, "-m", "swarm", "world", "large-maze", "--agents", "3", "--seed", "4", "--run-id",
+                 "aresume", "--listen", endpoint, "--state-dir", str(tmp_path), "--persist-every", "20",
+                 "--deadline", "5", "--summary-file", str(summary_file)]  # fmt: skip
+    world = subprocess.Popen(world_cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    procs = [world, *start_agents(endpoint, "aresume", "carrot", 3)]
+    try:
+        deadline = time.monotonic() + 120
+        while True:
+            saved = persist.load_arrays(state) if state.exists() else None
+            if saved and int(saved[0]["tick"]) >= 100:
+                break
+            assert time.monotonic() < deadline and world.poll() is None, "the world never persisted"
+            time.sleep(0.05)
+        os.kill(world.pid, signal.SIGKILL)
+        world.wait()
+        before, _ = persist.load_arrays(state)
+        world = subprocess.Popen(world_cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        procs.append(world)
+        assert world.wait(timeout=300) == 0, world.stderr.read().decode()[-3000:]
+        summary = json.loads(summary_file.read_text())
+        assert summary["ticks"] > int(before["tick"]) and summary["agents_lost"] == 0  # the same agents came back
+        assert summary["finished"] and summary["reached"] == 3
+        robots = {r["agent"]: r for r in summary["robots"]}
+        for a in range(3):  # the robots went on from where they were, their paths counted across the restart
+            assert robots[a]["start"] == [round(float(v), 4) for v in before["start_pose"][a]]
+            assert robots[a]["path_length"] >= float(before["path_length"][a])
+    finally:
+        stop(procs)
+
+
+def test_an_arena_state_of_another_scenario_is_refused_in_one_line(tmp_path):
+    import subprocess
+    import sys
+
+    from world_server import persist
+    from world_server.arena import ArenaWorld
+
+    world = ArenaWorld(load_scenario("zmaze"))
+    persist.save_arrays(tmp_path / "other.arena.npz", {**world.snapshot(), "slots": np.zeros(1, np.int64)},
+                        {"scenario": load_scenario("zmaze").describe(), "stats": {}})  # fmt: skip
+    out = subprocess.run([sys.executable, "-m", "swarm", "world", "large-maze", "--run-id", "other", "--state-dir",
+                          str(tmp_path), "--listen", free_endpoint(), "--start-timeout", "1"],
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert out.returncode == 2 and "another scenario" in out.stderr and "Traceback" not in out.stderr, out.stderr

@@ -292,6 +292,40 @@ class ArenaWorld:
             self.in_world[a] = True
         self._update_zones()
 
+    # ------------------------------------------------------------ persistence
+
+    STATE = ("in_world", "present", "finished", "reached_tick", "dwell", "waypoint", "start_pose", "path_length",
+             "zones")  # fmt: skip
+    BODY_STATE = ("distance", "collisions", "blocked_seconds", "contact", "motion")
+
+    def snapshot(self) -> dict[str, np.ndarray]:
+        """What a restarted world resumes from (arrays only).  pymunk's contact
+        caches are not in it, so a resumed run is close to, not bit-equal with,
+        the run it continues (docs/arena.md)."""
+        out = {k: np.array(getattr(self, k)) for k in self.STATE}
+        out.update({f"body_{k}": np.array(getattr(self.bodies, k)) for k in self.BODY_STATE})
+        out["pose"] = self.pose.copy()
+        out["velocity"] = self.bodies.velocities()
+        out["tick"] = np.array(self.tick)
+        out["sim_seconds"] = np.array(self.bodies.sim_seconds)
+        out["optimum"] = np.array([np.nan if v is None else v for v in self.optimum])
+        out["rejected"] = np.array([self.rejected[k] for k in REJECT_REASONS])
+        return out
+
+    def restore(self, state: dict[str, np.ndarray]) -> None:
+        for k in self.STATE:
+            getattr(self, k)[...] = state[k]
+        for k in self.BODY_STATE:
+            getattr(self.bodies, k)[...] = state[f"body_{k}"]
+        self.tick = int(state["tick"])
+        self.bodies.sim_seconds = float(state["sim_seconds"])
+        self.optimum = [None if np.isnan(v) else float(v) for v in state["optimum"]]
+        self.rejected = {k: int(v) for k, v in zip(REJECT_REASONS, state["rejected"], strict=True)}
+        for a in range(self.n):
+            self.bodies.restore(a, state["pose"][a], state["velocity"][a], bool(self.in_world[a]))
+        self._obstacles_at(self.tick)
+        self._update_zones()
+
     def remove_agent(self, agent: int) -> None:
         """The agent is gone: its body stops where it is and stays an obstacle."""
         self.present[agent] = False

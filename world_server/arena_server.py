@@ -12,14 +12,18 @@ mix controllers.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from swarm import protocol as proto
 from swarm import protocol_arena as arena_proto
 from swarm.arena.engine import arena_summary
 from swarm.arena.scenario import controller_params
+from swarm.scenario import ScenarioError
+from world_server import persist
 from world_server.arena import ArenaWorld
-from world_server.server import ACTIVE, FREE, LOST, WorldServer
+from world_server.server import ACTIVE, FREE, JOINING, LOST, WorldServer
 
 
 class ArenaServer(WorldServer):
@@ -33,6 +37,38 @@ class ArenaServer(WorldServer):
         self.wheels = np.zeros((self.world.n, 2))
         self.ok = np.zeros(self.world.n, np.bool_)
         self.readings: list[dict[str, np.ndarray]] = []
+        self.state_file = Path(self.state_dir) / f"{self.keys.run}.arena.npz" if self.state_dir else None
+
+    # ------------------------------------------------------------ persistence
+
+    def _resume(self) -> bool:
+        """Continue a run persisted under this run id, if there is one: the
+        robots where they were, their counters, the agents' slots (the agents
+        that were in come back when their liveliness token reappears)."""
+        loaded = persist.load_arrays(self.state_file) if self.state_file else None
+        if loaded is None:
+            return False
+        arrays, meta = loaded
+        if meta["scenario"] != self.scenario.describe():
+            raise ScenarioError(str(self.state_file), "run id", f"holds run {self.keys.run!r} of another scenario; "
+                                "use another --run-id or remove the file")  # fmt: skip
+        self.world.restore(arrays)
+        self.tick = int(arrays["tick"])
+        slots = arrays["slots"]
+        self.slots[:] = np.where((slots == ACTIVE) | (slots == JOINING), JOINING, slots)
+        self.stats.joins = int(meta["stats"]["joins"])
+        self.stats.agents_lost = int(meta["stats"]["agents_lost"])
+        self.stats.rejected = dict(meta["stats"]["rejected"])
+        self.group_of = {int(a): g for a, g in meta["stats"]["groups"].items()}
+        return True
+
+    def save_state(self) -> None:
+        if self.state_file is None:
+            return
+        stats = {"joins": self.stats.joins, "agents_lost": self.stats.agents_lost, "rejected": self.stats.rejected,
+                 "groups": {str(a): g for a, g in self.group_of.items()}}  # fmt: skip
+        persist.save_arrays(self.state_file, {**self.world.snapshot(), "slots": self.slots},
+                            {"scenario": self.scenario.describe(), "stats": stats})  # fmt: skip
 
     def _open_recorder(self, path, viewer: str | None):
         from swarm.recording_arena import ArenaRecorder

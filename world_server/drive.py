@@ -144,6 +144,16 @@ class DiffDrive:
         self.motion[:, 1] = (self.pose[:, 2] - start[:, 2] + math.pi) % (2 * math.pi) - math.pi
         self.sim_seconds += self.period
 
+    def velocities(self) -> np.ndarray:
+        return self._positions()[:, 2:]
+
+    def restore(self, i: int, pose: np.ndarray, velocity: np.ndarray, in_world: bool) -> None:
+        self.place(i, pose)
+        self._bodies[i].velocity = (float(velocity[0]), float(velocity[1]))
+        self._discs[i].filter = (
+            self._pymunk.ShapeFilter() if in_world else self._pymunk.ShapeFilter(categories=0, mask=0)
+        )
+
     def enter(self, i: int, pose: np.ndarray) -> None:
         """A parked robot comes into the world at `pose`."""
         self.place(i, pose)

@@ -21,20 +21,33 @@ def state_path(state_dir: str | Path, run_id: str) -> Path:
 
 
 def save(path: Path, world, tick: int, slots: np.ndarray, stats: dict, scenario: dict) -> None:
+    arrays = {"slots": slots, "body_xy": world.body_xy, **{k: getattr(world, k) for k in ARRAYS}}
+    save_arrays(path, arrays, {"tick": tick, "stats": stats, "scenario": scenario})
+
+
+def save_arrays(path: Path, arrays: dict, meta: dict) -> None:
+    """Any world kind's state: its arrays and a JSON meta, written atomically."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    meta = json.dumps({"tick": tick, "stats": stats, "scenario": scenario})
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "wb") as f:
-        np.savez(f, slots=slots, meta=np.array(meta), body_xy=world.body_xy, **{k: getattr(world, k) for k in ARRAYS})
+        np.savez(f, meta=np.array(json.dumps(meta)), **arrays)
         f.flush()
         os.fsync(f.fileno())
     os.replace(tmp, path)
 
 
-def load(path: Path) -> dict | None:
+def load_arrays(path: Path) -> tuple[dict, dict] | None:
     if not path.exists():
         return None
     with np.load(path, allow_pickle=False) as data:
-        state = {k: data[k].copy() for k in (*ARRAYS, "slots", "body_xy")}
-        state.update(json.loads(str(data["meta"])))
-    return state
+        arrays = {k: data[k].copy() for k in data.files if k != "meta"}
+        meta = json.loads(str(data["meta"]))
+    return arrays, meta
+
+
+def load(path: Path) -> dict | None:
+    loaded = load_arrays(path)
+    if loaded is None:
+        return None
+    arrays, meta = loaded
+    return {**arrays, **meta}
