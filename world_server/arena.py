@@ -29,6 +29,8 @@ def rect_edges(rect) -> list[tuple[float, float, float, float]]:
 
 
 class ArenaWorld:
+    """The arena's state; it keeps world_server.contract.World."""
+
     kind = "arena"
 
     def __init__(self, scenario: ArenaScenario, index_cell: float | None = None, parked: bool = False):
@@ -117,6 +119,12 @@ class ArenaWorld:
     @property
     def contact(self) -> np.ndarray:
         return self.bodies.contact
+
+    def perceive_all(self) -> list[dict[str, np.ndarray]]:
+        return self.perceive()
+
+    def apply_all(self, actions: np.ndarray) -> None:
+        self.apply(actions)
 
     def perceive(self) -> list[dict[str, np.ndarray]]:
         """Every robot's perception of the start-of-tick world (one ray pass)."""

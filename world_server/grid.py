@@ -40,6 +40,8 @@ from agents.controllers.layout import (
     MARK_NONE,
     N_DIRS,
     OBST,
+    PERC_F_LEN,
+    PERC_LEN,
     PHER,
     RES,
     TRAIL,
@@ -49,6 +51,7 @@ from agents.controllers.layout import (
 )
 from swarm.scenario import Layout, PhysicsParams, Scenario
 from world_server.bodies import Bodies
+from world_server.persist import ARRAYS as PERSISTED
 from world_server.steering import waypoints
 
 # Integer layers of the grid, stacked in one (N_LAYERS, H, W) array.
@@ -199,9 +202,13 @@ def resolve_tick(layers, pher, pher_scratch, base_r, base_c, pos, payload, acts,
 
 
 class GridWorld:
-    """The grid's state: layers, pheromone, agents' positions and payloads."""
+    """The grid's state: layers, pheromone, agents' positions and payloads.
+    It keeps world_server.contract.World (`until` says what `done` means)."""
 
-    def __init__(self, scenario: Scenario, layout: Layout | None = None):
+    kind = "grid"
+    SNAPSHOT = PERSISTED
+
+    def __init__(self, scenario: Scenario, layout: Layout | None = None, until: str = "foraged"):
         layout = layout if layout is not None else scenario.layout()
         h, w = layout.shape
         self.scenario = scenario
@@ -230,6 +237,38 @@ class GridWorld:
         self.wparams = np.array([scenario.q_max, a.deposit, a.diffusion, a.evaporation], dtype=np.float64)
         self.pheromone_on = scenario.controller == "ant"  # only ants lay pheromone
         self.bodies = Bodies(scenario.physics, layout.obstacles, n, layout.base)
+        self.n, self.tick, self.until = n, 0, until
+
+    # ------------------------------------------------------------- contract
+
+    def perceive_all(self) -> tuple[np.ndarray, np.ndarray]:
+        pi = np.zeros((self.n, PERC_LEN), np.int64)
+        pf = np.zeros((self.n, PERC_F_LEN), np.float64)
+        for a in range(self.n):
+            self.perceive(a, pi[a], pf[a])
+        return pi, pf
+
+    def apply_all(self, actions: np.ndarray) -> None:
+        self.acts[:] = actions
+        self.resolve(self.tick)
+        self.tick += 1
+
+    def done(self) -> bool:
+        foraged = int(self.counters[C_DELIVERED]) >= self.total
+        converged = int(self.counters[C_OPTIMAL]) == self.reachable
+        return {"foraged": foraged, "converged": converged, "both": foraged and converged}[self.until]
+
+    def snapshot(self) -> dict[str, np.ndarray]:
+        return {**{k: getattr(self, k).copy() for k in self.SNAPSHOT}, "body_xy": self.body_xy.copy(),
+                "tick": np.array(self.tick)}  # fmt: skip
+
+    def restore(self, state: dict[str, np.ndarray]) -> None:
+        for k in self.SNAPSHOT:
+            getattr(self, k)[...] = state[k]
+        self.bodies.place(state["body_xy"])
+        self.tick = int(state["tick"])
+
+    # ------------------------------------------------------------------ parts
 
     def perceive(self, agent: int, pi: np.ndarray, pf: np.ndarray) -> None:
         r, c = self.pos[agent]

@@ -14,6 +14,7 @@ import numpy as np
 from agents.controllers.arena import make_controller
 from agents.controllers.navigation.astar import Planner
 from swarm.arena.scenario import ArenaScenario, controller_params
+from swarm.stepper import step_world
 from world_server.arena import ArenaWorld
 
 OPTIMUM_CELL, OPTIMUM_CLEARANCE = 0.01, 0.04  # the DFT paper's A* optimum
@@ -70,17 +71,19 @@ class ArenaEngine:
         `recorder` (swarm.recording_arena.ArenaRecorder) takes every tick."""
         w = self.world
         started = time.perf_counter()
-        ran = 0
-        while ran < n and not w.done():
-            t0 = time.perf_counter()
-            for a, (c, p) in enumerate(zip(self.controllers, w.perceive(), strict=True)):
+        last = [started]
+
+        def decide(perceptions, tick: int) -> np.ndarray:
+            for a, (c, p) in enumerate(zip(self.controllers, perceptions, strict=True)):
                 self.actions[a] = c.step(p)
-            w.apply(self.actions)
-            if recorder is not None:
-                recorder.capture(
-                    w.tick - 1, tick_ms=(time.perf_counter() - t0) * 1000, rejected=sum(w.rejected.values())
-                )
-            ran += 1
+            return self.actions
+
+        def record() -> None:
+            now = time.perf_counter()
+            recorder.capture(w.tick - 1, tick_ms=(now - last[0]) * 1000, rejected=sum(w.rejected.values()))
+            last[0] = now
+
+        ran = step_world(w, decide, n, record if recorder is not None else None)
         self.wall_seconds += time.perf_counter() - started
         return ran
 
