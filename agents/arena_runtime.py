@@ -21,6 +21,7 @@ class ArenaAgentRuntime(AgentRuntime):
 
     def _prepare(self, count: int) -> None:
         self.brains: list = [None] * count
+        self.sent_plans: dict[int, tuple] = {}  # agent -> (length, first, last point) of the last plan sent
 
     def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
         brain = make_controller(msg.get("controller", self.controller))
@@ -40,4 +41,17 @@ class ArenaAgentRuntime(AgentRuntime):
             wheels.append(np.zeros(2) if self.null else self.brains[slot].step(reading))
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 2))
         self.session.put(self.keys.act(self.group), payload)
+        if not self.null:
+            self._send_plans(obs.tick, agents)
         return len(agents)
+
+    def _send_plans(self, tick: int, agents: list[int]) -> None:
+        """A controller's new plan goes to the world once, for the recording."""
+        for agent in agents:
+            path = self.brains[self.slot_of[agent]].record().get("path")
+            if path is None or len(path) < 2:
+                continue
+            key = (len(path), *np.asarray(path[0]).tolist(), *np.asarray(path[-1]).tolist())
+            if self.sent_plans.get(agent) != key:
+                self.sent_plans[agent] = key
+                self.session.put(self.keys.plan(self.group), arena_proto.plan_message(tick, agent, path))

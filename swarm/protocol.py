@@ -8,6 +8,7 @@ Key expressions, all under one prefix per run, `swarm/<run>/`:
     act/<group>       agent process -> world: their actions for that tick
     marks/<group>     agent process -> world: their mark writes (merged by min);
                       `get swarm/<run>/marks/**` returns the marking environment
+    plans/<group>     agent process -> world (arena): a path a controller planned, for the recording
     alive/<id>        liveliness token of an agent
     state             world -> anyone: per-tick summary
 
@@ -54,6 +55,7 @@ class Keys:
         self.state = f"{self.prefix}/state"
         self.acts = f"{self.prefix}/act/*"
         self.marks = f"{self.prefix}/marks/**"
+        self.plans = f"{self.prefix}/plans/*"
         self.alive_all = f"{self.prefix}/alive/*"
 
     def obs(self, group: str) -> str:
@@ -64,6 +66,9 @@ class Keys:
 
     def mark(self, group: str) -> str:
         return f"{self.prefix}/marks/{group}"
+
+    def plan(self, group: str) -> str:
+        return f"{self.prefix}/plans/{group}"
 
     def alive(self, agent: int) -> str:
         return f"{self.prefix}/alive/{agent}"

@@ -3,6 +3,8 @@
     obs/<group>   world -> agent process: for one tick, every agent's sensor
                   readings, each array as [dtype, shape, little-endian bytes]
     act/<group>   agent process -> world: their wheel speeds (K x 2 float64, m/s)
+    plans/<group> agent process -> world: one agent's planned path (P x 2 float64, m), once
+                  per new plan, at most MAX_PLAN_POINTS points (the recording's, not the controller's)
 
 Decoding never raises on bad input: it returns a `Rejected` reason.  Wheel
 speeds are not judged here: the world checks every agent's pair (finite,
@@ -20,6 +22,7 @@ from swarm.protocol import FAMILY_ARENA, Rejected, act_header, first_rejection, 
 MAX_OBS_BYTES = 64 * 1024 * 1024  # observations come from the world; 100 animats take ~100 KB
 DTYPES = {"<f8": np.float64, "<i8": np.int64, "|u1": np.uint8, "|b1": np.bool_}
 MAX_SENSORS, MAX_DIMS = 32, 4
+MAX_PLAN_POINTS = 2000  # 32 KB: a plan message stays under the world's message limit
 
 
 @dataclass(frozen=True)
@@ -102,3 +105,37 @@ def parse_acts(data: bytes) -> ArenaActs | Rejected:
     if not isinstance(raw, bytes) or len(raw) != 16 * len(agents):
         return Rejected(f"wheels: expected {len(agents)}x2 binary float64")
     return ArenaActs(tick, agents, np.frombuffer(raw, dtype="<f8").reshape(len(agents), 2).astype(np.float64))
+
+
+@dataclass(frozen=True)
+class Plan:
+    tick: int
+    agent: int
+    path: np.ndarray  # (P, 2)
+
+
+def plan_message(tick: int, agent: int, path: np.ndarray) -> bytes:
+    """A planned path thinned to at most MAX_PLAN_POINTS points (ends kept)."""
+    path = np.asarray(path, np.float64).reshape(-1, 2)
+    if len(path) > MAX_PLAN_POINTS:
+        path = path[np.linspace(0, len(path) - 1, MAX_PLAN_POINTS).round().astype(int)]
+    return pack({"type": "plan", "family": FAMILY_ARENA, "tick": int(tick), "agent": int(agent),
+                 "path": path.astype("<f8").tobytes()})  # fmt: skip
+
+
+def parse_plan(data: bytes) -> Plan | Rejected:
+    m = unpack(data)
+    if isinstance(m, Rejected):
+        return m
+    if m.get("type") != "plan" or m.get("family") != FAMILY_ARENA:
+        return Rejected("not a plan")
+    tick, agent = int_field(m, "tick"), int_field(m, "agent")
+    if bad := first_rejection(tick, agent):
+        return bad
+    raw = m.get("path")
+    if not isinstance(raw, bytes) or len(raw) % 16 or not 0 < len(raw) // 16 <= MAX_PLAN_POINTS:
+        return Rejected(f"path: expected 1 to {MAX_PLAN_POINTS} points of 2 float64")
+    path = np.frombuffer(raw, dtype="<f8").reshape(-1, 2).astype(np.float64)
+    if not np.isfinite(path).all():
+        return Rejected("path: not finite")
+    return Plan(tick, agent, path)

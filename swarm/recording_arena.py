@@ -11,7 +11,8 @@ Layout (timeline `tick`; the record at tick t shows the world after tick t):
     world/robots          one batched point cloud (radius = body), coloured by group
     world/headings        arrows, one per robot
     world/trajectories    line strips of every robot's path so far (logged at each flush)
-    world/plans/<agent>   the path a controller planned (in-process runs: the controller's record())
+    world/plans/<agent>   the path a controller planned (in process from its record(); distributed, sent
+                          by its agent process on swarm/<run>/plans/<group>)
     metrics/<name>        reached, collisions, distance, agents_alive, tick_ms, rejected_messages
                           (in-process: the actions the world refused)
     metrics/robots/<name> per robot, one scalar each: path_length, collisions, in_goal, finished (dwelt)
@@ -210,14 +211,18 @@ class ArenaRecorder:
 
     def _log_plans(self, tick: int) -> None:
         for a, c in enumerate(self.controllers):
-            if a in self._plans_logged:
-                continue
-            path = np.asarray(c.record().get("path", np.zeros((0, 2))))
-            if len(path) > 1:
-                self._plans_logged.add(a)
-                self.rec.set_time("tick", sequence=tick)
-                self.rec.log(f"world/plans/{a}", self.rr.LineStrips2D([flip(path)], colors=[self.colours[a]],
-                                                                      radii=0.002, draw_order=3.0))  # fmt: skip
+            if a not in self._plans_logged:
+                path = np.asarray(c.record().get("path", np.zeros((0, 2))))
+                if len(path) > 1:
+                    self.log_plan(tick, a, path)
+
+    def log_plan(self, tick: int, agent: int, path: np.ndarray) -> None:
+        """A controller's planned path, at the tick it was planned."""
+        self._plans_logged.add(agent)
+        self.rec.set_time("tick", sequence=tick)
+        colour = self.colours[agent] if 0 <= agent < len(self.colours) else (200, 200, 200)
+        self.rec.log(f"world/plans/{agent}", self.rr.LineStrips2D([flip(path)], colors=[colour], radii=0.002,
+                                                                  draw_order=3.0))  # fmt: skip
 
     def flush(self) -> None:
         if not self._ticks:

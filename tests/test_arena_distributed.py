@@ -33,6 +33,10 @@ def test_lockstep_arena_equals_in_process_bit_for_bit(ref, agents, seed, noise, 
     np.testing.assert_array_equal(world.path_length, engine.world.path_length)
     assert summary["ticks"] == expected["ticks"] and summary["robots"] == expected["robots"]
     assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
+    from rerun.chunk import RrdReader
+
+    entities = {c.entity_path.lstrip("/") for c in RrdReader(rrd).stream()}
+    assert {f"world/plans/{a}" for a in range(agents)} <= entities  # the agents sent their plans
     read = summary_from(read_recording(rrd))  # the distributed recording rebuilds the same run
     assert read["ticks"] == summary["ticks"] and read["reached"] == summary["reached"]
     assert [r["path_length"] for r in read["robots"]] == [r["path_length"] for r in summary["robots"]]
@@ -70,6 +74,8 @@ def test_bad_arena_traffic_is_counted_and_never_acted_on():
             s.put(keys.act("intruder"), proto.pack({"type": "act", "family": "arena", "tick": 0, "agents": [0],
                                                     "wheels": b"short"}))  # fmt: skip
             s.put(keys.act("intruder"), proto.actions(0, [0], np.zeros((1, 7), np.int64), [False]))  # grid family
+            s.put(keys.plan("intruder"), arena_proto.plan_message(0, 0, np.zeros((3, 2))))  # another's plan
+            s.put(keys.plan("intruder"), b"\x01plan?")
         finally:
             s.close()
 
@@ -80,6 +86,7 @@ def test_bad_arena_traffic_is_counted_and_never_acted_on():
     assert any("not msgpack" in r for r in reasons) and any("wheels" in r for r in reasons)
     assert any("another process" in r or "unknown agent" in r for r in reasons)  # before or after it joined
     assert any("unknown controller family" in r for r in reasons)
+    assert reasons.get("plan: names an agent of another process") == 1 and reasons.get("plan: not msgpack") == 1
 
 
 def test_nan_and_huge_wheel_speeds_from_an_agent_are_refused():

@@ -70,6 +70,21 @@ class ArenaServer(WorldServer):
         persist.save_arrays(self.state_file, {**self.world.snapshot(), "slots": self.slots},
                             {"scenario": self.scenario.describe(), "stats": stats})  # fmt: skip
 
+    def _declare_shared(self, put) -> list:
+        return [self.session.declare_subscriber(self.keys.plans, lambda s: put(("plan", s)))]
+
+    def _handle_shared(self, kind: str, item) -> None:
+        if kind != "plan":
+            return
+        received = self._receive(item, arena_proto.parse_plan, "plan")
+        if received is None:
+            return
+        plan, group = received
+        if not (0 <= plan.agent < len(self.slots)) or self.group_of.get(plan.agent) != group:
+            self.stats.reject("plan: names an agent of another process")
+        elif self.recorder is not None:
+            self.recorder.log_plan(plan.tick, plan.agent, plan.path)
+
     def _open_recorder(self, path, viewer: str | None):
         from swarm.recording_arena import ArenaRecorder
 
