@@ -17,12 +17,11 @@ import uuid
 import numpy as np
 
 from agents.controllers import aot
+from agents.controllers.arena import ARENA_CONTROLLERS
 from agents.controllers.layout import A_MARK, MARK, MARK_NONE, controller_kind, new_action, new_memory
 from swarm import protocol as proto
 from swarm.bus import DEFAULT_ENDPOINT, open_client
 from swarm.monitor import world_info
-
-ARENA_CONTROLLERS = ("carrot", "wander")
 
 
 class JoinRefused(RuntimeError):

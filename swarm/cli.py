@@ -8,6 +8,7 @@ import signal
 import sys
 from pathlib import Path
 
+from agents.controllers.arena import ARENA_CONTROLLERS
 from swarm.cli_arena import (
     add_arena_run_args,
     add_sense_parser,
@@ -18,9 +19,9 @@ from swarm.cli_arena import (
     run_arena,
 )
 from swarm.errors import RecordingError, raise_interrupt
-from swarm.scenario import PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
+from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
 
-CONTROLLERS = ["cmarking", "marking", "ant", "carrot", "wander"]
+CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -344,7 +345,7 @@ def _scenario(args):
     common = {"agents": args.agents, "controller": args.controller, "seed": args.seed}
     if is_arena(scenario):
         return scenario.with_overrides(**common, **arena_overrides(args))
-    if args.controller in ("carrot", "wander"):
+    if args.controller in ARENA_CONTROLLERS:
         raise ScenarioError("command line", "controller", f"{args.controller} drives arena robots; pick an arena "
                             "scenario (zmaze, large-maze, ...) or a grid controller")  # fmt: skip
     return scenario.with_overrides(**common, physics=args.physics, body_diameter=args.body_diameter)

@@ -227,15 +227,25 @@ def parse_obs(data: bytes) -> Obs | Rejected | dict:
     return Obs(tick, agents, cells, pi, pf)
 
 
-def act_header(data: bytes, family: str) -> tuple[dict, int, np.ndarray] | Rejected:
-    """What every family's action message shares: (message, tick, agents)."""
-    m = unpack(data)
-    if isinstance(m, Rejected):
-        return m
-    if m.get("type") != "act":
-        return Rejected("not an action")
+def family_message(data: bytes, kind: str, family: str, what: str, limit: int = MAX_MESSAGE_BYTES) -> dict | Rejected:
+    """A message of this type and controller family, unpacked."""
+    m = unpack(data, limit)
+    return m if isinstance(m, Rejected) else check_family(m, kind, family, what)
+
+
+def check_family(m: dict, kind: str, family: str, what: str) -> dict | Rejected:
+    if m.get("type") != kind:
+        return Rejected(f"not {what}")
     if m.get("family") != family:
         return Rejected("unknown controller family")
+    return m
+
+
+def act_header(data: bytes, family: str) -> tuple[dict, int, np.ndarray] | Rejected:
+    """What every family's action message shares: (message, tick, agents)."""
+    m = family_message(data, "act", family, "an action")
+    if isinstance(m, Rejected):
+        return m
     tick, agents = int_field(m, "tick"), int_list(m, "agents")
     if bad := first_rejection(tick, agents):
         return bad

@@ -17,7 +17,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm.protocol import FAMILY_ARENA, Rejected, act_header, first_rejection, int_field, int_list, pack, unpack
+from swarm.protocol import (
+    FAMILY_ARENA,
+    Rejected,
+    act_header,
+    check_family,
+    family_message,
+    first_rejection,
+    int_field,
+    int_list,
+    pack,
+    unpack,
+)
 
 MAX_OBS_BYTES = 64 * 1024 * 1024  # observations come from the world; 100 animats take ~100 KB
 DTYPES = {"<f8": np.float64, "<i8": np.int64, "|u1": np.uint8, "|b1": np.bool_}
@@ -73,12 +84,11 @@ def _decode(entry) -> np.ndarray | Rejected:
 def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
     """A batch of readings, or the raw dict of a `stop` message."""
     m = unpack(data, MAX_OBS_BYTES)
+    if isinstance(m, Rejected) or m.get("type") == "stop":
+        return m
+    m = check_family(m, "obs", FAMILY_ARENA, "an arena observation")
     if isinstance(m, Rejected):
         return m
-    if m.get("type") == "stop":
-        return m
-    if m.get("type") != "obs" or m.get("family") != FAMILY_ARENA:
-        return Rejected("not an arena observation")
     tick, agents = int_field(m, "tick"), int_list(m, "agents")
     if bad := first_rejection(tick, agents):
         return bad
@@ -124,11 +134,9 @@ def plan_message(tick: int, agent: int, path: np.ndarray) -> bytes:
 
 
 def parse_plan(data: bytes) -> Plan | Rejected:
-    m = unpack(data)
+    m = family_message(data, "plan", FAMILY_ARENA, "a plan")
     if isinstance(m, Rejected):
         return m
-    if m.get("type") != "plan" or m.get("family") != FAMILY_ARENA:
-        return Rejected("not a plan")
     tick, agent = int_field(m, "tick"), int_field(m, "agent")
     if bad := first_rejection(tick, agent):
         return bad

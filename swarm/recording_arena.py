@@ -45,14 +45,8 @@ def arena_meta(scenario, world, run_id: str, runtime: str) -> dict:
     """What a reader needs to interpret the recording: taken at the first tick
     recorded, when the robots that start the run are in the world (a robot
     that joins later has no start or L_o here, and no row in `swarm report`)."""
-    from swarm.arena.engine import optimal_lengths
-
     inside = np.flatnonzero(world.in_world).tolist()
-    for a, lo in enumerate(
-        optimal_lengths(scenario, world.start_pose, [a for a in inside if world.optimum[a] is None])
-    ):
-        if lo is not None:
-            world.optimum[a] = lo
+    world.fill_optimum()
     return {"kind": "arena", "run_id": run_id, "runtime": runtime, "scenario": scenario.describe(),
             "name": scenario.name, "controller": scenario.controller, "agents": scenario.agents,
             "seed": scenario.seed, "noise": scenario.noise.level, "control_period": scenario.control_period,
@@ -101,7 +95,7 @@ class ArenaRecorder:
         self._pose: list[np.ndarray] = []
         self._robots: dict[str, list[np.ndarray]] = {k: [] for k in ROBOT_SERIES}
         self._metrics: dict[str, list[float]] = {k: [] for k in ARENA_METRICS}
-        self._paths: list[np.ndarray] = [world.pose[:, None, :2].astype(np.float32)]  # (n, T, 2) pieces
+        self._paths = world.pose[:, None, :2].astype(np.float32)  # (n, T, 2): every robot's path so far
         self._obstacles_on: tuple | None = None
         self._plans_logged: set[int] = set()
         self._static_done = False
@@ -259,8 +253,7 @@ class ArenaRecorder:
             rec.send_columns(f"metrics/robots/{name}", indexes=index,
                              columns=rr.Scalars.columns(scalars=values).partition([n] * len(ticks)))  # fmt: skip
             self._robots[name] = []
-        self._paths = [np.concatenate([*self._paths, pose[..., :2].transpose(1, 0, 2)], axis=1)]
-        paths = self._paths[0]
+        self._paths = paths = np.concatenate([self._paths, pose[..., :2].transpose(1, 0, 2)], axis=1)
         rec.set_time("tick", sequence=int(ticks[-1]))
         rec.log("world/trajectories", rr.LineStrips2D([flip(p) for p in paths], colors=self.colours, radii=0.002,
                                                       draw_order=4.0))  # fmt: skip

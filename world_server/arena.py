@@ -74,7 +74,6 @@ class ArenaWorld:
         self.bodies = DiffDrive(start, self.radius, s.wall_rects(), s.wall_segments(), s.control_period, s.substeps,
                                 self.in_world)  # fmt: skip
         self.present = np.ones(self.n, np.bool_)  # False: the agent is gone, its body stays as an obstacle
-        self._bodies_block = self.in_world  # every body in the world blocks rays, present or not
         self.suites: list[Suite] = []
         first = 0
         for g in s.groups:
@@ -171,7 +170,7 @@ class ArenaWorld:
         them); `mask` says which layers each ray sees (default: all)."""
         xy = np.ascontiguousarray(self.pose[:, :2])
         while True:
-            got = build_disc_index(xy, self.radius, self._bodies_block, 0.0, 0.0, self.cell, self.nx,
+            got = build_disc_index(xy, self.radius, self.in_world, 0.0, 0.0, self.cell, self.nx,
                                    self.ny, self.d_start, self.d_items, self.d_xyr)  # fmt: skip
             if got >= 0:
                 break
@@ -194,16 +193,20 @@ class ArenaWorld:
         rgb[robot] = self.robot_rgb[-2 - what[robot]]
         return rgb
 
+    def _refusals(self, actions: np.ndarray, robots: np.ndarray) -> np.ndarray:
+        """Per row of (k, 2) wheel speeds for these robots: the index in
+        REJECT_REASONS of why it cannot be acted on, or -1."""
+        finite = np.isfinite(actions).all(axis=1)
+        over = (np.abs(np.where(finite[:, None], actions, 0.0)) > self.max_wheel[robots, None] * (1 + 1e-9)).any(axis=1)
+        return np.where(~finite, 0, np.where(over, 1, -1))
+
     def judge(self, agent: int, wheels: np.ndarray) -> str | None:
         """Why one robot's wheel speeds cannot be acted on, or None."""
         wheels = np.asarray(wheels, np.float64)
         if wheels.shape != (ACTION_LEN,):
             return "wrong shape"
-        if not np.isfinite(wheels).all():
-            return "not finite"
-        if (np.abs(wheels) > self.max_wheel[agent] * (1 + 1e-9)).any():
-            return "over the wheel limit"
-        return None
+        k = int(self._refusals(wheels[None], np.array([agent]))[0])
+        return None if k < 0 else REJECT_REASONS[k]
 
     def validate(self, actions: np.ndarray) -> np.ndarray:
         """Which rows of (n, 2) wheel speeds may be acted on; the others are
@@ -212,12 +215,10 @@ class ArenaWorld:
         if actions.shape != (self.n, ACTION_LEN):
             self.rejected["wrong shape"] += self.n
             return np.zeros(self.n, np.bool_)
-        finite = np.isfinite(actions).all(axis=1)
-        within = finite & (np.abs(np.where(finite[:, None], actions, 0.0)) <= self.max_wheel[:, None] * (1 + 1e-9)
-                           ).all(axis=1)  # fmt: skip
-        self.rejected["not finite"] += int((~finite).sum())
-        self.rejected["over the wheel limit"] += int((finite & ~within).sum())
-        return within
+        why = self._refusals(actions, np.arange(self.n))
+        for k in (0, 1):
+            self.rejected[REJECT_REASONS[k]] += int((why == k).sum())
+        return why < 0
 
     def apply(self, actions: np.ndarray, ok: np.ndarray | None = None) -> None:
         """Integrate one control period from validated wheel speeds (rows with
@@ -339,6 +340,17 @@ class ArenaWorld:
         self.present[agent] = False
 
     # -------------------------------------------------------------- summary
+
+    def fill_optimum(self) -> None:
+        """L_o (A*) for every robot in the world that has none yet: once per robot,
+        its start does not change once it is in."""
+        from swarm.arena.engine import optimal_lengths
+
+        missing = [a for a in np.flatnonzero(self.in_world).tolist() if self.optimum[a] is None]
+        if missing:
+            for a, lo in enumerate(optimal_lengths(self.scenario, self.start_pose, missing)):
+                if lo is not None:
+                    self.optimum[a] = lo
 
     def robot_summaries(self, optimum: list[float | None]) -> list[dict[str, Any]]:
         """One row per robot that has been in the world."""

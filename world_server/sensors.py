@@ -102,6 +102,10 @@ class Suite:
         self.offsets = np.concatenate(offsets) if offsets else np.zeros(0)
         self.masks = np.concatenate(masks) if masks else np.zeros(0, np.uint8)
         self.per_robot = len(self.bearings)
+        n = len(self.robots)
+        bearing = np.tile(self.bearings, n)  # the group's rays, robot-major, without noise
+        self._fixed = (np.repeat(self.robots, self.per_robot), bearing, np.tile(self.ranges, n), np.cos(bearing),
+                       np.sin(bearing), np.tile(self.masks, n))  # fmt: skip
 
     # ------------------------------------------------------------------ rays
 
@@ -111,16 +115,6 @@ class Suite:
         solids).  The sonar's bearing error turns each cone as a whole; the
         other bearings are fixed, so their cosines are computed once."""
         n = len(self.robots)
-        if not hasattr(self, "_fixed"):
-            bearing = np.tile(self.bearings, n)
-            self._fixed = (
-                np.repeat(self.robots, self.per_robot),
-                bearing,
-                np.tile(self.ranges, n),
-                np.cos(bearing),
-                np.sin(bearing),
-                np.tile(self.masks, n),
-            )
         sonar = self.model.sensors.sonar
         if not (sonar and self.noise.factor("sonar") and sonar.bearing_error):
             return self._fixed

@@ -21,6 +21,7 @@ REGISTRY = {
     "carrot": "agents.controllers.carrot:CarrotController",
     "wander": "agents.controllers.wander:WanderController",
 }
+ARENA_CONTROLLERS = tuple(REGISTRY)
 # What a controller needs its robot to sense (checked when a scenario is loaded).
 REQUIRES = {"carrot": ("position", "compass"), "wander": ()}
 

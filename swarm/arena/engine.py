@@ -109,11 +109,7 @@ class ArenaEngine:
 
 def arena_summary(world: ArenaWorld, wall_seconds: float, runtime: str) -> dict[str, Any]:
     s = world.scenario
-    missing = [a for a in np.flatnonzero(world.in_world).tolist() if world.optimum[a] is None]
-    if missing:  # A* once per robot: its start does not change once it is in
-        for a, lo in enumerate(optimal_lengths(s, world.start_pose, missing)):
-            if lo is not None:
-                world.optimum[a] = lo
+    world.fill_optimum()
     robots = world.robot_summaries(world.optimum)
     goals = [r for r in robots if r["goal"] is not None]
     ratios = [r["path_ratio"] for r in robots if r["path_ratio"] is not None]

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from agents.controllers.arena import ARENA_CONTROLLERS, REQUIRES
 from swarm.arena.models import (
     IR,
     MODELS,
@@ -42,7 +43,6 @@ from swarm.arena.models import (
 from swarm.scenario import ScenarioError, no_unknown, typed
 from world_server.sensors import NOISE_LEVELS, ZONE_KINDS, Noise
 
-ARENA_CONTROLLERS = ("carrot", "wander")
 START_STREAM = 0x53544152  # keeps start-pose draws apart from every other use of the seed
 GOAL_STREAM = 0x474F414C
 SPACED_DRAWS = 200
@@ -583,8 +583,6 @@ def check_arena(s: ArenaScenario, source: str) -> None:
                                 "wheel speed and turn rate")  # fmt: skip
         if g.count < 1:
             raise ScenarioError(source, f"group {gi + 1}.count", f"expected at least 1, got {g.count}")
-        from agents.controllers.arena import REQUIRES
-
         missing = [k for k in REQUIRES.get(g.controller, ()) if not getattr(m.sensors, k)]
         if missing:
             raise ScenarioError(source, f"group {gi + 1}.robot", f"{g.controller} needs the {' and '.join(missing)} "
