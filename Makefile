@@ -12,13 +12,16 @@ install: $(STAMP)
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "swarm needs Python 3.11 or newer"'
-	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[dev]'
+	@echo "swarm: installing into $(VENV) (a few minutes the first time; errors, if any, are shown)"
+	@$(PYTHON) -m venv $(VENV)
+	@$(BIN)/pip install -qq --upgrade pip
+	@$(BIN)/pip install -qq -e '.[dev]'
 	@touch $(STAMP)
+	@echo "swarm: installed: $(BIN)/swarm --help"
 
 demo: install
-	$(BIN)/swarm up setup1 --agents 20 --seed 1
+	@echo "swarm: 20 agent processes forage on setup1 (the first run compiles the kernels, about a minute)"
+	@$(BIN)/swarm up setup1 --agents 20 --seed 1
 
 # The web-viewer test drives Debian's chromium headless (Playwright, no browser download).
 browser:

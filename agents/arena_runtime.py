@@ -40,7 +40,7 @@ class ArenaAgentRuntime(AgentRuntime):
             agents.append(agent)
             wheels.append(np.zeros(2) if self.null else self.brains[slot].step(reading))
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 2))
-        self.session.put(self.keys.act(self.group), payload)
+        self.act_publisher.put(payload)
         if not self.null:
             self._send_plans(obs.tick, agents)
         return len(agents)

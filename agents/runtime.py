@@ -10,7 +10,7 @@ a family's controllers are and how their messages look is the subclass's:
 
 from __future__ import annotations
 
-import queue
+import threading
 import time
 import uuid
 
@@ -18,25 +18,26 @@ import numpy as np
 
 from agents.controllers import aot
 from agents.controllers.arena import ARENA_CONTROLLERS
-from agents.controllers.layout import A_MARK, MARK, MARK_NONE, controller_kind, new_action, new_memory
+from agents.controllers.layout import A_MARK, controller_kind, new_memory
 from swarm import protocol as proto
 from swarm.bus import DEFAULT_ENDPOINT, open_client
+from swarm.errors import RunError
 from swarm.monitor import world_info
 
 
-class JoinRefused(RuntimeError):
+class JoinRefused(RunError):
     pass
 
 
 def load_step():
-    """The ahead-of-time build of the controller step when it exists (no numba
+    """The ahead-of-time build of `dispatch.answer_rows` when it exists (no numba
     in this process), else the JIT's (compiled or loaded from the cache now)."""
     step = aot.load()
     if step is None:
-        from agents.controllers.dispatch import step_controller, warm_up
+        from agents.controllers.dispatch import answer_rows, warm_up
 
         warm_up()
-        step = step_controller
+        step = answer_rows
     return step
 
 
@@ -51,11 +52,15 @@ class AgentRuntime:
         self.null = null  # benchmark floor: answer without running the controller
         self._prepare(count)  # before joining: the world observes us at once
         self.idle_timeout = idle_timeout
-        self.inbox: queue.Queue = queue.Queue()
         self.session = open_client(connect, timeout=join_timeout)
         self.group = uuid.uuid4().hex  # this process: its agents' messages travel together
         # Subscribed before joining: the world starts observing an agent as soon as it sees its token.
-        self._decls = [self.session.declare_subscriber(self.keys.obs(self.group), self.inbox.put)]
+        # A FIFO channel read by the main thread: no Python callback thread between zenoh and the step.
+        self.inbox = self.session.declare_subscriber(self.keys.obs(self.group))
+        self.act_publisher = self.session.declare_publisher(self.keys.act(self.group))
+        self._decls = [self.inbox, self.act_publisher]
+        self._heard = time.monotonic()  # when the last observation came
+        self._closed = threading.Event()
         self.agents: list[int] = []  # our agents' ids, by slot
         self.tokens: dict[int, object] = {}  # agent id -> its liveliness token
         self.rejoin_after = rejoin_after
@@ -77,6 +82,9 @@ class AgentRuntime:
 
     def _answer(self, obs) -> int:
         raise NotImplementedError
+
+    def _restore(self, memory) -> None:
+        """A resumed world hands back the controllers' memory of its saved tick."""
 
     # -------------------------------------------------------------- transport
 
@@ -105,27 +113,42 @@ class AgentRuntime:
     def run(self) -> int:
         """Answer observations until the world says stop; returns agent-steps answered."""
         answered = 0
-        heard = time.monotonic()
+        self._heard = time.monotonic()
+        threading.Thread(target=self._wake_when_quiet, name="swarm-wake", daemon=True).start()
         while True:
-            try:
-                batch = [self.inbox.get(timeout=self.rejoin_after)]
-            except queue.Empty:
-                if time.monotonic() - heard > self.idle_timeout:
-                    raise TimeoutError(f"no observation for {self.idle_timeout:.0f} s; is the world gone?") from None
-                self._rejoin_if_dropped()
-                continue
-            heard = time.monotonic()
-            while not self.inbox.empty():  # behind (real time): answer only the newest
-                batch.append(self.inbox.get_nowait())
+            batch = [self.inbox.recv()]
+            while (more := self.inbox.try_recv()) is not None:  # behind (real time): answer only the newest
+                batch.append(more)
             latest = None
             for sample in batch:
                 msg = self._parse(sample.payload.to_bytes())
-                if isinstance(msg, dict):  # stop
-                    return answered
-                if not isinstance(msg, proto.Rejected):
+                if isinstance(msg, dict):
+                    if msg.get("type") == "stop":
+                        return answered
+                elif isinstance(msg, proto.Memory):
+                    self._heard = time.monotonic()
+                    self._restore(msg)
+                elif not isinstance(msg, proto.Rejected):
                     latest = msg
             if latest is not None:
+                self._heard = time.monotonic()
                 answered += self._answer(latest)
+            elif (quiet := time.monotonic() - self._heard) > self.idle_timeout:
+                raise TimeoutError(f"no observation for {self.idle_timeout:.0f} s; is the world gone?")
+            elif quiet >= self.rejoin_after:
+                self._rejoin_if_dropped()
+
+    def _wake_when_quiet(self) -> None:
+        """The main thread blocks in the channel: when no observation has come
+        for `rejoin_after`, wake it with a message to ourselves so that it can
+        check our membership (and give up after `idle_timeout`)."""
+        wake = proto.pack({"type": "wake"})
+        while not self._closed.wait(self.rejoin_after / 2):
+            if time.monotonic() - self._heard >= self.rejoin_after:
+                try:
+                    self.session.put(self.keys.obs(self.group), wake)
+                except Exception:  # the session is closing
+                    return
 
     def _rejoin_if_dropped(self) -> None:
         """Quiet for a while: if the world has declared some of our agents lost
@@ -151,60 +174,64 @@ class AgentRuntime:
         self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
 
     def close(self) -> None:
+        self._closed.set()
         for d in [*self._decls, *self.tokens.values()]:
             d.undeclare()
         self.session.close()
 
 
 class GridAgentRuntime(AgentRuntime):
-    """Grid controllers: one compiled step over flat arrays, memory per agent."""
+    """Grid controllers: one compiled call checks and steps the whole batch
+    (`dispatch.answer_rows`); memory per agent."""
 
     family = proto.FAMILY_GRID
 
     def _prepare(self, count: int) -> None:
         self.kind = controller_kind(self.controller)
-        self.step = None if self.null else load_step()
+        self.answer_rows = load_step()
         self.mem = new_memory(count)
-        self.act = new_action()
-        self.seed = 0
+        self.rows = np.zeros((count, proto.ACT_ROW), dtype=np.int64)  # the action message, reused
+        self.slot_table = np.full(0, -1, dtype=np.int64)  # agent id -> its slot (memory row), -1: not ours
+        self.seed = np.int64(0)
         self.params = np.zeros(1)
 
     def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
-        self.seed = int(msg["seed"])
+        self.seed = np.int64(msg["seed"])
         self.params = np.array(msg["params"], dtype=np.float64)
         self.mem[slot] = new_memory(1)[0]
+        self.slot_table[self.slot_table == slot] = -1
+        if agent >= len(self.slot_table):
+            self.slot_table = np.concatenate([self.slot_table, np.full(agent + 1 - len(self.slot_table), -1)])
+        self.slot_table[agent] = slot
 
     def _parse(self, data: bytes):
-        return proto.parse_obs(data)
+        return proto.obs_blocks(data)
 
-    def _answer(self, obs: proto.Obs) -> int:
-        """Step every agent of ours in the batch; one mark message, one action message."""
-        acts = np.zeros((len(obs.agents), self.act.shape[0]), dtype=np.int64)
-        agents, marked, mark_agents, mark_cells, mark_values = [], [], [], [], []
-        seed = np.int64(self.seed)
-        for i, agent in enumerate(obs.agents.tolist()):
-            slot = self.slot_of.get(agent)
-            if slot is None:
-                continue
-            act = acts[len(agents)]
-            if self.null:
-                act[0] = 4  # STAY
-            else:
-                self.step(self.kind, obs.pi[i], obs.pf[i], self.mem[slot], act, self.params, seed, agent, obs.tick)
-            value = int(act[A_MARK])
-            lowers = value != MARK_NONE and value < obs.pi[i, MARK]  # a write that changes nothing is not sent
-            if lowers:
-                mark_agents.append(agent)
-                mark_cells.append(int(obs.cells[i]))
-                mark_values.append(value)
-            agents.append(agent)
-            marked.append(lowers)
-        if mark_agents:
-            self.session.put(
-                self.keys.mark(self.group), proto.mark_writes(obs.tick, mark_agents, mark_cells, mark_values)
-            )
-        self.session.put(self.keys.act(self.group), proto.actions(obs.tick, agents, acts[: len(agents)], marked))
-        return len(agents)
+    def _restore(self, memory: proto.Memory) -> None:
+        for agent, *words in memory.rows.tolist():
+            if (slot := self.slot_of.get(agent)) is not None:
+                self.mem[slot] = words
+
+    def _answer(self, obs: proto.ObsBlocks) -> int:
+        """Step every agent of ours in the batch; one action message, and one
+        mark message when a write lowers a mark."""
+        n = self.answer_rows(self.kind, np.frombuffer(obs.ints, "<i8"), np.frombuffer(obs.pf, "<f8"), self.mem,
+                             self.slot_table, self.rows, self.params, self.seed, obs.tick, self.null)  # fmt: skip
+        if n < 0:
+            return 0  # a malformed observation: not answered (the world counts the miss)
+        rows = self.rows[:n]
+        if rows[:, proto.R_MARKED].any():
+            self._send_marks(obs, rows)
+        self.act_publisher.put(proto.pack_actions(obs.tick, rows))
+        return n
+
+    def _send_marks(self, obs: proto.ObsBlocks, rows: np.ndarray) -> None:
+        ints = np.frombuffer(obs.ints, "<i8").reshape(-1, proto.OBS_INTS)
+        cell_of = dict(zip(ints[:, 0].tolist(), ints[:, 1].tolist(), strict=True))
+        marked = rows[rows[:, proto.R_MARKED] == 1]
+        agents = marked[:, proto.R_AGENT].tolist()
+        self.session.put(self.keys.mark(self.group), proto.mark_writes(
+            obs.tick, agents, [cell_of[a] for a in agents], marked[:, proto.R_ACT + A_MARK].tolist()))  # fmt: skip
 
 
 def make_runtime(run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,

@@ -8,6 +8,7 @@ survive fork (agents are started with `spawn` or as separate commands).
 from __future__ import annotations
 
 import json
+import re
 import time
 
 import zenoh
@@ -31,13 +32,25 @@ def config(mode: str, listen: list[str] | None = None, connect: list[str] | None
     return c
 
 
+def direct(callback) -> zenoh.handlers.Callback:
+    """A callback run on zenoh's own receiving thread rather than a Python
+    thread of its own: one thread hand-off less per message.  It must only
+    enqueue (e.g. `queue.SimpleQueue.put`, which is C and never blocks)."""
+    return zenoh.handlers.Callback(callback, indirect=False)
+
+
+def _said(exc: Exception) -> str:
+    """zenoh's error without the Rust source locations it appends."""
+    return re.sub(r" at /\S+\.rs:\d+\.?", "", str(exc))
+
+
 def open_router(listen: str = DEFAULT_ENDPOINT) -> zenoh.Session:
     """A session in router mode: the embedded router every other process joins."""
     try:
         return zenoh.open(config("router", listen=[listen]))
     except zenoh.ZError as exc:
         raise ConnectionError(
-            f"cannot listen on {listen} ({exc}); is another world running? pick another --listen"
+            f"cannot listen on {listen} ({_said(exc)}); is another world running? pick another --listen"
         ) from None
 
 
@@ -50,6 +63,6 @@ def open_client(connect: str = DEFAULT_ENDPOINT, timeout: float = 30.0) -> zenoh
         except zenoh.ZError as exc:
             if time.monotonic() > deadline:
                 raise ConnectionError(
-                    f"no zenoh router at {connect} after {timeout:.0f} s ({exc}); start `swarm world` first"
+                    f"no zenoh router at {connect} after {timeout:.0f} s ({_said(exc)}); start `swarm world` first"
                 ) from None
             time.sleep(0.2)

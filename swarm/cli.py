@@ -18,7 +18,7 @@ from swarm.cli_arena import (
     print_arena_summary,
     run_arena,
 )
-from swarm.errors import RecordingError, raise_interrupt
+from swarm.errors import RecordingError, RunError, raise_interrupt
 from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
 
 CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
@@ -157,6 +157,8 @@ def build_parser() -> argparse.ArgumentParser:
     _client_args(agent)
     agent.add_argument("--count", type=_positive, default=1, metavar="K", help="independent agents in this process")
     agent.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
+    agent.add_argument("--join-timeout", type=float, default=60.0, metavar="S",
+                       help="give up when no world has answered within S seconds (default 60)")  # fmt: skip
 
     up = sub.add_parser(
         "up",
@@ -310,10 +312,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ScenarioError, RecordingError) as exc:
         print(f"swarm: error: {exc}", file=sys.stderr)
         return 2
-    except (ConnectionError, TimeoutError) as exc:
+    except (ConnectionError, TimeoutError, RunError) as exc:
         print(f"swarm: error: {exc}", file=sys.stderr)
         return 2
-
     except KeyboardInterrupt:
         print("swarm: interrupted", file=sys.stderr)
         return 130
@@ -373,7 +374,8 @@ def cmd_agent(args) -> int:
     from swarm.protocol import ENDED
 
     try:
-        runtime = make_runtime(args.run_id, args.controller, args.connect, args.count, null=args.null)
+        runtime = make_runtime(args.run_id, args.controller, args.connect, args.count, null=args.null,
+                               join_timeout=args.join_timeout)  # fmt: skip
     except JoinRefused as exc:
         print(f"swarm: {exc}", file=sys.stderr)
         return 0 if ENDED in str(exc) else 2  # a late agent of a finished run has nothing to do

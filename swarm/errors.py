@@ -3,6 +3,10 @@ SIGTERM handler that turns termination into KeyboardInterrupt, kept in a module
 that imports nothing heavy so the command can use them cheaply."""
 
 
+class RunError(Exception):
+    """A run cannot start or go on: a process of it failed, or the world refused an agent."""
+
+
 class RecordingError(Exception):
     """A recording is missing, not a swarm recording, damaged or truncated."""
 

@@ -22,7 +22,7 @@ from agents.controllers import aot
 from agents.controllers.dispatch import warm_up
 from swarm import protocol as proto
 from swarm.bus import open_client
-from swarm.errors import raise_interrupt
+from swarm.errors import RunError, raise_interrupt
 from swarm.scenario import PhysicsParams, is_arena, load_scenario
 from world_server.grid import GridWorld
 
@@ -135,32 +135,70 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
             agent_cmds += [cmd + (["--null"] if null else [])] * (n // per_process)
         if null:
             world_cmd.append("--null")
-        quiet = {"stdout": subprocess.DEVNULL, "start_new_session": True}
-        procs: list[subprocess.Popen] = []
+        children = _Children(Path(tmp), run_id)
         session = None
         try:
-            world = subprocess.Popen(world_cmd, **quiet)
-            procs.append(world)
+            world = children.start("the world", world_cmd)
             session = _connect(listen, world)
             rss = {}
             if session is not None:  # None: the world is already done (e.g. it resumed a finished run)
-                procs += [subprocess.Popen(cmd, **quiet) for cmd in agent_cmds]
-                rss = _follow(session, proto.Keys(run_id), world, procs, agents, progress)
+                for i, cmd in enumerate(agent_cmds):
+                    children.start(f"agent process {i + 1}", cmd)
+                rss = _follow(session, proto.Keys(run_id), children, agents, progress)
             world.wait()
             if not summary_file.exists():  # exit 1 with a summary is an unfinished run, not a failure
-                raise RuntimeError(f"the world process failed (exit {world.returncode}); its errors are above")
+                raise children.failure(world)
             summary = json.loads(summary_file.read_text())
             if rss:
                 summary["agent_process_rss_mb"] = round(max(rss.values()) / 1024, 1)
             grace = time.monotonic() + 10  # agents leave on the world's stop message; the rest are ended below
-            for p in procs[1:]:
+            for p in children.procs[1:]:
                 with contextlib.suppress(subprocess.TimeoutExpired):
                     p.wait(timeout=max(0.0, grace - time.monotonic()))
             return summary
         finally:
             if session is not None:
                 session.close()
-            _terminate(procs)
+            _terminate(children.procs)
+
+
+class _Children:
+    """The launcher's processes, each with its standard error in a file, so
+    that a failure is said in one line (the child's own last error) rather
+    than as the child's output."""
+
+    def __init__(self, folder: Path, run_id: str):
+        self.folder, self.run_id = folder, run_id
+        self.procs: list[subprocess.Popen] = []
+        self.names: dict[int, str] = {}
+
+    def start(self, name: str, cmd: list[str]) -> subprocess.Popen:
+        log = self.folder / f"child-{len(self.procs)}.err"
+        with open(log, "wb") as err:
+            p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err, start_new_session=True)
+        self.procs.append(p)
+        self.names[p.pid] = name
+        return p
+
+    def failed_agent(self) -> subprocess.Popen | None:
+        return next((p for p in self.procs[1:] if p.poll() not in (None, 0)), None)
+
+    def failure(self, p: subprocess.Popen) -> RunError:
+        """The error to report for a failed child: its own last error line;
+        the whole of its output is kept in a file named in the message."""
+        i = self.procs.index(p)
+        text = (self.folder / f"child-{i}.err").read_text(errors="replace")
+        lines = [line.strip() for line in text.splitlines() if line.strip()]
+        ours = [line for line in lines if line.startswith("swarm")]
+        cause = (ours or lines or [f"it exited with status {p.returncode} and said nothing"])[-1]
+        cause = cause.removeprefix("swarm: error: ").removeprefix("swarm: ")
+        name = self.names[p.pid]
+        where = ""
+        if not ours and lines:  # not one of our errors (a crash): keep its output for the bug report
+            kept = Path(tempfile.gettempdir()) / f"swarm-{self.run_id}-{name.replace(' ', '-')}.log"
+            kept.write_text(text)
+            where = f" (its output: {kept})"
+        return RunError(f"{name} failed: {cause}{where}; every process of the run was stopped")
 
 
 def _connect(listen: str, world: subprocess.Popen, timeout: float = 300.0):
@@ -186,12 +224,14 @@ def _rss_kb(pid: int) -> int:
     return 0
 
 
-def _follow(session, keys: proto.Keys, world: subprocess.Popen, procs, agents: int, progress: bool) -> dict:
-    """Show progress until the world exits; return each agent process's peak RSS (kB)."""
+def _follow(session, keys: proto.Keys, children: _Children, agents: int, progress: bool) -> dict:
+    """Show progress until the world exits; return each agent process's peak RSS (kB).
+    An agent process that fails stops the run (RunError)."""
     import queue
 
     from tqdm import tqdm
 
+    world, procs = children.procs[0], children.procs
     rss: dict[int, int] = {}
     states: queue.Queue = queue.Queue()
     sub = session.declare_subscriber(keys.state, states.put)
@@ -201,12 +241,14 @@ def _follow(session, keys: proto.Keys, world: subprocess.Popen, procs, agents: i
             try:
                 msg = proto.unpack(states.get(timeout=0.5).payload.to_bytes())
             except queue.Empty:
-                if any(p.poll() not in (None, 0) for p in procs[1:]) and progress:
-                    bar.set_postfix_str("an agent process exited")
+                if (failed := children.failed_agent()) is not None:
+                    raise children.failure(failed) from None
                 continue
             if isinstance(msg, proto.Rejected):
                 continue
             if msg.get("tick", 0) % 50 == 1:
+                if (failed := children.failed_agent()) is not None:
+                    raise children.failure(failed)
                 for p in procs[1:]:
                     rss[p.pid] = max(rss.get(p.pid, 0), _rss_kb(p.pid))
             bar.total = msg.get("total", msg.get("with_goal"))

@@ -26,19 +26,26 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import msgpack
 import numpy as np
 
-from agents.controllers.layout import ACT_LEN, PERC_F_LEN, PERC_LEN
+from agents.controllers.layout import ACT_LEN, MEM_LEN, PERC_F_LEN, PERC_LEN, new_memory
 
-VERSION = 1
+VERSION = 2
 FAMILY_GRID = "grid"
 FAMILY_ARENA = "arena"
 FAMILIES = (FAMILY_GRID, FAMILY_ARENA)
 MAX_MESSAGE_BYTES = 64 * 1024
 MAX_WELCOME_BYTES = 16 * 1024 * 1024  # an arena agent's welcome carries its map
 INT64_MAX = 2**63 - 1
+OBS_PERCEPTION = 2  # an observation row: agent, cell, then the integer perception
+OBS_INTS = OBS_PERCEPTION + PERC_LEN
+R_AGENT, R_ACT = 0, 1  # an action row: agent, action (ACT_LEN), marked, memory (MEM_LEN)
+R_MARKED = R_ACT + ACT_LEN
+R_MEM = R_MARKED + 1
+ACT_ROW = R_MEM + MEM_LEN
 ENDED = "the run has ended"  # the world's refusal to a join after the run (the agent then exits quietly)
 
 
@@ -108,15 +115,6 @@ def int_field(message: dict, key: str, low: int = 0, high: int = INT64_MAX) -> i
     return value
 
 
-def _ints(message: dict, key: str, length: int) -> np.ndarray | Rejected:
-    values = message.get(key)
-    if not isinstance(values, list) or len(values) != length:
-        return Rejected(f"{key}: expected {length} integers")
-    if not all(isinstance(v, int) and not isinstance(v, bool) and -INT64_MAX <= v <= INT64_MAX for v in values):
-        return Rejected(f"{key}: expected {length} integers")
-    return np.array(values, dtype=np.int64)
-
-
 # ------------------------------------------------------------------- messages
 
 
@@ -134,19 +132,42 @@ def refuse_reply(reason: str) -> bytes:
     return pack({"type": "refused", "reason": reason})
 
 
-def observations(tick: int, agents: np.ndarray, cells: np.ndarray, pi: np.ndarray, pf: np.ndarray) -> bytes:
-    """One message for every agent of one agent process: pi (K x PERC_LEN int64)
-    and pf (K x PERC_F_LEN float64) travel as little-endian binary blocks."""
-    return pack({"type": "obs", "tick": tick, "agents": agents.tolist(), "cells": cells.tolist(),
-                 "pi": pi.astype("<i8").tobytes(), "pf": pf.astype("<f8").tobytes()})  # fmt: skip
+def observations(tick: int, ints: np.ndarray, pf: np.ndarray) -> bytes:
+    """One message for every agent of one agent process.  `ints` (K x OBS_INTS,
+    int64) holds per row the agent, its cell and its integer perception; `pf`
+    (K x PERC_F_LEN, float64) its float perception; both little-endian blocks."""
+    return pack({"type": "obs", "tick": tick, "ints": ints.astype("<i8", copy=False).tobytes(),
+                 "pf": pf.astype("<f8", copy=False).tobytes()})  # fmt: skip
 
 
-def actions(tick: int, agents: list[int], acts: np.ndarray, marked: list[bool]) -> bytes:
-    """The actions of one agent process for one tick.  `marked[i]`: agent i put a
-    mark write for this tick on the marks key space (zenoh does not order puts
-    on different keys, so the world waits for both)."""
-    return pack({"type": "act", "family": FAMILY_GRID, "tick": tick, "agents": list(agents),
-                 "acts": acts.astype("<i8").tobytes(), "marked": [bool(m) for m in marked]})  # fmt: skip
+def pack_actions(tick: int, rows: np.ndarray) -> bytes:
+    """The actions of one agent process for one tick: `rows` (K x ACT_ROW, int64)
+    hold per agent its id, action, whether it put a mark write for this tick on
+    the marks key space (zenoh does not order puts on different keys, so the
+    world waits for both) and its controller memory after the step (the world
+    keeps it, so a restarted world resumes every controller exactly)."""
+    return pack({"type": "act", "family": FAMILY_GRID, "tick": tick, "rows": rows.astype("<i8", copy=False).tobytes()})
+
+
+def action_rows(agents, acts: np.ndarray, marked, memory: np.ndarray | None = None) -> np.ndarray:
+    """Rows for `pack_actions` from separate columns (tests and tools)."""
+    rows = np.zeros((len(agents), ACT_ROW), dtype=np.int64)
+    rows[:, R_AGENT] = agents
+    rows[:, R_ACT : R_ACT + ACT_LEN] = np.asarray(acts).reshape(len(agents), -1)[:, :ACT_LEN]
+    rows[:, R_MARKED] = np.asarray(marked, dtype=np.int64)
+    rows[:, R_MEM:] = new_memory(len(agents)) if memory is None else memory
+    return rows
+
+
+def actions(tick: int, agents, acts: np.ndarray, marked, memory: np.ndarray | None = None) -> bytes:
+    return pack_actions(tick, action_rows(agents, acts, marked, memory))
+
+
+def memory_message(agents: np.ndarray, memory: np.ndarray) -> bytes:
+    """World -> agent process, before the first tick of a resumed run: the
+    controller memory each of its agents had at the saved tick."""
+    rows = np.column_stack([np.asarray(agents, dtype=np.int64), memory]).astype("<i8")
+    return pack({"type": "memory", "rows": rows.tobytes()})
 
 
 def mark_writes(tick: int, agents: list[int], cells: list[int], values: list[int]) -> bytes:
@@ -162,18 +183,37 @@ def stop_message(reason: str) -> bytes:
 @dataclass(frozen=True)
 class Obs:
     tick: int
-    agents: np.ndarray  # (K,)
-    cells: np.ndarray  # (K,)
-    pi: np.ndarray  # (K, PERC_LEN)
+    ints: np.ndarray  # (K, OBS_INTS): agent, cell, integer perception
     pf: np.ndarray  # (K, PERC_F_LEN)
+
+    @property
+    def agents(self) -> np.ndarray:
+        return self.ints[:, 0]
+
+    @property
+    def cells(self) -> np.ndarray:
+        return self.ints[:, 1]
+
+    @property
+    def pi(self) -> np.ndarray:
+        return self.ints[:, 2:]
+
+
+class ObsBlocks(NamedTuple):
+    tick: int
+    ints: bytes  # K x OBS_INTS little-endian int64, unchecked
+    pf: bytes  # K x PERC_F_LEN little-endian float64, unchecked
+
+
+@dataclass(frozen=True)
+class Memory:
+    rows: np.ndarray  # (K, 1 + MEM_LEN): agent, memory
 
 
 @dataclass(frozen=True)
 class Acts:
     tick: int
-    agents: np.ndarray  # (K,)
-    acts: np.ndarray  # (K, ACT_LEN)
-    marked: np.ndarray  # (K,) bool
+    rows: np.ndarray  # (K, ACT_ROW): agent, action, marked, memory (validated by the world, row by row)
 
 
 @dataclass(frozen=True)
@@ -193,38 +233,55 @@ def int_list(m: dict, key: str, high: int = INT64_MAX) -> np.ndarray | Rejected:
     return np.array(values, dtype=np.int64)
 
 
-def _block(m: dict, key: str, rows: int, cols: int, dtype: str) -> np.ndarray | Rejected:
-    raw = m.get(key)
-    if not isinstance(raw, bytes) or len(raw) != rows * cols * 8:
-        return Rejected(f"{key}: expected {rows}x{cols} binary values")
-    block = np.frombuffer(raw, dtype=dtype).reshape(rows, cols)
-    if dtype == "<f8" and not np.isfinite(block).all():
-        return Rejected(f"{key}: not finite")
-    return block.astype(np.int64 if dtype == "<i8" else np.float64)
-
-
 def first_rejection(*values):
     return next((v for v in values if isinstance(v, Rejected)), None)
 
 
-def parse_obs(data: bytes) -> Obs | Rejected | dict:
-    """A batch of observations, or the raw dict of a `stop` message."""
+def _rows(raw, key: str, cols: int, dtype: str, limit: int = 100_000) -> np.ndarray | Rejected:
+    """A binary block of whole rows, copied (writable, native)."""
+    width = cols * 8
+    if not isinstance(raw, bytes) or len(raw) % width or len(raw) // width > limit:
+        return Rejected(f"{key}: expected rows of {cols} binary values")
+    return np.frombuffer(raw, dtype=dtype).reshape(-1, cols).copy()
+
+
+def obs_blocks(data: bytes) -> ObsBlocks | Memory | Rejected | dict:
+    """The agent's hot path: the header checked, the blocks left as bytes (the
+    compiled step checks their shapes and values, `dispatch.answer_rows`).
+    Also a resumed run's controller memory, or the raw dict of a `stop` (or
+    `wake`) message."""
     m = unpack(data)
     if isinstance(m, Rejected):
         return m
-    if m.get("type") == "stop":
+    kind = m.get("type")
+    if kind in ("stop", "wake"):
         return m
-    if m.get("type") != "obs":
+    if kind == "memory":
+        rows = _rows(m.get("rows"), "rows", 1 + MEM_LEN, "<i8")
+        return rows if isinstance(rows, Rejected) else Memory(rows)
+    if kind != "obs":
         return Rejected("not an observation")
-    tick, agents, cells = int_field(m, "tick"), int_list(m, "agents"), int_list(m, "cells")
-    if bad := first_rejection(tick, agents, cells):
+    tick, ints, pf = m.get("tick"), m.get("ints"), m.get("pf")
+    if type(tick) is not int or not 0 <= tick <= INT64_MAX:
+        return Rejected("tick: expected an integer")
+    if type(ints) is not bytes or type(pf) is not bytes:
+        return Rejected("ints, pf: expected binary blocks")
+    return ObsBlocks(tick, ints, pf)
+
+
+def parse_obs(data: bytes) -> Obs | Memory | Rejected | dict:
+    """`obs_blocks` with the blocks checked and decoded (tools and tests)."""
+    blocks = obs_blocks(data)
+    if not isinstance(blocks, ObsBlocks):
+        return blocks
+    ints, pf = _rows(blocks.ints, "ints", OBS_INTS, "<i8"), _rows(blocks.pf, "pf", PERC_F_LEN, "<f8")
+    if bad := first_rejection(ints, pf):
         return bad
-    if len(cells) != len(agents):
-        return Rejected("cells: one per agent")
-    pi, pf = _block(m, "pi", len(agents), PERC_LEN, "<i8"), _block(m, "pf", len(agents), PERC_F_LEN, "<f8")
-    if bad := first_rejection(pi, pf):
-        return bad
-    return Obs(tick, agents, cells, pi, pf)
+    if len(pf) != len(ints):
+        return Rejected("pf: one row per agent")
+    if not np.isfinite(pf).all():
+        return Rejected("pf: not finite")
+    return Obs(blocks.tick, ints, pf)
 
 
 def family_message(data: bytes, kind: str, family: str, what: str, limit: int = MAX_MESSAGE_BYTES) -> dict | Rejected:
@@ -253,17 +310,16 @@ def act_header(data: bytes, family: str) -> tuple[dict, int, np.ndarray] | Rejec
 
 
 def parse_acts(data: bytes) -> Acts | Rejected:
-    header = act_header(data, FAMILY_GRID)
-    if isinstance(header, Rejected):
-        return header
-    m, tick, agents = header
-    acts = _block(m, "acts", len(agents), ACT_LEN, "<i8")
-    if isinstance(acts, Rejected):
-        return acts
-    marked = m.get("marked")
-    if not isinstance(marked, list) or len(marked) != len(agents) or not all(isinstance(x, bool) for x in marked):
-        return Rejected("marked: expected one true or false per agent")
-    return Acts(tick, agents, acts, np.array(marked, dtype=bool))
+    m = family_message(data, "act", FAMILY_GRID, "an action")
+    if isinstance(m, Rejected):
+        return m
+    tick = int_field(m, "tick")
+    raw = m.get("rows")
+    if isinstance(tick, Rejected):
+        return tick
+    if not isinstance(raw, bytes) or len(raw) % (ACT_ROW * 8):
+        return Rejected(f"rows: expected rows of {ACT_ROW} binary integers")
+    return Acts(tick, np.frombuffer(raw, dtype="<i8").reshape(-1, ACT_ROW))
 
 
 def parse_marks(data: bytes) -> Marks | Rejected:

@@ -84,7 +84,7 @@ def _decode(entry) -> np.ndarray | Rejected:
 def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
     """A batch of readings, or the raw dict of a `stop` message."""
     m = unpack(data, MAX_OBS_BYTES)
-    if isinstance(m, Rejected) or m.get("type") == "stop":
+    if isinstance(m, Rejected) or m.get("type") in ("stop", "wake"):
         return m
     m = check_family(m, "obs", FAMILY_ARENA, "an arena observation")
     if isinstance(m, Rejected):

@@ -73,7 +73,7 @@ def test_bad_arena_traffic_is_counted_and_never_acted_on():
             s.put(keys.act("intruder"), arena_proto.actions(0, [7], np.array([[0.1, 0.1]])))  # unknown agent
             s.put(keys.act("intruder"), proto.pack({"type": "act", "family": "arena", "tick": 0, "agents": [0],
                                                     "wheels": b"short"}))  # fmt: skip
-            s.put(keys.act("intruder"), proto.actions(0, [0], np.zeros((1, 7), np.int64), [False]))  # grid family
+            s.put(keys.act("intruder"), proto.actions(0, [0], np.zeros((1, 8), np.int64), [False]))  # grid family
             s.put(keys.plan("intruder"), arena_proto.plan_message(0, 0, np.zeros((3, 2))))  # another's plan
             s.put(keys.plan("intruder"), b"\x01plan?")
         finally:

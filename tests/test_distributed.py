@@ -44,57 +44,22 @@ def test_bad_traffic_is_counted_and_changes_nothing():
 
     def attack(endpoint, keys):
         s = open_client(endpoint)
-        stay = np.array([[4, 0, 0, 0, 0, 0, 0]], dtype=np.int64)
+        stay = np.array([[4, 0, 0, 0, 0, 0, 0, 0]], dtype=np.int64)
+        rows = proto.action_rows([0], stay, [False])
+
+        def act(**fields):
+            return proto.pack({"type": "act", "family": "grid", "tick": 0, "rows": rows.tobytes(), **fields})
+
         try:
             s.put(keys.act("intruder"), b"\x00\xffgarbage")  # not msgpack
             s.put(keys.act("intruder"), proto.pack({"type": "act", "tick": "soon"}))  # wrong schema
             s.put(keys.act("intruder"), proto.actions(0, [0], stay, [False]))  # another process's agent
             s.put(keys.act("intruder"), proto.actions(0, [99], stay, [False]))  # unknown agent
-            s.put(
-                keys.act("intruder"),
-                proto.pack(
-                    {
-                        "type": "act",
-                        "family": "grid",
-                        "tick": float("nan"),
-                        "agents": [0],
-                        "acts": stay.tobytes(),
-                        "marked": [False],
-                    }
-                ),
-            )
-            s.put(
-                keys.act("intruder"),
-                proto.pack(
-                    {
-                        "type": "act",
-                        "family": "grid",
-                        "tick": 0,
-                        "agents": [2**64 - 1],
-                        "acts": stay.tobytes(),
-                        "marked": [False],
-                    }
-                ),
-            )
-            s.put(
-                keys.act("intruder"),
-                proto.pack(
-                    {"type": "act", "family": "grid", "tick": 0, "agents": [0], "acts": b"short", "marked": [False]}
-                ),
-            )
-            s.put(
-                keys.act("intruder"),
-                proto.pack(
-                    {
-                        "type": "act",
-                        "family": "bees",
-                        "tick": 0,
-                        "agents": [0],
-                        "acts": stay.tobytes(),
-                        "marked": [False],
-                    }
-                ),
-            )
+            s.put(keys.act("intruder"), proto.actions(0, [-1], stay, [False]))  # a negative id
+            s.put(keys.act("intruder"), act(tick=float("nan")))
+            s.put(keys.act("intruder"), act(tick=2**64 - 1))
+            s.put(keys.act("intruder"), act(rows=b"short"))
+            s.put(keys.act("intruder"), act(family="bees"))
             s.put(keys.mark("intruder"), proto.mark_writes(0, [0], [0], [0]))  # a forged mark
             for _ in range(300):  # a flood
                 s.put(keys.act("flood"), b"\x93\x01\x02")

@@ -20,7 +20,6 @@ from swarm import protocol as proto
 from swarm import protocol_arena as arena_proto
 from swarm.arena.engine import arena_summary
 from swarm.arena.scenario import controller_params
-from swarm.scenario import ScenarioError
 from world_server import persist
 from world_server.arena import ArenaWorld
 from world_server.server import ACTIVE, FREE, JOINING, LOST, WorldServer
@@ -49,9 +48,7 @@ class ArenaServer(WorldServer):
         if loaded is None:
             return False
         arrays, meta = loaded
-        if meta["scenario"] != self.scenario.describe():
-            raise ScenarioError(str(self.state_file), "run id", f"holds run {self.keys.run!r} of another scenario; "
-                                "use another --run-id or remove the file")  # fmt: skip
+        self._check_same_scenario(meta["scenario"])
         self.world.restore(arrays)
         self.tick = int(arrays["tick"])
         slots = arrays["slots"]
@@ -59,7 +56,8 @@ class ArenaServer(WorldServer):
         self.stats.joins = int(meta["stats"]["joins"])
         self.stats.agents_lost = int(meta["stats"]["agents_lost"])
         self.stats.rejected = dict(meta["stats"]["rejected"])
-        self.group_of = {int(a): g for a, g in meta["stats"]["groups"].items()}
+        for a, g in meta["stats"]["groups"].items():
+            self._assign_group(int(a), g)
         return True
 
     def save_state(self) -> None:

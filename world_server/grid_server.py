@@ -15,26 +15,12 @@ from pathlib import Path
 import numpy as np
 
 from agents.controllers.dispatch import controller_params
-from agents.controllers.layout import (
-    A_DEPOSIT,
-    A_LOAD,
-    A_MARK,
-    A_MODE,
-    A_MOVE,
-    A_TRAIL_ID,
-    A_TRAIL_OP,
-    A_UNLOAD,
-    MARK_NONE,
-    N_MODES,
-    PERC_F_LEN,
-    PERC_LEN,
-    STAY,
-    TRAIL_ERASE,
-)  # fmt: skip
+from agents.controllers.layout import A_MARK, A_MODE, A_MOVE, A_TRAIL_OP, MARK_NONE, PERC_F_LEN, STAY, new_memory
 from swarm import protocol as proto
 from swarm.engine import UNTIL, is_done
-from world_server import persist
+from world_server import grid_wire, persist
 from world_server.grid import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, L_OBST, GridWorld, write_mark
+from world_server.grid_wire import REFUSALS, accept_rows, observe_rows
 from world_server.server import ACTIVE, JOINING, WorldServer
 
 
@@ -44,10 +30,12 @@ class GridServer(WorldServer):
     def _make_world(self) -> None:
         self.world = GridWorld(self.scenario)
         self.world.warm_up()
+        grid_wire.warm_up(self.world)
         self.cparams = controller_params(self.scenario)
         n = self.scenario.agents
         self.mark_due = np.zeros(n, dtype=bool)  # its action announced a mark write
         self.mark_got = np.zeros(n, dtype=bool)  # that mark write arrived
+        self.memory = new_memory(n)  # every controller's memory after its last step (saved: exact resume)
         self.state_file = persist.state_path(self.state_dir, self.keys.run) if self.state_dir else None
 
     def _declare_shared(self, put) -> list:
@@ -68,9 +56,7 @@ class GridServer(WorldServer):
         state = persist.load(self.state_file) if self.state_file else None
         if state is None:
             return False
-        if state["scenario"] != self.scenario.describe():
-            raise ValueError(f"{self.state_file} holds run {self.keys.run!r} of another scenario; "
-                             "use another --run-id or remove the file")  # fmt: skip
+        self._check_same_scenario(state["scenario"])
         w = self.world
         for key in persist.ARRAYS:
             getattr(w, key)[...] = state[key]
@@ -82,7 +68,8 @@ class GridServer(WorldServer):
         self.stats.joins = int(state["stats"].get("joins", 0))
         self.stats.agents_lost = int(state["stats"].get("agents_lost", 0))
         self.stats.rejected = dict(state["stats"].get("rejected", {}))
-        self.group_of = {int(a): g for a, g in state["stats"].get("groups", {}).items()}
+        for a, g in state["stats"].get("groups", {}).items():
+            self._assign_group(int(a), g)
         return True
 
     def _open_recorder(self, path: Path, viewer: str | None):
@@ -126,32 +113,38 @@ class GridServer(WorldServer):
         w.acts[:, A_MARK] = MARK_NONE
         w.acts[:, A_TRAIL_OP:A_MODE] = 0  # the mode stays as last reported
 
-    def _observe(self, tick: int, agents: np.ndarray) -> bytes:
+    def _observations(self, tick: int, groups: dict[str, np.ndarray]):
+        """Every active agent perceived in one compiled pass, in group order,
+        each process's rows sent as one block."""
         w = self.world
-        pi = np.zeros((len(agents), PERC_LEN), dtype=np.int64)
+        agents = np.concatenate(list(groups.values())) if groups else np.zeros(0, np.int64)
+        ints = np.zeros((len(agents), proto.OBS_INTS), dtype=np.int64)
         pf = np.zeros((len(agents), PERC_F_LEN), dtype=np.float64)
-        if not self.null:
-            for i, a in enumerate(agents):
-                w.perceive(int(a), pi[i], pf[i])
-        cells = w.pos[agents, 0] * w.layers.shape[2] + w.pos[agents, 1]
-        return proto.observations(tick, agents, cells, pi, pf)
+        observe_rows(w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked, agents,
+                     ints, pf, self.null)  # fmt: skip
+        start = 0
+        for group, members in groups.items():
+            end = start + len(members)
+            yield group, proto.observations(tick, ints[start:end], pf[start:end])
+            start = end
 
     def _on_act(self, sample) -> None:
         received = self._receive(sample, proto.parse_acts, "act")
         if received is None:
             return
         msg, group = received
-        for a, act, marked in zip(msg.agents.tolist(), msg.acts, msg.marked.tolist(), strict=True):
-            if not self._acting(a, group, msg.tick):
-                continue
-            if not _valid_action(act):
-                self.stats.reject("act: out-of-range action")
-            else:
-                row = self.world.acts[a]
-                row[:] = act
-                row[A_MARK] = MARK_NONE  # marks travel on the marks key space
-                self.acted[a] = True
-                self.mark_due[a] = marked
+        if not self._current(msg.tick):
+            self.stats.late_actions += len(msg.rows)
+            for _ in range(len(msg.rows)):
+                self.stats.reject("act: not for this tick")
+            return
+        lockstep = self.mode == "lockstep"
+        refused = accept_rows(msg.rows, self.slots, self.group_ids, self.group_index.get(group, -1), lockstep,
+                              self.acted, self.world.acts, self.mark_due, self.memory)  # fmt: skip
+        if refused.any():
+            for reason, count in zip(REFUSALS, refused.tolist(), strict=True):
+                if count:
+                    self.stats.rejected[reason] = self.stats.rejected.get(reason, 0) + count
 
     def _on_mark(self, sample) -> None:
         received = self._receive(sample, proto.parse_marks, "mark")
@@ -216,13 +209,6 @@ class GridServer(WorldServer):
             "reachable_cells": w.reachable, "rejected_moves": int(w.counters[C_REJECTED]),
             "grid": list(w.layout.shape), **w.bodies.summary(s.agents),
         }  # fmt: skip
-
-
-def _valid_action(act: np.ndarray) -> bool:
-    return bool(
-        0 <= act[A_MOVE] <= STAY and 0 <= act[A_TRAIL_OP] <= TRAIL_ERASE and act[A_TRAIL_ID] >= 0
-        and all(act[i] in (0, 1) for i in (A_LOAD, A_UNLOAD, A_DEPOSIT)) and 0 <= act[A_MODE] < N_MODES
-    )  # fmt: skip
 
 
 def _update_bound(layers: np.ndarray, r: int, c: int) -> int:

@@ -30,6 +30,7 @@ import zenoh
 
 from swarm import protocol as proto
 from swarm.bus import open_client, open_router
+from swarm.scenario import ScenarioError
 
 # JOINING: welcomed, but its observation subscriber may not be routed yet; it is
 # ACTIVE once its liveliness token arrives (declared after the subscriber).
@@ -91,9 +92,13 @@ class WorldServer:
         self.acted = np.zeros(scenario.agents, dtype=bool)  # action received this tick
         self.nonces: dict[str, int] = {}
         self.group_of: dict[int, str] = {}  # agent -> its agent process (message group)
+        self.group_index: dict[str, int] = {}  # message group -> a number, for the compiled checks
+        self.group_ids = np.full(scenario.agents, -1, dtype=np.int64)  # agent -> its group's number
+        self._publishers: dict[str, object] = {}  # message group -> its declared observation publisher
+        self._grouping: tuple[bytes, int, dict] | None = None  # (active agents, joins, their groups) of the last tick
         self.stats = Stats()
         self.tick = 0
-        self.events: queue.Queue = queue.Queue()
+        self.events: queue.SimpleQueue = queue.SimpleQueue()
         self.started = 0.0
         self.persist_every = persist_every
         self.resume_timeout = resume_timeout
@@ -113,6 +118,7 @@ class WorldServer:
             self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s)), history=True),
             *self._declare_shared(put),
         ]
+        self._state_publisher = self.session.declare_publisher(k.state)
 
     # ----------------------------------------------------- hooks of a world kind
 
@@ -128,6 +134,12 @@ class WorldServer:
 
     def _resume(self) -> bool:
         return False
+
+    def _check_same_scenario(self, saved: str) -> None:
+        """A run id names one run: a saved state of another scenario is refused (one line)."""
+        if saved != self.scenario.describe():
+            raise ScenarioError(str(self.state_file), "run id", f"holds run {self.keys.run!r} of another scenario; "
+                                "use another --run-id or remove the file")  # fmt: skip
 
     def save_state(self) -> None:
         """Persist the world (kinds that can resume)."""
@@ -171,7 +183,13 @@ class WorldServer:
         """Before the tick's observations go out."""
 
     def _observe(self, tick: int, agents: np.ndarray) -> bytes:
+        """The observation message of one agent process."""
         raise NotImplementedError
+
+    def _observations(self, tick: int, groups: dict[str, np.ndarray]):
+        """(group, message) for every agent process; kinds that can perceive
+        every agent at once override this."""
+        return [(group, self._observe(tick, agents)) for group, agents in groups.items()]
 
     def _on_act(self, sample) -> None:
         raise NotImplementedError
@@ -238,12 +256,16 @@ class WorldServer:
             if self.slots[agent] == LOST:
                 self._reuse(agent)
             self.nonces[nonce] = agent
-            self.group_of[agent] = request["group"]
+            self._assign_group(agent, request["group"])
             self.slots[agent] = JOINING
             self.misses[agent] = 0
             self.stats.joins += 1
         info = {"run": self.keys.run, "seed": self.scenario.seed, "tick": self.tick, **self._welcome(agent)}
         self._reply(query, self.keys.join, proto.join_reply(agent, nonce, info))
+
+    def _assign_group(self, agent: int, group: str) -> None:
+        self.group_of[agent] = group
+        self.group_ids[agent] = self.group_index.setdefault(group, len(self.group_index))
 
     def _on_alive(self, sample) -> None:
         agent = self._sender(sample)
@@ -345,10 +367,9 @@ class WorldServer:
         active = np.flatnonzero(self.slots == ACTIVE)
         self.acted[:] = False
         self._begin_tick()
-        for group, agents in self._groups(active).items():
-            payload = self._observe(tick, agents)
+        for group, payload in self._observations(tick, self._groups(active)):
             self.bytes_out += len(payload)
-            self.session.put(self.keys.obs(group), payload)
+            self._publisher(group).put(payload)
         if self.mode == "lockstep":  # a barrier: until all have answered or the deadline
             deadline = time.monotonic() + self.deadline
             while not self.answered(active).all():
@@ -382,13 +403,27 @@ class WorldServer:
         if self.recorder is not None:
             self.recorder.capture(tick, present=present, tick_ms=self.tick_seconds[-1] * 1000,
                                   rejected=self.stats.rejected_total)  # fmt: skip
-        self.session.put(self.keys.state, proto.pack({"type": "state", **self.progress()}))
+        self._state_publisher.put(proto.pack({"type": "state", **self.progress()}))
 
     def _groups(self, agents: np.ndarray) -> dict[str, np.ndarray]:
+        """The active agents by agent process, worked out again only when
+        the active set or the joins have changed since the last tick."""
+        key = agents.tobytes()
+        if self._grouping is not None and self._grouping[:2] == (key, self.stats.joins):
+            return self._grouping[2]
         groups: dict[str, list[int]] = {}
         for a in agents.tolist():
             groups.setdefault(self.group_of[a], []).append(a)
-        return {g: np.array(members, dtype=np.int64) for g, members in groups.items()}
+        grouped = {g: np.array(members, dtype=np.int64) for g, members in groups.items()}
+        self._grouping = (key, self.stats.joins, grouped)
+        for gone in set(self._publishers) - set(grouped):
+            self._publishers.pop(gone).undeclare()
+        return grouped
+
+    def _publisher(self, group: str):
+        if (pub := self._publishers.get(group)) is None:
+            pub = self._publishers[group] = self.session.declare_publisher(self.keys.obs(group))
+        return pub
 
     def run(self) -> dict:
         if not (self.resumed and self.done()):  # a finished run resumed has nothing left to do
@@ -456,7 +491,7 @@ class WorldServer:
     def close(self) -> None:
         if self.recorder is not None:  # an interrupted run still ends its recording
             self._close_recording(self.summary())
-        for d in self._decls:
+        for d in [*self._decls, *self._publishers.values(), self._state_publisher]:
             d.undeclare()
         self.session.close()
 

@@ -1,7 +1,7 @@
 """Ahead-of-time build of the controllers' step, for agent processes.
 
 `import numba` alone costs an agent process 88 MB.  numba's pycc compiles
-the very same `dispatch.step_controller` (and everything it calls) into a
+the very same `dispatch.answer_rows` (and everything it calls) into a
 plain extension module.  Agent processes import that module, which needs only
 numpy, instead of the JIT.  The module is named after the source digest and lives
 in the compile cache (swarm.jitcache), so an edited controller is rebuilt
@@ -22,8 +22,17 @@ from pathlib import Path
 
 from swarm.jitcache import cache_root, source_digest
 
-# kind, perception (int, float), memory, action, params, seed, agent, tick
-SIGNATURE = "void(i8, i8[::1], f8[::1], i8[::1], i8[::1], f8[::1], i8, i8, i8)"
+
+def signature():
+    """dispatch.answer_rows: kind, a message's blocks (read-only), memories, slot table, action rows, params,
+    seed, tick, null."""
+    from numba import types as t
+
+    def message_block(dtype):
+        return t.Array(dtype, 1, "C", readonly=True)
+
+    return t.int64(t.int64, message_block(t.int64), message_block(t.float64), t.int64[:, ::1], t.int64[::1],
+                   t.int64[:, ::1], t.float64[::1], t.int64, t.int64, t.boolean)  # fmt: skip
 
 
 def module_name() -> str:
@@ -44,14 +53,14 @@ def build() -> Path:
         return done
     from numba.pycc import CC
 
-    from agents.controllers.dispatch import step_controller
+    from agents.controllers.dispatch import answer_rows
 
     out = build_dir()
     out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=out) as tmp:  # concurrent builds: atomic rename at the end
         cc = CC(module_name())
         cc.output_dir = tmp
-        cc.export("step", SIGNATURE)(step_controller.py_func)
+        cc.export("answer_rows", signature())(answer_rows.py_func)
         cc.compile()
         (result,) = Path(tmp).glob(f"{module_name()}.*.so")
         final = out / result.name
@@ -64,14 +73,14 @@ def build() -> Path:
 
 
 def load():
-    """The compiled `step`, or None when it has not been built for this source."""
+    """The compiled `answer_rows`, or None when it has not been built for this source."""
     path = built()
     if path is None:
         return None
     if str(path.parent) not in sys.path:
         sys.path.insert(0, str(path.parent))
     try:
-        return importlib.import_module(module_name()).step
+        return importlib.import_module(module_name()).answer_rows
     except ImportError:
         return None
 

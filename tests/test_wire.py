@@ -1,0 +1,106 @@
+"""The grid's wire, without zenoh: messages round-trip, every bad row is refused
+by reason and changes nothing, and the agent's batch step equals the engine's."""
+
+import numpy as np
+
+from agents.controllers.dispatch import answer_rows, controller_params, step_controller
+from agents.controllers.layout import A_MARK, A_MOVE, ACT_LEN, MARK, MARK_NONE, controller_kind, new_memory
+from swarm import protocol as proto
+from swarm.scenario import load_scenario
+from world_server.grid import GridWorld
+from world_server.grid_wire import REFUSALS, accept_rows, observe_rows
+
+ACTIVE, FREE = 2, 0
+
+
+def _world(agents=3, seed=5):
+    scenario = load_scenario("setup2").with_overrides(agents=agents, seed=seed)
+    return scenario, GridWorld(scenario)
+
+
+def test_observation_rows_round_trip_and_equal_the_world_perception():
+    _, w = _world()
+    agents = np.array([2, 0], dtype=np.int64)
+    ints = np.zeros((2, proto.OBS_INTS), np.int64)
+    pf = np.zeros((2, 5))
+    observe_rows(w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked, agents, ints,
+                 pf, False)  # fmt: skip
+    obs = proto.parse_obs(proto.observations(7, ints, pf))
+    assert isinstance(obs, proto.Obs) and obs.tick == 7
+    assert obs.agents.tolist() == [2, 0]
+    for i, a in enumerate(agents):
+        pi, pfa = np.zeros(25, np.int64), np.zeros(5)
+        w.perceive(int(a), pi, pfa)
+        np.testing.assert_array_equal(obs.pi[i], pi)
+        assert obs.cells[i] == w.pos[a, 0] * w.layers.shape[2] + w.pos[a, 1]
+    assert obs.ints.flags.writeable and obs.ints.flags.c_contiguous
+
+
+def test_malformed_observations_are_rejected_not_raised():
+    good = proto.observations(1, np.zeros((1, proto.OBS_INTS), np.int64), np.zeros((1, 5)))
+    assert isinstance(proto.parse_obs(good), proto.Obs)
+    for bad in (b"", b"\x00\xff", proto.pack({"type": "obs", "tick": 1, "ints": b"123", "pf": b""}),
+                proto.pack({"type": "obs", "tick": -1, "ints": b"", "pf": b""}),
+                proto.observations(1, np.zeros((1, proto.OBS_INTS), np.int64), np.full((1, 5), np.nan)),
+                proto.observations(1, np.zeros((2, proto.OBS_INTS), np.int64), np.zeros((1, 5)))):  # fmt: skip
+        assert isinstance(proto.parse_obs(bad), proto.Rejected)
+    memory = proto.parse_obs(proto.memory_message(np.array([3]), new_memory(1)))
+    assert isinstance(memory, proto.Memory) and memory.rows[0, 0] == 3
+
+
+def test_every_bad_row_is_refused_by_reason_and_changes_nothing():
+    n = 4
+    slots = np.array([ACTIVE, ACTIVE, FREE, ACTIVE], np.int64)
+    group_ids = np.array([0, 1, -1, 0], np.int64)
+    acts = np.zeros((n, ACT_LEN), np.int64)
+    acted, mark_due, memory = np.zeros(n, bool), np.zeros(n, bool), np.zeros((n, 8), np.int64)
+    stay = np.zeros(ACT_LEN, np.int64)
+    stay[A_MOVE] = 4
+    wild = stay.copy()
+    wild[A_MOVE] = 99
+    rows = proto.action_rows([0, 1, 2, 99, -1, 3, 0], [stay, stay, stay, stay, stay, wild, stay],
+                             [0, 0, 0, 0, 0, 0, 0], np.arange(56).reshape(7, 8))  # fmt: skip
+    refused = accept_rows(rows, slots, group_ids, 0, True, acted, acts, mark_due, memory)
+    counts = dict(zip(REFUSALS, refused.tolist(), strict=True))
+    assert counts == {"act: unknown agent": 3, "act: names an agent of another process": 1,
+                      "act: second action in one tick": 1, "act: out-of-range action": 1}  # fmt: skip
+    assert acted.tolist() == [True, False, False, False]
+    assert acts[0, A_MOVE] == 4 and acts[0, A_MARK] == MARK_NONE and not acts[1:].any()
+    np.testing.assert_array_equal(memory[0], np.arange(8))  # the first row of agent 0, not the refused second
+    assert not memory[1:].any()
+
+
+def test_the_batch_answer_equals_the_engine_step_agent_by_agent():
+    scenario, w = _world(agents=5, seed=9)
+    kind, params = controller_kind(scenario.controller), controller_params(scenario)
+    agents = np.arange(5, dtype=np.int64)
+    ints, pf = np.zeros((5, proto.OBS_INTS), np.int64), np.zeros((5, 5))
+    observe_rows(w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked, agents, ints,
+                 pf, False)  # fmt: skip
+    blocks = proto.obs_blocks(proto.observations(12, ints, pf))
+    ints_ro, pf_ro = np.frombuffer(blocks.ints, "<i8"), np.frombuffer(blocks.pf, "<f8")
+    mems, out = new_memory(4), np.zeros((4, proto.ACT_ROW), np.int64)
+    slot_of = np.array([3, 2, -1, 1, 0], np.int64)  # agent 2 is not ours
+    seed = np.int64(scenario.seed)
+    n = answer_rows(kind, ints_ro, pf_ro, mems, slot_of, out, params, seed, 12, False)
+    assert n == 4 and out[:n, proto.R_AGENT].tolist() == [0, 1, 3, 4]
+    for row, agent in zip(out[:n], (0, 1, 3, 4), strict=True):
+        mem, act = new_memory(1)[0], np.zeros(ACT_LEN, np.int64)
+        pi = ints[agent, proto.OBS_PERCEPTION :]
+        step_controller(kind, pi, pf[agent], mem, act, params, seed, agent, 12)
+        np.testing.assert_array_equal(row[proto.R_ACT : proto.R_ACT + ACT_LEN], act)
+        np.testing.assert_array_equal(row[proto.R_MEM :], mem)
+        np.testing.assert_array_equal(mems[slot_of[agent]], mem)
+        lowers = act[A_MARK] != MARK_NONE and act[A_MARK] < ints[agent, proto.OBS_PERCEPTION + MARK]
+        assert row[proto.R_MARKED] == int(lowers)
+    # blocks that disagree, or a float that is not finite: refused whole, nothing stepped
+    before = mems.copy()
+    assert answer_rows(kind, ints_ro[:-1], pf_ro, mems, slot_of, out, params, seed, 12, False) == -1
+    bad = pf.copy()
+    bad[3, 0] = np.nan
+    assert answer_rows(kind, ints_ro, bad.ravel(), mems, slot_of, out, params, seed, 12, False) == -1
+    np.testing.assert_array_equal(mems, before)
+    # the null floor answers STAY for ours and leaves the memory alone
+    assert answer_rows(kind, ints_ro, pf_ro, mems, slot_of, out, params, seed, 13, True) == 4
+    assert (out[:4, proto.R_ACT + A_MOVE] == 4).all()
+    np.testing.assert_array_equal(mems, before)

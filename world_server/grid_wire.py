@@ -1,0 +1,105 @@
+"""The grid world's side of the wire, compiled: observation rows out, action rows in.
+
+The lock-step tick's cost is per message, and at one agent per process there
+are a hundred messages each way per tick: the world fills every active
+agent's observation row in one call, and checks and applies a whole action
+message in one call, rather than a Python loop over agents and fields.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from agents.controllers.layout import (
+    A_DEPOSIT,
+    A_LOAD,
+    A_MARK,
+    A_MODE,
+    A_MOVE,
+    A_TRAIL_ID,
+    A_TRAIL_OP,
+    A_UNLOAD,
+    ACT_LEN,
+    MARK_NONE,
+    MEM_LEN,
+    N_MODES,
+    PERC_F_LEN,
+    STAY,
+    TRAIL_ERASE,
+)  # fmt: skip
+from swarm.protocol import ACT_ROW, OBS_INTS, R_ACT, R_AGENT, R_MARKED, R_MEM
+from world_server.grid import perceive
+
+ACTIVE = 2  # world_server.server.ACTIVE (a slot whose agent is in the run)
+
+# Why an action row was refused (index into the counts `accept_rows` returns).
+REFUSALS = ("act: unknown agent", "act: names an agent of another process", "act: second action in one tick",
+            "act: out-of-range action")  # fmt: skip
+UNKNOWN, FOREIGN, SECOND, OUT_OF_RANGE = range(4)
+
+
+@njit(cache=True)
+def observe_rows(layers, pher, pher_on, base_r, base_c, pos, payload, blocked, agents, ints, pf, null):
+    """Row i of `ints` / `pf`: agent `agents[i]`, its cell, its perception
+    (left zero in the benchmark's null world)."""
+    width = layers.shape[2]
+    for i in range(len(agents)):
+        a = agents[i]
+        r, c = pos[a, 0], pos[a, 1]
+        ints[i, 0] = a
+        ints[i, 1] = r * width + c
+        if not null:
+            perceive(layers, pher, pher_on, base_r, base_c, r, c, payload[a], blocked[a], ints[i, 2:], pf[i])
+
+
+@njit(cache=True, inline="always")
+def _valid(row) -> bool:
+    a = R_ACT
+    if not (0 <= row[a + A_MOVE] <= STAY and 0 <= row[a + A_TRAIL_OP] <= TRAIL_ERASE and row[a + A_TRAIL_ID] >= 0):
+        return False
+    if not 0 <= row[a + A_MODE] < N_MODES:
+        return False
+    for k in (A_LOAD, A_UNLOAD, A_DEPOSIT):
+        if row[a + k] != 0 and row[a + k] != 1:
+            return False
+    return row[R_MARKED] == 0 or row[R_MARKED] == 1
+
+
+@njit(cache=True)
+def accept_rows(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory):
+    """Check every row of one action message from process `group` and apply
+    those that pass; returns the refusals counted by reason (REFUSALS).  A
+    refused row changes nothing."""
+    refused = np.zeros(len(REFUSALS), dtype=np.int64)
+    n = len(slots)
+    for i in range(rows.shape[0]):
+        row = rows[i]
+        a = row[R_AGENT]
+        if a < 0 or a >= n or slots[a] != ACTIVE:
+            refused[UNKNOWN] += 1
+        elif group_ids[a] != group:
+            refused[FOREIGN] += 1
+        elif lockstep and acted[a]:  # in real time the latest action wins
+            refused[SECOND] += 1
+        elif not _valid(row):
+            refused[OUT_OF_RANGE] += 1
+        else:
+            for k in range(ACT_LEN):
+                acts[a, k] = row[R_ACT + k]
+            acts[a, A_MARK] = MARK_NONE  # marks travel on the marks key space
+            for k in range(MEM_LEN):
+                memory[a, k] = row[R_MEM + k]
+            acted[a] = True
+            mark_due[a] = row[R_MARKED] == 1
+    return refused
+
+
+def warm_up(world) -> None:
+    """Load both kernels now (no agents, no rows), so the first tick does not compile."""
+    none, ints, pf = np.zeros(0, np.int64), np.zeros((0, OBS_INTS), np.int64), np.zeros((0, PERC_F_LEN))
+    observe_rows(world.layers, world.pher, world.pheromone_on, world.base[0], world.base[1], world.pos,
+                 world.payload, world.blocked, none, ints, pf, False)  # fmt: skip
+    n = len(world.pos)
+    accept_rows(np.zeros((0, ACT_ROW), np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64), 0, True,
+                np.zeros(n, bool), world.acts, np.zeros(n, bool), np.zeros((n, MEM_LEN), np.int64))  # fmt: skip
