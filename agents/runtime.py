@@ -198,7 +198,8 @@ class GridAgentRuntime(AgentRuntime):
     def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
         self.seed = np.int64(msg["seed"])
         self.params = np.array(msg["params"], dtype=np.float64)
-        self.mem[slot] = new_memory(1)[0]
+        # the slot's memory: fresh, or where a resumed run's agent was saved (this one takes it over)
+        self.mem[slot] = msg.get("memory", new_memory(1)[0])
         self.slot_table[self.slot_table == slot] = -1
         if agent >= len(self.slot_table):
             self.slot_table = np.concatenate([self.slot_table, np.full(agent + 1 - len(self.slot_table), -1)])

@@ -143,7 +143,11 @@ def test_lost_agents_cargo_is_dropped_where_it_stood():
     assert w.delivered == 60
 
 
-def test_kill_9_the_world_and_restart_it_resumes_from_disk(tmp_path):
+@pytest.mark.parametrize("kill_at, agents_too", [(40, False), (400, False), (200, True)])
+def test_kill_9_the_world_then_a_restart_ends_exactly_as_swarm_run(tmp_path, kill_at, agents_too):
+    """The saved state holds the world and every controller's memory: after kill -9
+    of the world (and, `agents_too`, of every agent process, with new ones started
+    for the restarted world), the run ends with the in-process run's result."""
     import json
     import os
     import signal
@@ -153,34 +157,45 @@ def test_kill_9_the_world_and_restart_it_resumes_from_disk(tmp_path):
 
     from world_server import persist
 
+    scenario = load_scenario("setup1").with_overrides(agents=3, seed=4)
+    engine = Engine(scenario)
+    expected = engine.run().summary
     endpoint = free_endpoint()
-    state = persist.state_path(tmp_path, "resume")
+    state = persist.state_path(tmp_path, "exact")
     summary_file = tmp_path / "summary.json"
     world_cmd = [sys.executable, "-m", "swarm", "world", "setup1", "--agents", "3", "--seed", "4", "--run-id",
-                 "resume", "--listen", endpoint, "--state-dir", str(tmp_path), "--persist-every", "20",
-                 "--deadline", "5", "--summary-file", str(summary_file)]  # fmt: skip
+                 "exact", "--listen", endpoint, "--state-dir", str(tmp_path), "--persist-every", "20",
+                 "--deadline", "10", "--summary-file", str(summary_file)]  # fmt: skip
     world = subprocess.Popen(world_cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    procs = [world, *start_agents(endpoint, "resume", "cmarking", 3)]
+    agents = start_agents(endpoint, "exact", "cmarking", 3)
+    procs = [world, *agents]
     try:
         deadline = time.monotonic() + 120
         while True:
             saved = persist.load(state) if state.exists() else None
-            if saved and saved["tick"] >= 100:
+            if saved and saved["tick"] >= kill_at:
                 break
             assert time.monotonic() < deadline and world.poll() is None, "the world never persisted"
-            time.sleep(0.05)
+            time.sleep(0.01)
+        time.sleep(0.004)  # a few ticks past the save: the agents' controllers are ahead of the saved state
         os.kill(world.pid, signal.SIGKILL)
         world.wait()
+        if agents_too:
+            for p in agents:
+                p.kill()
+            procs += start_agents(endpoint, "exact", "cmarking", 3)
         before = persist.load(state)
-        assert before["tick"] >= 100 and before["tick"] % 20 == 0
+        assert before["tick"] >= kill_at and before["tick"] % 20 == 0
         world = subprocess.Popen(world_cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         procs.append(world)
         assert world.wait(timeout=300) == 0, world.stderr.read().decode()[-3000:]
         summary = json.loads(summary_file.read_text())
-        assert summary["finished"] and summary["delivered"] == summary["total"]
-        assert summary["iterations"] > before["tick"]
-        assert summary["agents_lost"] == 0  # the same three agents came back
-        assert summary["explored_cells"] >= int(before["counters"][1])
+        for key in ("iterations", "delivered", "total", "finished", "explored_cells", "optimal_cells"):
+            assert summary[key] == expected[key], (key, before["tick"])
+        assert summary["missed_ticks"] == 0 and summary["rejected_messages"] == 0
+        final = persist.load(state)
+        np.testing.assert_array_equal(final["layers"], engine.world.layers)
+        np.testing.assert_array_equal(final["pos"], engine.world.pos)
     finally:
         stop(procs)
 

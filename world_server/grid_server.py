@@ -65,6 +65,8 @@ class GridServer(WorldServer):
         slots = state["slots"]
         # Agents that were in the run come back when their liveliness token reappears.
         self.slots[:] = np.where((slots == ACTIVE) | (slots == JOINING), JOINING, slots)
+        self.returning[:] = self.slots == JOINING
+        self.memory[...] = state["memory"]
         self.stats.joins = int(state["stats"].get("joins", 0))
         self.stats.agents_lost = int(state["stats"].get("agents_lost", 0))
         self.stats.rejected = dict(state["stats"].get("rejected", {}))
@@ -84,7 +86,8 @@ class GridServer(WorldServer):
             return
         stats = {"joins": self.stats.joins, "agents_lost": self.stats.agents_lost, "rejected": self.stats.rejected,
                  "groups": {str(a): g for a, g in self.group_of.items()}}  # fmt: skip
-        persist.save(self.state_file, self.world, self.tick, self.slots, stats, self.scenario.describe())
+        persist.save(self.state_file, self.world, self.tick, self.slots, stats, self.scenario.describe(),
+                     memory=self.memory)  # fmt: skip
 
     # ------------------------------------------------------------------ joins
 
@@ -94,10 +97,19 @@ class GridServer(WorldServer):
         return None
 
     def _welcome(self, agent: int) -> dict:
-        return {"controller": self.scenario.controller, "params": self.cparams.tolist()}
+        return {"controller": self.scenario.controller, "params": self.cparams.tolist(),
+                "memory": self.memory[agent].tolist()}  # fmt: skip
 
     def _reuse(self, agent: int) -> None:
         self.world.new_body(agent)
+        self.memory[agent] = new_memory(1)[0]
+
+    def _hand_back(self) -> None:
+        """Agents that survived the world's restart ran a few ticks past the
+        saved one: their controllers go back to the saved memory (on the
+        observation key, so it arrives before the first observation)."""
+        for group, agents in self._groups(np.flatnonzero(self.slots == ACTIVE)).items():
+            self._publisher(group).put(proto.memory_message(agents, self.memory[agents]))
 
     def _remove(self, agent: int) -> None:
         self.world.drop_load(agent)

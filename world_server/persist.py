@@ -13,15 +13,16 @@ from pathlib import Path
 
 import numpy as np
 
-ARRAYS = ("layers", "pher", "pos", "payload", "blocked", "counters")
+ARRAYS = ("layers", "pher", "pos", "payload", "blocked", "counters", "acts")
 
 
 def state_path(state_dir: str | Path, run_id: str) -> Path:
     return Path(state_dir) / f"{run_id}.state.npz"
 
 
-def save(path: Path, world, tick: int, slots: np.ndarray, stats: dict, scenario: dict) -> None:
-    arrays = {"slots": slots, "body_xy": world.body_xy, **{k: getattr(world, k) for k in ARRAYS}}
+def save(path: Path, world, tick: int, slots: np.ndarray, stats: dict, scenario: dict, **extra: np.ndarray) -> None:
+    """The grid world's arrays, the slots, and `extra` arrays (the controllers' memory)."""
+    arrays = {"slots": slots, "body_xy": world.body_xy, **{k: getattr(world, k) for k in ARRAYS}, **extra}
     save_arrays(path, arrays, {"tick": tick, "stats": stats, "scenario": scenario})
 
 

@@ -89,6 +89,8 @@ class WorldServer:
         self.agent_steps = 0  # actions received in time, over the run
         self.slots = np.full(scenario.agents, FREE, dtype=np.int64)
         self.misses = np.zeros(scenario.agents, dtype=np.int64)
+        # A resumed run's agents that have not come back yet: a newcomer takes one over (body and memory).
+        self.returning = np.zeros(scenario.agents, dtype=bool)
         self.acted = np.zeros(scenario.agents, dtype=bool)  # action received this tick
         self.nonces: dict[str, int] = {}
         self.group_of: dict[int, str] = {}  # agent -> its agent process (message group)
@@ -165,7 +167,11 @@ class WorldServer:
         return None
 
     def _free_slots(self, request: dict) -> np.ndarray:
-        return np.flatnonzero((self.slots == FREE) | (self.slots == LOST))
+        """Slots a newcomer may take, in order: first those of a resumed run
+        whose agents have not come back (the newcomer continues that agent
+        exactly: its body and its controller's memory), then free ones."""
+        free = np.flatnonzero((self.slots == FREE) | (self.slots == LOST))
+        return np.concatenate([np.flatnonzero(self.returning), free])
 
     def _welcome(self, agent: int) -> dict:
         raise NotImplementedError
@@ -178,6 +184,10 @@ class WorldServer:
 
     def _starting(self) -> None:
         """The agents that start the run have joined; the first tick is next."""
+
+    def _hand_back(self) -> None:
+        """A resumed run, before its first tick: give the agents back what their
+        controllers held at the saved tick (kinds whose controllers keep memory)."""
 
     def _begin_tick(self) -> None:
         """Before the tick's observations go out."""
@@ -253,7 +263,9 @@ class WorldServer:
                 self._reply(query, self.keys.join, proto.refuse_reply("the swarm is full"))
                 return
             agent = int(free[0])
-            if self.slots[agent] == LOST:
+            if self.returning[agent]:
+                self.returning[agent] = False  # taken over where it was saved
+            elif self.slots[agent] == LOST:
                 self._reuse(agent)
             self.nonces[nonce] = agent
             self._assign_group(agent, request["group"])
@@ -273,11 +285,13 @@ class WorldServer:
             return
         if sample.kind == zenoh.SampleKind.PUT and self.slots[agent] == JOINING:
             self.slots[agent] = ACTIVE
+            self.returning[agent] = False
         elif sample.kind == zenoh.SampleKind.DELETE and self.slots[agent] in (JOINING, ACTIVE):
             self._lose(agent)
 
     def _lose(self, agent: int) -> None:
         self.slots[agent] = LOST
+        self.returning[agent] = False
         self.stats.agents_lost += 1
         if not self.done():  # after the run, agents leaving do not change the final world
             self._remove(agent)
@@ -429,6 +443,8 @@ class WorldServer:
         if not (self.resumed and self.done()):  # a finished run resumed has nothing left to do
             self.wait_for_agents()
         self._starting()
+        if self.resumed:
+            self._hand_back()
         self.started = time.monotonic()
         while not self.done() and self.tick < self.max_iterations:
             if not (self.slots == ACTIVE).any():
