@@ -52,10 +52,13 @@ def floor(processes: int, ticks: int = 300, endpoint: str = "tcp/127.0.0.1:17555
     try:
         for p in procs:
             p.start()
+        deadline = time.monotonic() + 120
         with lock:
             while got[0] < processes:
-                if not lock.wait(120):
-                    raise TimeoutError(f"only {got[0]} of {processes} floor processes started")
+                lock.wait(1)
+                dead = sum(p.exitcode is not None for p in procs)
+                if dead or time.monotonic() > deadline:
+                    raise TimeoutError(f"only {got[0]} of {processes} floor processes started ({dead} exited)")
             got[0] = 0
         latency = []
         started = time.perf_counter()
