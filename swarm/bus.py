@@ -32,13 +32,6 @@ def config(mode: str, listen: list[str] | None = None, connect: list[str] | None
     return c
 
 
-def direct(callback) -> zenoh.handlers.Callback:
-    """A callback run on zenoh's own receiving thread rather than a Python
-    thread of its own: one thread hand-off less per message.  It must only
-    enqueue (e.g. `queue.SimpleQueue.put`, which is C and never blocks)."""
-    return zenoh.handlers.Callback(callback, indirect=False)
-
-
 def _said(exc: Exception) -> str:
     """zenoh's error without the Rust source locations it appends."""
     return re.sub(r" at /\S+\.rs:\d+\.?", "", str(exc))
