@@ -298,25 +298,21 @@ def check_family(m: dict, kind: str, family: str, what: str) -> dict | Rejected:
     return m
 
 
-def act_header(data: bytes, family: str) -> tuple[dict, int, np.ndarray] | Rejected:
-    """What every family's action message shares: (message, tick, agents)."""
-    m = family_message(data, "act", family, "an action")
-    if isinstance(m, Rejected):
-        return m
-    tick, agents = int_field(m, "tick"), int_list(m, "agents")
-    if bad := first_rejection(tick, agents):
-        return bad
-    return m, tick, agents  # type: ignore[return-value]
-
-
-def parse_acts(data: bytes) -> Acts | Rejected:
-    m = family_message(data, "act", FAMILY_GRID, "an action")
+def family_header(data: bytes, kind: str, family: str, what: str) -> tuple[dict, int] | Rejected:
+    """What every family's agent message shares: (message, tick), type, family and tick checked."""
+    m = family_message(data, kind, family, what)
     if isinstance(m, Rejected):
         return m
     tick = int_field(m, "tick")
+    return tick if isinstance(tick, Rejected) else (m, tick)
+
+
+def parse_acts(data: bytes) -> Acts | Rejected:
+    header = family_header(data, "act", FAMILY_GRID, "an action")
+    if isinstance(header, Rejected):
+        return header
+    m, tick = header
     raw = m.get("rows")
-    if isinstance(tick, Rejected):
-        return tick
     if not isinstance(raw, bytes) or len(raw) % (ACT_ROW * 8):
         return Rejected(f"rows: expected rows of {ACT_ROW} binary integers")
     return Acts(tick, np.frombuffer(raw, dtype="<i8").reshape(-1, ACT_ROW))

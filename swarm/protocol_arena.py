@@ -20,9 +20,8 @@ import numpy as np
 from swarm.protocol import (
     FAMILY_ARENA,
     Rejected,
-    act_header,
     check_family,
-    family_message,
+    family_header,
     first_rejection,
     int_field,
     int_list,
@@ -107,10 +106,13 @@ def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
 
 
 def parse_acts(data: bytes) -> ArenaActs | Rejected:
-    header = act_header(data, FAMILY_ARENA)
+    header = family_header(data, "act", FAMILY_ARENA, "an action")
     if isinstance(header, Rejected):
         return header
-    m, tick, agents = header
+    m, tick = header
+    agents = int_list(m, "agents")
+    if isinstance(agents, Rejected):
+        return agents
     raw = m.get("wheels")
     if not isinstance(raw, bytes) or len(raw) != 16 * len(agents):
         return Rejected(f"wheels: expected {len(agents)}x2 binary float64")
@@ -134,12 +136,13 @@ def plan_message(tick: int, agent: int, path: np.ndarray) -> bytes:
 
 
 def parse_plan(data: bytes) -> Plan | Rejected:
-    m = family_message(data, "plan", FAMILY_ARENA, "a plan")
-    if isinstance(m, Rejected):
-        return m
-    tick, agent = int_field(m, "tick"), int_field(m, "agent")
-    if bad := first_rejection(tick, agent):
-        return bad
+    header = family_header(data, "plan", FAMILY_ARENA, "a plan")
+    if isinstance(header, Rejected):
+        return header
+    m, tick = header
+    agent = int_field(m, "agent")
+    if isinstance(agent, Rejected):
+        return agent
     raw = m.get("path")
     if not isinstance(raw, bytes) or len(raw) % 16 or not 0 < len(raw) // 16 <= MAX_PLAN_POINTS:
         return Rejected(f"path: expected 1 to {MAX_PLAN_POINTS} points of 2 float64")

@@ -147,8 +147,7 @@ class GridServer(WorldServer):
         msg, group = received
         if not self._current(msg.tick):
             self.stats.late_actions += len(msg.rows)
-            for _ in range(len(msg.rows)):
-                self.stats.reject("act: not for this tick")
+            self.stats.reject("act: not for this tick", len(msg.rows))
             return
         lockstep = self.mode == "lockstep"
         refused = accept_rows(msg.rows, self.slots, self.group_ids, self.group_index.get(group, -1), lockstep,
@@ -156,7 +155,7 @@ class GridServer(WorldServer):
         if refused.any():
             for reason, count in zip(REFUSALS, refused.tolist(), strict=True):
                 if count:
-                    self.stats.rejected[reason] = self.stats.rejected.get(reason, 0) + count
+                    self.stats.reject(reason, count)
 
     def _on_mark(self, sample) -> None:
         received = self._receive(sample, proto.parse_marks, "mark")

@@ -45,8 +45,8 @@ class Stats:
     late_actions: int = 0
     missed_ticks: int = 0
 
-    def reject(self, reason: str) -> None:
-        self.rejected[reason] = self.rejected.get(reason, 0) + 1
+    def reject(self, reason: str, count: int = 1) -> None:
+        self.rejected[reason] = self.rejected.get(reason, 0) + count
 
     @property
     def rejected_total(self) -> int:
