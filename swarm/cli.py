@@ -22,6 +22,7 @@ from swarm.errors import RecordingError, RunError, raise_interrupt
 from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
 
 CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
+FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize")
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -38,7 +39,9 @@ examples:
   swarm experiment table1 --reps 100
   swarm run zmaze --noise high                  # an arena: the carrot e-puck in the DFT paper's Z-maze
   swarm sense zmaze --pose 0.2,0.5,0            # what a robot senses there
-  swarm bench engine | distributed | recording | arena
+  swarm run office --controller fingerprint     # the scout maps the office floor with fingerprints of places
+  swarm experiment fingerprint-localize         # map on one tour, localize on another (Tapus et al. 2006)
+  swarm bench engine | distributed | recording | arena | fingerprint
   docker compose up swarm                       # the same in containers (compose.yaml, docs/docker.md)
 """
 
@@ -100,17 +103,27 @@ def build_parser() -> argparse.ArgumentParser:
 
     names_help = "; ".join(f"{e.name}: {e.title.split(': ', 1)[1]}" for e in EXPERIMENTS.values())
     names_help += "; carrot: follow the carrot in zmaze and large-maze at three noise levels (DFT paper, cases 1-2)"
-    exp.add_argument("name", choices=[*EXPERIMENTS, "carrot"], metavar="NAME", help=names_help)
-    exp.add_argument("--scenario", help="carrot only: zmaze or large-maze (default both)")
+    names_help += (
+        "; fingerprint-calibrate | fingerprint-map | fingerprint-localize: topological mapping and "
+        "localization with fingerprints of places on office (Tapus et al. 2006)"
+    )
+    exp.add_argument("name", choices=[*EXPERIMENTS, "carrot", *FINGERPRINT_EXPERIMENTS], metavar="NAME",
+                     help=names_help)  # fmt: skip
+    exp.add_argument(
+        "--scenario",
+        help="carrot: zmaze or large-maze (default both); fingerprint-*: a floor with "
+        "'mapping' and 'localize' routes and place zones (default office)",
+    )
     exp.add_argument("--reps", type=_positive, help="runs per configuration (default per experiment)")
     exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
     exp.add_argument("--seed", type=_seed, default=0, help="first seed (runs use seed..seed+reps-1)")
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
 
     bench = sub.add_parser("bench", help="measure throughput", description="Measure throughput.")
-    bench.add_argument("target", choices=["engine", "distributed", "recording", "arena"],
+    bench.add_argument("target", choices=["engine", "distributed", "recording", "arena", "fingerprint"],
                        help="engine: the in-process engine; distributed: world + agent processes; "
-                       "recording: what recording costs; arena: sensing and physics of the arena")  # fmt: skip
+                       "recording: what recording costs; arena: sensing and physics of the arena; "
+                       "fingerprint: features, one alignment, localization against 20-1000 nodes")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument("--quick", action="store_true", help="shorter measurement")
 
@@ -465,6 +478,14 @@ def cmd_report(args) -> int:
 
 
 def cmd_experiment(args) -> int:
+    if args.name in FINGERPRINT_EXPERIMENTS:
+        from swarm.arena.fingerprint import run_fingerprint_experiment
+
+        result = run_fingerprint_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out)
+        print(result["markdown"])
+        print(f"wrote {result['out']}/runs.csv, table.md" + ("" if args.name.endswith("calibrate") else
+                                                             ", summary.csv, plot.png"))  # fmt: skip
+        return 0
     if args.name == "carrot":
         from swarm.arena.experiments import run_carrot_experiment
 
@@ -485,6 +506,12 @@ def cmd_experiment(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    if args.target == "fingerprint":
+        from swarm.bench_fingerprint import bench_fingerprint, format_fingerprint_bench
+
+        result = bench_fingerprint(quick=args.quick)
+        print(json.dumps(result) if args.json else format_fingerprint_bench(result))
+        return 0
     if args.target == "arena":
         from swarm.bench_arena import bench_arena, format_arena_bench
 

@@ -96,6 +96,10 @@ def print_arena_summary(summary: dict, as_json: bool) -> int:
                 f"  robot {r['agent']} ({r['controller']}): {'reached' if r['reached'] else 'not reached'}{first}, "
                 f"L_p {r['path_length']:.3f} m, L_o {lo} m, L_p/L_o {ratio}, collisions {r['collisions']}"
             )
+            if r.get("map"):
+                m = r["map"]
+                print(f"    map: {m['fingerprints']} fingerprints, {m['nodes']} nodes, {m['links']} links, "
+                      f"{m['loops_closed']} loops closed")  # fmt: skip
         if len(summary["robots"]) > 20:
             print(f"  ... {len(summary['robots']) - 20} more robots (--json lists them all)")
         if "agents_lost" in summary:

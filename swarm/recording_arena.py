@@ -13,6 +13,8 @@ Layout (timeline `tick`; the record at tick t shows the world after tick t):
     world/trajectories    line strips of every robot's path so far (logged at each flush)
     world/plans/<agent>   the path a controller planned (in process from its record(); distributed, sent
                           by its agent process on swarm/<run>/plans/<group>)
+    world/map/<agent>/…,  a controller's topological map over the floor plan, its belief and current
+    map/<agent>/…         fingerprint (in process; swarm/recording_topomap.py)
     metrics/<name>        reached, collisions, distance, agents_alive, tick_ms, rejected_messages
                           (in-process: the actions the world refused)
     metrics/robots/<name> per robot, one scalar each: path_length, collisions, in_goal, finished (dwelt)
@@ -98,6 +100,7 @@ class ArenaRecorder:
         self._paths = world.pose[:, None, :2].astype(np.float32)  # (n, T, 2): every robot's path so far
         self._obstacles_on: tuple | None = None
         self._plans_logged: set[int] = set()
+        self._maps = None
         self._static_done = False
 
     def _log_static(self) -> None:
@@ -189,6 +192,7 @@ class ArenaRecorder:
             self._log_obstacles(tick, on)
         if self.controllers is not None:
             self._log_plans(tick)
+            self._log_maps(tick)
         if len(self._ticks) >= self.flush_every:
             self.flush()
 
@@ -209,6 +213,17 @@ class ArenaRecorder:
                 path = np.asarray(c.record().get("path", np.zeros((0, 2))))
                 if len(path) > 1:
                     self.log_plan(tick, a, path)
+
+    def _log_maps(self, tick: int) -> None:
+        """The topological map of each controller that keeps one (swarm.recording_topomap)."""
+        for a, c in enumerate(self.controllers):
+            if not getattr(c, "keeps_map", False):
+                continue
+            if self._maps is None:
+                from swarm.recording_topomap import MapLog
+
+                self._maps = MapLog(self.rr, self.rec, self.colours)
+            self._maps.capture(tick, a, c.record(), self.world.pose[a, :2])
 
     def log_plan(self, tick: int, agent: int, path: np.ndarray) -> None:
         """A controller's planned path, at the tick it was planned."""

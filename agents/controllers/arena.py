@@ -20,10 +20,17 @@ import numpy as np
 REGISTRY = {
     "carrot": "agents.controllers.carrot:CarrotController",
     "wander": "agents.controllers.wander:WanderController",
+    "fingerprint": "agents.controllers.fingerprint:FingerprintController",
 }
 ARENA_CONTROLLERS = tuple(REGISTRY)
+# Each controller's own scenario table, checked when a scenario is loaded (a callable raising ValueError).
+TABLES = {
+    "carrot": "agents.controllers.carrot:CarrotParams.from_table",
+    "wander": "agents.controllers.wander.controller:WanderParams.from_table",
+    "fingerprint": "agents.controllers.fingerprint.controller:check_table",
+}
 # What a controller needs its robot to sense (checked when a scenario is loaded).
-REQUIRES = {"carrot": ("position", "compass"), "wander": ()}
+REQUIRES = {"carrot": ("position", "compass"), "wander": (), "fingerprint": ("camera", "laser", "odometry", "compass")}
 
 
 class ArenaController(Protocol):
@@ -36,6 +43,15 @@ class ArenaController(Protocol):
     def restore(self, state: dict[str, Any]) -> None: ...
 
     def record(self) -> dict[str, np.ndarray]: ...
+
+
+def check_table(name: str, table: dict[str, Any]) -> None:
+    """Raise ValueError (one line, naming the field) if `table` is not a valid [name] table."""
+    module, attr = TABLES[name].split(":")
+    target: Any = importlib.import_module(module)
+    for part in attr.split("."):
+        target = getattr(target, part)
+    target(table)
 
 
 def make_controller(name: str) -> ArenaController:

@@ -104,7 +104,11 @@ class ArenaEngine:
         return self.summary()
 
     def summary(self) -> dict[str, Any]:
-        return arena_summary(self.world, self.wall_seconds, "in-process")
+        out = arena_summary(self.world, self.wall_seconds, "in-process")
+        for robot, c in zip(out["robots"], self.controllers, strict=True):
+            if hasattr(c, "summary"):  # what a controller learned (a map), beside what its body did
+                robot.update(c.summary())
+        return out
 
 
 def arena_summary(world: ArenaWorld, wall_seconds: float, runtime: str) -> dict[str, Any]:

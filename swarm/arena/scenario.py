@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from agents.controllers.arena import ARENA_CONTROLLERS, REQUIRES
+from agents.controllers.arena import ARENA_CONTROLLERS, REQUIRES, check_table
 from swarm.arena.models import (
     IR,
     MODELS,
@@ -575,6 +575,11 @@ def check_arena(s: ArenaScenario, source: str) -> None:
     for i, o in enumerate(s.obstacles):
         if not (inside(o.rect[0], o.rect[1]) and inside(o.rect[2], o.rect[3])):
             raise ScenarioError(source, f"obstacle {i + 1}", f"{list(o.rect)} is outside the arena")
+    for name, table in s.controller_params.items():
+        try:
+            check_table(name, table)
+        except (ValueError, TypeError) as e:
+            raise ScenarioError(source, f"[{name}]", str(e).removeprefix(f"[{name}]: ")) from None
     rects, segs = s.blocking_rects(0), s.wall_segments()
     for gi, g in enumerate(s.groups):
         m = g.robot
@@ -699,9 +704,11 @@ def controller_params(s: ArenaScenario, agent: int) -> dict[str, Any]:
             "max_wheel_speed": m.max_wheel_speed,
             "max_speed": m.max_speed,
             "max_turn_rate": m.max_turn_rate,
+            "laser_range": m.sensors.laser.range if m.sensors.laser else None,
         },
         "control_period": s.control_period,
         "noise": s.noise.level,
         "goal_radius": s.goal_radius,
+        **s.controller_params,  # every controller's table: one may drive with another's (fingerprint: carrot)
         group.controller: s.controller_params.get(group.controller, {}),
     }

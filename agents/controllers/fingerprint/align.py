@@ -1,0 +1,250 @@
+"""Global alignment with uncertainty (Tapus et al. 2004, after Needleman-Wunsch),
+circular: the cost of turning one fingerprint into another, minimised over
+the rotations of one of them, and a probability of matching from it.
+
+The costs are negative log-probabilities of the events that make two views
+of one place differ (our reading of "with uncertainty"; the constants are
+ours, docs/fingerprint.md):
+- a feature missed or spurious (a gap) costs -ln(p_miss) of its type: hue
+  patches are seldom missed, edges and corners more often, an empty-space
+  quantum `n` often gains or loses one;
+- a hue patch read one bin off (lighting, the bin boundary) costs
+  `hue_near`; any other substitution costs `wrong`, more than a gap of either
+  feature, so one missing feature always costs less than one wrong one;
+- identical features cost nothing.
+
+Two kernels: `cyclic_cost_exact` tries every rotation (m global alignments;
+the reference) and `cyclic_cost` does one pass over the node's string
+written twice, each cell remembering where its path entered, a path allowed
+to consume at most one turn of the node, the node's characters it left out
+charged as gaps.  Each of its answers is the cost of a real alignment with a
+real rotation, so it is never below the exact minimum; tests measure how
+often it is above.  `localize` runs `cyclic_cost` against every node of a map
+in one compiled call.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+from numba import njit
+
+HUES = 16  # symbols 0..15: hue bins 'A'..'P'
+V, C, N = 16, 17, 18  # vertical edge, laser corner; N + k - 1: a run of k empty-space quanta
+MAX_RUN = 36
+SYMBOLS = N + MAX_RUN
+LETTERS = "ABCDEFGHIJKLMNOP" + "vc"
+SCALE = 1000  # costs are integers in thousandths of a nat (exact sums, one integer per cell)
+SHIFT = 12  # a DP cell is cost << SHIFT | the column where its path entered (strings up to 2047)
+MAX_LENGTH = (1 << (SHIFT - 1)) - 1
+
+
+def to_string(codes: np.ndarray) -> str:
+    """The paper's notation: one `n` per empty-space quantum."""
+    return "".join(LETTERS[c] if c < N else "n" * (c - N + 1) for c in (int(x) for x in codes))
+
+
+def from_string(text: str) -> np.ndarray:
+    """Symbols of a fingerprint written as the paper writes it (runs of `n` become one symbol)."""
+    out: list[int] = []
+    for ch in text:
+        if ch == "n":
+            if out and N <= out[-1] < SYMBOLS - 1:
+                out[-1] += 1
+            else:
+                out.append(N)
+        elif ch in LETTERS:
+            out.append(LETTERS.index(ch))
+        else:
+            raise ValueError(f"fingerprint {text!r}: {ch!r} is not a feature; use A-P, v, c or n")
+    return np.array(out, np.int8)
+
+
+@dataclass(frozen=True)
+class AlignParams:
+    miss_hue: float = 0.02  # chance that a colour patch is missed or spurious
+    miss_edge: float = 0.5  # a vertical edge
+    miss_corner: float = 0.5  # a laser corner
+    miss_space: float = 0.5  # one empty-space quantum more or less
+    hue_near: float = 1.2  # a hue patch read one bin off
+    wrong: float = 4.0  # any other substitution (more than a gap of either feature)
+    # Probability of matching: logistic in the cost per character of the longer string,
+    # P = 1 / (1 + exp((d - centre) / width)); calibrated on office (docs/fingerprint.md).
+    centre: float = 0.544
+    width: float = 0.122
+
+    @classmethod
+    def from_table(cls, table: dict | None) -> AlignParams:
+        table = table or {}
+        known = {f.name for f in fields(cls)}
+        if unknown := sorted(set(table) - known):
+            raise ValueError(f"[fingerprint.align]: unknown field {unknown[0]!r}; expected one of "
+                             f"{', '.join(sorted(known))}")  # fmt: skip
+        return cls(**{k: float(v) for k, v in table.items()})
+
+    def tables(self) -> tuple[np.ndarray, np.ndarray]:
+        """(substitution costs SYMBOLS x SYMBOLS, gap cost per symbol), integers of SCALE.
+
+        A run of k empty quanta is one symbol: it aligns with a run of l at the
+        cost of |k - l| quanta gapped, and is gapped whole at k of them."""
+        gap = np.empty(SYMBOLS)
+        gap[:HUES] = -math.log(self.miss_hue)
+        gap[V], gap[C] = -math.log(self.miss_edge), -math.log(self.miss_corner)
+        runs = np.arange(1, MAX_RUN + 1)
+        gap[N:] = runs * -math.log(self.miss_space)
+        sub = np.full((SYMBOLS, SYMBOLS), self.wrong)
+        for a in range(HUES):
+            for b in range(HUES):
+                ring = min(abs(a - b), HUES - abs(a - b))
+                sub[a, b] = 0.0 if ring == 0 else (self.hue_near if ring == 1 else self.wrong)
+        sub[V, V] = sub[C, C] = 0.0
+        sub[N:, N:] = np.abs(runs[:, None] - runs[None, :]) * -math.log(self.miss_space)
+        sub[N:, :N] = sub[:N, N:] = 1e6  # empty space is never a feature: always two gaps
+        return np.round(sub * SCALE).astype(np.int64), np.round(gap * SCALE).astype(np.int64)
+
+    def probability(self, cost: np.ndarray | float, longer: np.ndarray | int) -> np.ndarray:
+        """P(match) from a cost (in nats) and the longer string's length in the paper's characters."""
+        d = np.asarray(cost, np.float64) / np.maximum(np.asarray(longer, np.float64), 1.0)
+        return 1.0 / (1.0 + np.exp(np.clip((d - self.centre) / self.width, -50.0, 50.0)))
+
+
+@njit(cache=True)
+def _global(a, b, sub, gap):  # pragma: no cover - compiled
+    n, m = len(a), len(b)
+    row = np.empty(m + 1, np.int64)
+    row[0] = 0
+    for j in range(1, m + 1):
+        row[j] = row[j - 1] + gap[b[j - 1]]
+    for i in range(1, n + 1):
+        diag = row[0]
+        row[0] = diag + gap[a[i - 1]]
+        ga = gap[a[i - 1]]
+        for j in range(1, m + 1):
+            up = row[j]
+            best = min(up + ga, diag + sub[a[i - 1], b[j - 1]], row[j - 1] + gap[b[j - 1]])
+            row[j] = best
+            diag = up
+    return row[m]
+
+
+@njit(cache=True)
+def cyclic_cost_exact(a, b, sub, gap):  # pragma: no cover - compiled
+    """min over rotations r of the global alignment of a with b rotated by r."""
+    m = len(b)
+    if m == 0:
+        return _global(a, b, sub, gap)
+    bb = np.concatenate((b, b))
+    best = _global(a, b, sub, gap)
+    for r in range(1, m):
+        best = min(best, _global(a, bb[r : r + m], sub, gap))
+    return best
+
+
+@njit(cache=True)
+def _cyclic(qsub, qgap, b, gap):  # pragma: no cover - compiled
+    """The one-pass kernel for a query given as its rows of the substitution
+    table and its gaps, both shifted (computed once per query, not per node)."""
+    n, m = len(qgap), len(b)
+    w = 2 * m
+    mask = (1 << SHIFT) - 1
+    never = np.int64(1) << np.int64(60)
+    gb = np.empty(w + 1, np.int64)  # gap of the node's character that column j consumes, shifted
+    cb = np.empty(w + 1, np.int64)
+    prefix = np.zeros(w + 1, np.int64)  # gap costs of bb[:j]
+    gb[0], cb[0] = 0, 0
+    for j in range(1, w + 1):
+        cb[j] = b[(j - 1) % m]
+        prefix[j] = prefix[j - 1] + gap[cb[j]]
+        gb[j] = gap[cb[j]] << SHIFT
+    row = np.empty(w + 1, np.int64)
+    for j in range(w + 1):  # a path enters the node's string at one of its m characters: a rotation
+        row[j] = j if j < m else never | j
+    for i in range(n):
+        srow = qsub[i]
+        ga = qgap[i]
+        diag = row[0]
+        left = diag + ga
+        row[0] = left
+        for j in range(1, w + 1):
+            up = row[j]
+            best = up + ga
+            s = diag + srow[cb[j]]
+            s = s if j - (diag & mask) <= m else never  # at most one turn of the node
+            best = s if s < best else best
+            h = left + gb[j]
+            h = h if j - (left & mask) <= m else never
+            best = h if h < best else best
+            row[j] = best
+            left = best
+            diag = up
+    best = never
+    for j in range(w + 1):
+        end = (row[j] & mask) + m
+        if j <= end and end <= w:
+            best = min(best, (row[j] >> SHIFT) + prefix[end] - prefix[j])  # the turn's characters left out
+    return best
+
+
+@njit(cache=True)
+def cyclic_cost(a, b, sub, gap):  # pragma: no cover - compiled
+    """One pass over b written twice (see the module's docstring).  A cell holds
+    cost << SHIFT | entry column, so one integer min keeps both (ties: the
+    earlier entry), and no branch depends on the data."""
+    if len(a) == 0 or len(b) == 0:
+        return _global(a, b, sub, gap)
+    qsub = np.empty((len(a), sub.shape[1]), np.int64)
+    qgap = np.empty(len(a), np.int64)
+    for i in range(len(a)):
+        qsub[i] = sub[a[i]] << SHIFT
+        qgap[i] = gap[a[i]] << SHIFT
+    return _cyclic(qsub, qgap, b, gap)
+
+
+@njit(cache=True)
+def localize_costs(a, codes, offsets, sub, gap):  # pragma: no cover - compiled
+    """cyclic_cost of `a` against every node k: codes[offsets[k]:offsets[k+1]]."""
+    k = len(offsets) - 1
+    out = np.empty(k, np.int64)
+    qsub = np.empty((len(a), sub.shape[1]), np.int64)
+    qgap = np.empty(len(a), np.int64)
+    for i in range(len(a)):
+        qsub[i] = sub[a[i]] << SHIFT
+        qgap[i] = gap[a[i]] << SHIFT
+    for i in range(k):
+        b = codes[offsets[i] : offsets[i + 1]]
+        out[i] = _global(a, b, sub, gap) if len(a) == 0 or len(b) == 0 else _cyclic(qsub, qgap, b, gap)
+    return out
+
+
+def paper_length(codes: np.ndarray) -> int:
+    """Length in the paper's characters (each empty quantum one `n`)."""
+    c = np.asarray(codes, np.int64)
+    return int(np.where(c >= N, c - N + 1, 1).sum())
+
+
+class Matcher:
+    """The alignment's costs and calibration, with the compiled kernels behind
+    plain calls (int8 symbols in, costs in nats or probabilities out)."""
+
+    def __init__(self, params: AlignParams | None = None):
+        self.params = params or AlignParams()
+        self.sub, self.gap = self.params.tables()
+
+    def cost(self, a: np.ndarray, b: np.ndarray, exact: bool = False) -> float:
+        a, b = np.asarray(a, np.int8), np.asarray(b, np.int8)
+        if max(len(a), len(b)) > MAX_LENGTH:
+            raise ValueError(f"a fingerprint of {max(len(a), len(b))} symbols; at most {MAX_LENGTH} align")
+        kernel = cyclic_cost_exact if exact else cyclic_cost
+        return kernel(a, b, self.sub, self.gap) / SCALE
+
+    def probability(self, a: np.ndarray, b: np.ndarray) -> float:
+        return float(self.params.probability(self.cost(a, b), max(paper_length(a), paper_length(b))))
+
+    def against(self, a: np.ndarray, codes: np.ndarray, offsets: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+        """P(match) of `a` with each of a packed set of strings (a map's nodes:
+        node k is codes[offsets[k]:offsets[k + 1]], `lengths` in the paper's characters)."""
+        a = np.asarray(a, np.int8)
+        costs = localize_costs(a, codes, offsets, self.sub, self.gap) / SCALE
+        return self.params.probability(costs, np.maximum(lengths, paper_length(a)))

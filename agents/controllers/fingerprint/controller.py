@@ -1,0 +1,176 @@
+"""The fingerprint controller: drive, take a fingerprint every `spacing` metres,
+map with it (or localize on a map it is given), report its belief.
+
+It sees the panoramic camera, the laser, the odometry and the compass.
+Mapping and localization use only those; the position sensor, when the
+robot has one, only steers the carrot along a prescribed route, as the
+paper's robot was driven along its tour.  Odometry is integrated along the
+compass heading into the odometric frame in which nodes and links live.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from agents.controllers.fingerprint.align import AlignParams, Matcher
+from agents.controllers.fingerprint.features import FeatureParams, Fingerprint, fingerprint
+from agents.controllers.fingerprint.signatures import FingerprintSignatures, map_from_data, map_to_data
+from agents.controllers.navigation.topomap import MapParams, TopoMap
+
+DRIVES = ("route", "explore")
+MODES = ("map", "localize")
+
+
+@dataclass(frozen=True)
+class FingerprintParams:
+    spacing: float = 0.15  # metres between fingerprints (75 m / 500 fingerprints, as the paper's tour)
+    drive: str = "route"  # route: the carrot along the group's route; explore: wander
+    mode: str = "map"  # map: build the map; localize: on the map given in params["topomap"]
+    theta: float = 0.5  # largest dissimilarity at which a fingerprint joins the current node
+    keep: int = 30  # fingerprints a node keeps for its mean
+    closure: float = 0.5  # belief in a known node that closes a loop
+
+    @classmethod
+    def from_table(cls, table: dict[str, Any] | None) -> FingerprintParams:
+        table = {k: v for k, v in (table or {}).items() if k not in ("features", "align")}
+        known = {f.name for f in fields(cls)}
+        if unknown := sorted(set(table) - known):
+            raise ValueError(f"[fingerprint]: unknown field {unknown[0]!r}; expected one of "
+                             f"{', '.join(sorted(known | {'features', 'align'}))}")  # fmt: skip
+        p = cls(**{k: (v if k in ("drive", "mode") else int(v) if k == "keep" else float(v)) for k, v in table.items()})
+        if p.drive not in DRIVES:
+            raise ValueError(f"[fingerprint].drive: {p.drive!r}; expected one of {', '.join(DRIVES)}")
+        if p.mode not in MODES:
+            raise ValueError(f"[fingerprint].mode: {p.mode!r}; expected one of {', '.join(MODES)}")
+        if not (p.spacing > 0 and 0 < p.theta < 1 and p.keep >= 1):
+            raise ValueError("[fingerprint]: spacing > 0, 0 < theta < 1 and keep >= 1 are required")
+        return p
+
+
+def check_table(table: dict[str, Any] | None) -> None:
+    """The whole [fingerprint] table, its [fingerprint.features] and [fingerprint.align] included."""
+    table = table or {}
+    FingerprintParams.from_table(table)
+    FeatureParams.from_table(table.get("features"))
+    AlignParams.from_table(table.get("align"))
+
+
+def _plain(value: Any) -> Any:
+    """Arrays inside a snapshot as lists, so that it is JSON- and msgpack-safe."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+class FingerprintController:
+    keeps_map = True  # the recorder draws its topological map
+
+    def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
+        table = params.get("fingerprint") or {}
+        self.p = FingerprintParams.from_table(table)
+        self.features = FeatureParams.from_table(table.get("features"))
+        self.matcher = Matcher(AlignParams.from_table(table.get("align")))
+        self.signatures = FingerprintSignatures(self.matcher)
+        map_params = MapParams(theta=self.p.theta, keep=self.p.keep, closure=self.p.closure)
+        if self.p.mode == "localize":
+            if params.get("topomap") is None:
+                raise ValueError(
+                    "[fingerprint].mode = 'localize' needs a map: give params['topomap'] "
+                    "(swarm experiment fingerprint-localize builds one with a mapping tour first)"
+                )
+            self.map = map_from_data(params["topomap"], self.signatures, map_params)
+        else:
+            self.map = TopoMap(self.signatures, map_params)
+        if self.p.drive == "route":
+            from agents.controllers.carrot import CarrotController
+
+            self.driver = CarrotController()
+        else:
+            from agents.controllers.wander import WanderController
+
+            self.driver = WanderController()
+        self.driver.reset(seed, agent, params)
+        self.laser_range = float(params["robot"].get("laser_range") or 8.0)
+        self.tick = 0
+        self.position = np.zeros(2)  # odometric frame
+        self.last_position = np.zeros(2)
+        self.since = math.inf  # metres since the last fingerprint (inf: take one at once)
+        self.current: Fingerprint | None = None
+        self.believed, self.matched = -1, -1
+        self.log: list[tuple[int, int, int, int]] = []  # (tick, believed node, matched node, nodes in the map)
+
+    @property
+    def finished(self) -> bool:
+        """The route is driven to its end (an explorer never finishes)."""
+        return self.p.drive == "route" and bool(self.driver.stopped)
+
+    def step(self, perception: dict[str, np.ndarray]) -> np.ndarray:
+        for name in ("camera_rgb", "camera_range", "laser", "odometry", "compass"):
+            if name not in perception:
+                raise ValueError(f"fingerprint needs the camera, laser, odometry and compass ({name!r} is missing); "
+                                 "the scout has them")  # fmt: skip
+        wheels = self.driver.step(perception)
+        distance = float(perception["odometry"][0])
+        heading = float(perception["compass"])
+        self.position = self.position + distance * np.array([math.cos(heading), math.sin(heading)])
+        self.since += abs(distance)
+        if self.since >= self.p.spacing:
+            self.since = 0.0
+            self._observe(perception)
+        self.tick += 1
+        return wheels
+
+    def _observe(self, perception: dict[str, np.ndarray]) -> None:
+        scan = np.asarray(perception["laser"], np.float64)
+        self.current = fingerprint(perception["camera_rgb"], perception["camera_range"], scan,
+                                   self.laser_range, self.features)  # fmt: skip
+        moved = self.position - self.last_position
+        self.last_position = self.position.copy()
+        if self.p.mode == "map":
+            self.believed = self.map.observe(self.current, self.position, moved)
+            likelihood = self.map.likelihood
+        else:
+            likelihood, belief = self.map.localize(self.current, moved)
+            self.believed = int(np.argmax(belief))
+        self.matched = int(np.argmax(likelihood)) if len(likelihood) else self.believed
+        self.log.append((self.tick, self.believed, self.matched, len(self.map.nodes)))
+
+    def map_data(self) -> dict[str, Any]:
+        """The map as plain data (to save, to send, to localize on later)."""
+        return map_to_data(self.map)
+
+    def summary(self) -> dict[str, Any]:
+        return {"map": {"fingerprints": len(self.log), "nodes": len(self.map.nodes), "links": len(self.map.links),
+                        "loops_closed": self.map.closures}}  # fmt: skip
+
+    def snapshot(self) -> dict[str, Any]:
+        return {"tick": self.tick, "position": self.position.tolist(), "last_position": self.last_position.tolist(),
+                "since": self.since, "map": self.map_data(), "log": [list(r) for r in self.log],
+                "driver": _plain(self.driver.snapshot()),
+                "params": asdict(self.p)}  # fmt: skip
+
+    def restore(self, state: dict[str, Any]) -> None:
+        self.tick, self.since = int(state["tick"]), float(state["since"])
+        self.position, self.last_position = np.array(state["position"]), np.array(state["last_position"])
+        self.map = map_from_data(state["map"], self.signatures, self.map.params)
+        self.log = [tuple(row) for row in state["log"]]
+        self.driver.restore(state["driver"])
+
+    def record(self) -> dict[str, np.ndarray]:
+        out = {k: v for k, v in self.driver.record().items() if k == "path"}
+        out["node"] = np.array(self.believed)
+        out["matched"] = np.array(self.matched)
+        out["nodes"] = np.array(len(self.map.nodes))
+        out["links"] = np.array(list(self.map.links), np.int64).reshape(-1, 2)
+        out["belief"] = np.asarray(self.map.belief, np.float64)
+        if self.current is not None:
+            out["fingerprint"] = self.current.codes
+        return out

@@ -1,0 +1,96 @@
+"""Fingerprints as the topological map's place signature: the likelihood of a
+fingerprint at each node (circular alignment against every node's mean in
+one compiled call) and the mean of a node's fingerprints.
+
+The mean of strings: the set median (medoid), the member whose alignment
+costs to all the others sum least.  It is always a fingerprint the robot
+really saw, a spurious or missed feature of one member never enters it, and
+it needs no rule for averaging bearings; the paper builds its mean
+"between the previous mean fingerprint and the new one" without saying how
+(docs/fingerprint.md).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from agents.controllers.fingerprint.align import Matcher, paper_length
+from agents.controllers.fingerprint.features import Fingerprint
+from agents.controllers.navigation.topomap import Link, MapParams, Node, TopoMap
+
+
+def pack(strings: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(codes, offsets, lengths in the paper's characters) of a list of symbol strings."""
+    codes = np.concatenate(strings).astype(np.int8) if strings else np.zeros(0, np.int8)
+    offsets = np.zeros(len(strings) + 1, np.int64)
+    offsets[1:] = np.cumsum([len(s) for s in strings])
+    return codes, offsets, np.array([paper_length(s) for s in strings], np.int64)
+
+
+class FingerprintSignatures:
+    def __init__(self, matcher: Matcher):
+        self.matcher = matcher
+        self._means: list[Fingerprint] = []
+        self._packed = pack([])
+
+    def likelihoods(self, observation: Fingerprint, means: list[Fingerprint]) -> np.ndarray:
+        same = len(means) == len(self._means) and all(a is b for a, b in zip(means, self._means, strict=True))
+        if not same:  # a node was added or its mean changed: pack them again (held, so no id is reused)
+            self._means, self._packed = list(means), pack([m.codes for m in means])
+        return self.matcher.against(observation.codes, *self._packed)
+
+    def mean(self, members: list[Fingerprint]) -> Fingerprint:
+        if len(members) <= 2:
+            return members[0]
+        k = len(members)
+        cost = np.zeros((k, k))
+        for i in range(k):
+            for j in range(i + 1, k):
+                cost[i, j] = cost[j, i] = self.matcher.cost(members[i].codes, members[j].codes)
+        return members[int(np.argmin(cost.sum(axis=1)))]
+
+
+def _fp_data(f: Fingerprint) -> list:
+    return [f.codes.tolist(), f.bearings.tolist()]
+
+
+def _fp(data: list) -> Fingerprint:
+    return Fingerprint(np.array(data[0], np.int8), np.array(data[1], np.float64))
+
+
+def map_to_data(m: TopoMap) -> dict[str, Any]:
+    """A fingerprint map as plain data (msgpack- and JSON-safe)."""
+    return {
+        "nodes": [{"mean": _fp_data(n.mean), "members": [_fp_data(f) for f in n.members],
+                   "position": n.position.tolist(), "observations": n.observations, "visits": n.visits,
+                   "seen_at": [list(p) for p in n.seen_at]}
+                  for n in m.nodes],
+        "links": [[a, b, link.displacement.tolist(), link.count] for (a, b), link in m.links.items()],
+        "current": m.current, "belief": np.asarray(m.belief).tolist(), "closures": m.closures,
+        "odometer": m.odometer,
+    }  # fmt: skip
+
+
+def map_from_data(data: dict[str, Any], signatures: FingerprintSignatures, params: MapParams) -> TopoMap:
+    try:
+        nodes = []
+        for n in data["nodes"]:
+            members = [_fp(f) for f in n["members"]]
+            mean = _fp(n["mean"])
+            # the mean is one of the members: keep it the same object, as the live map does
+            same = [f for f in members if np.array_equal(f.codes, mean.codes)]
+            nodes.append(Node(same[0] if same else mean, members, np.array(n["position"], np.float64),
+                              int(n["observations"]), int(n["visits"]),
+                              [(float(x), float(y), float(o)) for x, y, o in n.get("seen_at", [])]))  # fmt: skip
+        links = {(int(a), int(b)): Link(np.array(d, np.float64), int(c)) for a, b, d, c in data["links"]}
+        m = TopoMap(signatures, params, nodes, links, int(data.get("current", -1)),
+                    np.array(data.get("belief", []), np.float64), int(data.get("closures", 0)),
+                    odometer=float(data.get("odometer", 0.0)))  # fmt: skip
+    except (KeyError, TypeError, ValueError, IndexError) as e:
+        raise ValueError(
+            f"a fingerprint map: malformed ({type(e).__name__}: {e}); "
+            "expected what FingerprintController.map_data() writes"
+        ) from None
+    return m

@@ -1,0 +1,257 @@
+"""A topological map with Markov localization over its nodes, generic over what
+a place looks like (its signature).
+
+The fingerprint controller plugs in fingerprints of places (Tapus et al.
+2006); the BG animat will plug in its grey-level panorama and sonar (Girard et
+al. 2005, after Filliat).  A `Signatures` model says how likely an
+observation is at each node and what the mean of a node's observations is;
+everything else is here:
+
+- nodes: a mean signature, the observations that made it (the last
+  `keep`), where it lies in the robot's odometric frame (the mean of its
+  observations' positions: for links and display, never for matching), and
+  how many observations a visit to it lasts;
+- links: between nodes visited one after the other, with the odometric
+  displacement from the first node's centre (as it was when the robot
+  left it) to the second's (as it was when the robot came in; a new node's
+  centre is then its first observation), averaged over the traversals;
+  a new node is linked, too, to the nodes observed within `near` of where
+  it starts in the last `recent` metres of travel (the corridor stretch
+  before a room's door and the one after it meet there, though the robot
+  went through the room in between);
+- mapping (the paper's steps 1-5): each observation joins the current node
+  when its dissimilarity (1 - P(match)) to the node's mean is below theta;
+  else, if the belief given that the robot has left the current node puts
+  at least `closure` on one known node and the observation matches that
+  node within theta, the robot is there again (a loop closed: link to it
+  and go on there); else it starts a new node;
+- Markov (POMDP) localization: a belief over nodes, predicted with the
+  odometry since the last observation (stay for as long as visits there
+  last, or move along a link whose direction agrees with the motion), then
+  corrected by the likelihood of the observation at every node;
+- shortest routes between nodes over the links (Dijkstra).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+
+
+class Signatures(Protocol):
+    """What a place looks like, to the map."""
+
+    def likelihoods(self, observation: Any, means: list[Any]) -> np.ndarray:
+        """P(observation | node) for every node's mean signature (each in [0, 1])."""
+        ...
+
+    def mean(self, members: list[Any]) -> Any:
+        """The signature that stands for a node's observations."""
+        ...
+
+
+@dataclass
+class Node:
+    mean: Any
+    members: list[Any]
+    position: np.ndarray  # mean odometric position of the observations (x, y)
+    observations: int = 1
+    visits: int = 1
+    seen_at: list[tuple[float, float, float]] = field(default_factory=list)  # (x, y, odometer) of each observation
+
+    @property
+    def dwell(self) -> float:
+        """Observations a visit lasts, on average."""
+        return self.observations / max(self.visits, 1)
+
+
+@dataclass
+class Link:
+    displacement: np.ndarray  # from the first node's centre to the second's, odometric frame
+    count: int = 1
+
+    @property
+    def distance(self) -> float:
+        return float(np.hypot(*self.displacement))
+
+    @property
+    def direction(self) -> float:
+        return float(math.atan2(self.displacement[1], self.displacement[0]))
+
+
+@dataclass(frozen=True)
+class MapParams:
+    theta: float = 0.5  # the largest dissimilarity at which an observation joins a node
+    keep: int = 30  # observations a node keeps to compute its mean from
+    closure: float = 0.5  # a loop closes when the belief, the current node left out, gives a known node this
+    near: float = 1.5  # a new node is linked to every node observed this close (odometry) as well ...
+    recent: float = 20.0  # ... within this much travel (odometry drifts: farther back, near means little)
+    kappa: float = 2.0  # concentration of the link direction model (von Mises)
+    spread: float = 1e-2  # belief spread to every node at each prediction (kidnapping, errors)
+    floor: float = 1e-3  # likelihood floor: one bad match never rules a node out
+
+
+@dataclass
+class TopoMap:
+    signatures: Signatures
+    params: MapParams = field(default_factory=MapParams)
+    nodes: list[Node] = field(default_factory=list)
+    links: dict[tuple[int, int], Link] = field(default_factory=dict)
+    current: int = -1
+    belief: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    closures: int = 0
+    likelihood: np.ndarray = field(default_factory=lambda: np.zeros(0))  # of the last observation
+    odometer: float = 0.0  # distance travelled, for `recent`
+
+    # -------------------------------------------------------------- queries
+
+    def means(self) -> list[Any]:
+        return [n.mean for n in self.nodes]
+
+    def neighbours(self, i: int) -> list[tuple[int, Link]]:
+        out = []
+        for (a, b), link in self.links.items():
+            if a == i:
+                out.append((b, link))
+            elif b == i:
+                out.append((a, Link(-link.displacement, link.count)))
+        return out
+
+    def route(self, start: int, goal: int) -> list[int]:
+        """Nodes of a shortest route (by link distance) from start to goal; [] if none."""
+        dist, back = {start: 0.0}, {}
+        heap = [(0.0, start)]
+        while heap:
+            d, i = heapq.heappop(heap)
+            if i == goal:
+                path = [goal]
+                while path[-1] != start:
+                    path.append(back[path[-1]])
+                return path[::-1]
+            if d > dist.get(i, math.inf):
+                continue
+            for j, link in self.neighbours(i):
+                nd = d + link.distance
+                if nd < dist.get(j, math.inf):
+                    dist[j], back[j] = nd, i
+                    heapq.heappush(heap, (nd, j))
+        return []
+
+    # ------------------------------------------------------- localization
+
+    def _edges(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(from, to, direction) of every link both ways, cached until the links change."""
+        key = (len(self.nodes), len(self.links), sum(link.count for link in self.links.values()))
+        if getattr(self, "_edge_key", None) != key:
+            ab = np.array(list(self.links), np.int64).reshape(-1, 2)
+            d = np.array([link.direction for link in self.links.values()], np.float64)
+            self._edge_cache = (np.concatenate((ab[:, 0], ab[:, 1])), np.concatenate((ab[:, 1], ab[:, 0])),
+                                np.concatenate((d, (d + 2 * math.pi) % (2 * math.pi) - math.pi)))  # fmt: skip
+            self._edge_key = key
+        return self._edge_cache
+
+    def predict(self, displacement: np.ndarray) -> np.ndarray:
+        """The belief after the robot moved `displacement` (odometric frame)."""
+        k = len(self.nodes)
+        if k == 0:
+            return self.belief
+        b = self.belief
+        moved = float(np.hypot(*displacement))
+        src, dst, direction = self._edges()
+        dwell = np.array([n.dwell for n in self.nodes])
+        leave = 1.0 / np.maximum(dwell, 1.0) if moved > 0 else np.zeros(k)
+        leave = np.where(np.bincount(src, minlength=k) > 0, leave, 0.0)  # a node without links keeps its belief
+        heading = math.atan2(displacement[1], displacement[0])
+        w = np.exp(self.params.kappa * (np.cos(heading - direction) - 1.0))
+        w = w / np.bincount(src, weights=w, minlength=k)[src]
+        out = b * (1.0 - leave) + np.bincount(dst, weights=b[src] * leave[src] * w, minlength=k)
+        out = (1.0 - self.params.spread) * out + self.params.spread / k
+        return out / out.sum()
+
+    def correct(self, prior: np.ndarray, likelihood: np.ndarray) -> np.ndarray:
+        post = prior * (likelihood + self.params.floor)
+        total = post.sum()
+        return post / total if total > 0 else np.full(len(prior), 1.0 / len(prior))
+
+    def localize(self, observation: Any, displacement: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(likelihood, belief) of every node for an observation made after
+        moving `displacement`: updates the belief, leaves the map unchanged."""
+        likelihood = self.signatures.likelihoods(observation, self.means()) if self.nodes else np.zeros(0)
+        self.likelihood = likelihood
+        if len(self.belief) != len(self.nodes):  # first fix, or the map grew: start from the matching alone
+            self.belief = np.full(len(self.nodes), 1.0 / max(len(self.nodes), 1))
+        self.belief = self.correct(self.predict(displacement), likelihood) if self.nodes else self.belief
+        return likelihood, self.belief
+
+    # ------------------------------------------------------------ mapping
+
+    def observe(self, observation: Any, position: np.ndarray, displacement: np.ndarray) -> int:
+        """Map one observation made at odometric `position` after moving
+        `displacement`: join the current node, close a loop to a known one, or
+        start a new node (steps 1-5 of the paper).  Returns the node it joined."""
+        position = np.asarray(position, np.float64)
+        self.odometer += float(np.hypot(*displacement))
+        if not self.nodes:
+            self.likelihood = np.ones(1)
+            return self._new_node(observation, position)
+        likelihood = self.signatures.likelihoods(observation, self.means())
+        self.likelihood = likelihood
+        if len(self.belief) != len(self.nodes):
+            self.belief = np.eye(len(self.nodes))[self.current]
+        self.belief = self.correct(self.predict(displacement), likelihood)
+        if 1.0 - likelihood[self.current] < self.params.theta:
+            self._join(self.current, observation, position)
+            return self.current
+        others = self.belief.copy()  # the belief given that the robot has left the current node
+        others[self.current] = 0.0
+        best = int(np.argmax(others))
+        share = others[best] / others.sum() if others.sum() > 0 else 0.0
+        if share >= self.params.closure and 1.0 - likelihood[best] < self.params.theta:
+            self.closures += 1
+            self._move(best, observation, position)
+            return best
+        return self._new_node(observation, position)
+
+    def _join(self, i: int, observation: Any, position: np.ndarray) -> None:
+        node = self.nodes[i]
+        node.members = [*node.members, observation][-self.params.keep :]
+        node.position = node.position + (position - node.position) / (node.observations + 1)
+        node.observations += 1
+        node.seen_at.append((float(position[0]), float(position[1]), self.odometer))
+        node.mean = self.signatures.mean(node.members)
+
+    def _link(self, a: int, b: int) -> None:
+        key, sign = ((a, b), 1.0) if a < b else ((b, a), -1.0)
+        d = sign * (self.nodes[b].position - self.nodes[a].position)
+        if key in self.links:
+            link = self.links[key]
+            link.displacement = link.displacement + (d - link.displacement) / (link.count + 1)
+            link.count += 1
+        else:
+            self.links[key] = Link(d)
+
+    def _move(self, i: int, observation: Any, position: np.ndarray) -> None:
+        self._join(i, observation, position)
+        self.nodes[i].visits += 1
+        self._link(self.current, i)
+        self.current = i
+        self.belief = np.eye(len(self.nodes))[i]
+
+    def _new_node(self, observation: Any, position: np.ndarray) -> int:
+        here = (float(position[0]), float(position[1]), self.odometer)
+        self.nodes.append(Node(observation, [observation], position.copy(), seen_at=[here]))
+        i = len(self.nodes) - 1
+        if self.current >= 0:
+            self._link(self.current, i)
+        for j, node in enumerate(self.nodes[:-1]):
+            seen = np.asarray(node.seen_at).reshape(-1, 3)
+            seen = seen[seen[:, 2] >= self.odometer - self.params.recent]
+            if j != self.current and len(seen) and np.hypot(*(seen[:, :2] - position).T).min() <= self.params.near:
+                self._link(j, i)
+        self.current = i
+        self.belief = np.eye(len(self.nodes))[i]
+        return i

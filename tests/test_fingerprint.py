@@ -1,0 +1,356 @@
+"""The fingerprint controller (Tapus et al. 2006): features, circular alignment
+with uncertainty, the generic topological map with Markov localization, and
+the controller on the office floor."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from functools import cache
+
+import numpy as np
+import pytest
+
+from agents.controllers.fingerprint.align import (
+    AlignParams,
+    C,
+    Matcher,
+    N,
+    V,
+    cyclic_cost,
+    cyclic_cost_exact,
+    from_string,  # fmt: skip
+    paper_length,
+    to_string,
+)
+from agents.controllers.fingerprint.features import FeatureParams, camera_features, fingerprint, laser_corners
+from agents.controllers.navigation.topomap import Link, MapParams, TopoMap
+from swarm.scenario import ScenarioError, load_scenario
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "swarm", *args], capture_output=True, text=True, timeout=600)
+
+
+@cache
+def office():
+    return load_scenario("office")
+
+
+def sensed(x: float, y: float, theta: float = 0.0, noise: str = "low"):
+    from swarm.cli_arena import sense
+
+    r = sense(office().with_overrides(noise=noise), (x, y, theta))
+    return fingerprint(np.array(r["camera_rgb"]), np.array(r["camera_range"]), np.array(r["laser"]), 8.0,
+                       FeatureParams())  # fmt: skip
+
+
+# ------------------------------------------------------------------ strings
+
+
+def test_strings_round_trip_in_the_papers_notation():
+    text = "clfvnvcfnvncvnnvcvBnvBccE".replace("l", "L").replace("f", "F")  # the paper's example, hues upper case
+    codes = from_string(text)
+    assert to_string(codes) == text
+    assert paper_length(codes) == len(text)
+    assert (codes == N + 1).sum() == 1 and (codes == N).sum() == 4  # a run "nn" is one symbol of the alignment
+    with pytest.raises(ValueError, match="'x' is not a feature"):
+        from_string("vcx")
+
+
+# ---------------------------------------------------------------- features
+
+
+def test_a_colour_patch_is_a_hue_letter_at_its_bearing_with_edges_on_both_sides():
+    rgb = np.full((360, 3), 200, np.uint8)
+    rgb[85:96] = (0, 0, 255)  # blue, centred on 90 degrees
+    codes, bearings = camera_features(rgb, np.full(360, 3.0), FeatureParams())
+    hue = codes[codes < V]
+    assert len(hue) == 1 and to_string(hue) == "K"  # blue's hue 240 deg, bin 10 of 16
+    assert math.degrees(bearings[codes < V][0]) == pytest.approx(90, abs=1)
+    edges = np.degrees(bearings[codes == V])
+    assert sorted(edges) == pytest.approx([84.5, 95.5])  # the boundaries between 84|85 and 95|96
+
+
+def test_the_laser_sees_the_four_corners_of_a_square_room():
+    beams = 360
+    angle = np.arange(beams) * 2 * math.pi / beams
+    half = 2.0  # a 4 m square room, the robot at its centre
+    ranges = half / np.maximum(np.abs(np.cos(angle)), np.abs(np.sin(angle)))
+    corners = np.degrees(laser_corners(ranges, 8.0, FeatureParams()))
+    assert len(corners) == 4
+    assert sorted(np.round(corners) % 360) == [45, 135, 225, 315]
+
+
+def test_a_real_fingerprint_has_every_kind_of_feature():
+    f = sensed(2.0, 9.0)
+    text = str(f)
+    assert {"v", "c", "n"} <= set(text) and any(ch.isupper() for ch in text)
+    assert 15 <= f.length <= 80
+
+
+# ---------------------------------------------------------------- matching
+
+
+def test_a_fingerprint_matches_itself_at_every_rotation():
+    m = Matcher()
+    for f in (sensed(2.0, 9.0), sensed(6.0, 3.0, 1.0), sensed(20.0, 6.0)):
+        for r in range(len(f.codes)):
+            rotated = np.roll(f.codes, r)
+            assert m.cost(f.codes, rotated) == 0.0
+            assert m.cost(f.codes, rotated, exact=True) == 0.0
+            assert m.probability(f.codes, rotated) > 0.98
+
+
+def test_one_missing_feature_costs_less_than_one_wrong_feature():
+    m = Matcher()
+    f = sensed(10.0, 9.4).codes
+    for k in np.flatnonzero(f < N):  # every feature in turn
+        missing = np.delete(f, k)
+        wrong = f.copy()
+        wrong[k] = C if f[k] != C else V
+        assert m.cost(f, missing, exact=True) < m.cost(f, wrong, exact=True)
+
+
+def test_a_place_seen_from_nearby_matches_it_better_than_another_place():
+    m = Matcher()
+    here = sensed(2.0, 9.0)
+    near = sensed(2.2, 9.3, 0.6)  # 36 cm away, turned 34 degrees
+    for other in (sensed(6.0, 2.6), sensed(10.0, 9.4), sensed(14.0, 6.0)):  # another room, a room alike, the corridor
+        assert m.probability(here.codes, near.codes) > m.probability(here.codes, other.codes)
+    assert m.probability(here.codes, near.codes) > 0.5 > m.probability(here.codes, sensed(10.0, 9.4).codes)
+
+
+def test_the_one_pass_kernel_is_a_real_alignment_and_exact_on_neighbouring_places():
+    """Never below the exact minimum over rotations (it is the cost of one
+    rotation's alignment), and equal to it for fingerprints of one place."""
+    m = Matcher()
+    prints = [sensed(2.0 + 0.1 * k, 8.5 + 0.1 * k, 0.3 * k) for k in range(6)]
+    prints += [sensed(6.0, 3.0), sensed(22.0, 6.0)]
+    equal = 0
+    for a in prints:
+        for b in prints:
+            fast = cyclic_cost(a.codes, b.codes, m.sub, m.gap)
+            exact = cyclic_cost_exact(a.codes, b.codes, m.sub, m.gap)
+            assert fast >= exact
+            equal += fast == exact
+    near = [(a, b) for a in prints[:6] for b in prints[:6]]
+    near_equal = sum(cyclic_cost(a.codes, b.codes, m.sub, m.gap) == cyclic_cost_exact(a.codes, b.codes, m.sub, m.gap)
+                     for a, b in near)  # fmt: skip
+    assert near_equal >= 0.8 * len(near)
+
+
+def test_localizing_against_a_packed_map_equals_matching_node_by_node():
+    from agents.controllers.fingerprint.signatures import pack
+
+    m = Matcher()
+    nodes = [sensed(x, y) for x, y in ((2, 9), (6, 3), (10, 9.4), (14, 6), (26, 8))]
+    query = sensed(2.1, 9.2, 0.4)
+    packed = m.against(query.codes, *pack([f.codes for f in nodes]))
+    one_by_one = [m.probability(query.codes, f.codes) for f in nodes]
+    assert packed == pytest.approx(one_by_one)
+    assert int(np.argmax(packed)) == 0
+
+
+def test_the_probability_calibration_recovers_a_known_logistic():
+    from swarm.arena.fingerprint import fit_logistic
+
+    rng = np.random.default_rng(3)
+    d = rng.uniform(0, 1.0, 20000)  # classes about equally common, as the fit weighs them
+    same = rng.uniform(size=d.size) < 1 / (1 + np.exp((d - 0.5) / 0.1))
+    centre, width = fit_logistic(d, same)
+    assert centre == pytest.approx(0.5, abs=0.03) and width == pytest.approx(0.1, abs=0.02)
+
+
+def test_align_params_refuse_unknown_fields():
+    with pytest.raises(ValueError, match="unknown field 'gap'"):
+        AlignParams.from_table({"gap": 1})
+
+
+# ------------------------------------------------------------ topological map
+
+
+class Labels:
+    """A toy place signature: an observation is a place label, seen right with
+    probability 0.7, else as a look-alike (the labels 'a' and 'b' alias)."""
+
+    def likelihoods(self, observation, means):
+        return np.array([0.9 if observation == m else (0.6 if {observation, m} == {"a", "b"} else 0.05)
+                         for m in means])  # fmt: skip
+
+    def mean(self, members):
+        values, counts = np.unique(members, return_counts=True)
+        return str(values[np.argmax(counts)])
+
+
+def corridor_map() -> TopoMap:
+    """Places a, x, b, y along a line, 2 m apart, three observations each."""
+    m = TopoMap(Labels(), MapParams(theta=0.3))
+    pos = 0.0
+    for label in "axby":
+        for _ in range(3):
+            m.observe(label, np.array([pos, 0.0]), np.array([0.5, 0.0]))
+            pos += 0.5
+        pos += 0.5
+    return m
+
+
+def test_mapping_makes_one_node_per_place_with_odometry_links():
+    m = corridor_map()
+    assert [n.mean for n in m.nodes] == list("axby")
+    assert set(m.links) == {(0, 1), (1, 2), (2, 3)}
+    link = m.links[(1, 2)]
+    # from the first node's centre when it was left (0.5) to where the robot entered the next (2.0)
+    assert link.distance == pytest.approx(1.5) and link.direction == pytest.approx(0.0)
+    assert m.route(0, 3) == [0, 1, 2, 3] and m.route(3, 0) == [3, 2, 1, 0]
+
+
+def test_the_markov_filter_tells_apart_places_that_look_alike():
+    """'a' and 'b' look alike: matching alone cannot say which; the belief,
+    carried along the links by odometry, can."""
+    m = corridor_map()
+    m.belief = np.eye(4)[0]  # known start: at a
+    walk = [("a", 0.0), ("x", 2.0), ("b", 2.0), ("b", 0.5)]
+    for label, moved in walk:
+        for _ in range(2 if moved else 1):
+            like, belief = m.localize(label, np.array([moved / 2 if moved else 0.0, 0.0]))
+    assert like[0] == 0.6 and like[2] == 0.9  # matching alone: b over a, but not by much
+    assert int(np.argmax(belief)) == 2 and belief[2] > 0.8  # the filter: b, surely
+
+
+def test_a_loop_is_closed_through_localization():
+    m = corridor_map()
+    nodes = len(m.nodes)
+    # back the way it came: y, b, x, a again
+    for label in "ybxa":
+        for _ in range(3):
+            m.observe(label, np.array([0.0, 0.0]), np.array([-0.5, 0.0]))
+    assert len(m.nodes) == nodes  # no place added twice
+    assert m.closures >= 3
+
+
+def test_a_link_keeps_the_mean_of_the_displacements_it_was_driven_with():
+    m = corridor_map()
+    m._link(0, 1)  # driven again between the nodes' centres (0.5 and 2.5): the mean of 1.5 and 2.0
+    assert m.links[(0, 1)].count == 2
+    assert m.links[(0, 1)].distance == pytest.approx(1.75)
+    assert isinstance(m.links[(0, 1)], Link)
+    assert m.route(0, 0) == [0]
+
+
+# --------------------------------------------------------------- controller
+
+
+@cache
+def mapping_tour():
+    from swarm.arena.fingerprint import drive_tour, tour_scenario
+
+    s = tour_scenario("office", "mapping", "low", 0)
+    return s, drive_tour(s)
+
+
+def test_the_mapping_tour_takes_about_500_fingerprints_and_maps_every_place_it_passes():
+    from swarm.arena.fingerprint import judge_map, places
+
+    s, run = mapping_tour()
+    judged = judge_map(run, places(s))
+    assert run["finished"]
+    assert 450 <= judged["fingerprints"] <= 530  # the paper: 500 over 75 m
+    assert judged["places_with_node"] == judged["places_visited"] == 12
+    assert 12 <= judged["nodes"] <= 30  # the paper: 20 on its floor
+    assert judged["purity"] > 0.65
+
+
+def test_localization_on_the_second_tour_beats_matching_alone_and_chance():
+    from swarm.arena.fingerprint import localize_job
+
+    row = localize_job(("office", "low", 0))
+    assert row["fingerprints"] >= 1000 and row["on_map"] >= 900
+    assert row["match_correct"] > 5 * row["chance"]  # matching alone well above chance
+    assert row["markov_correct"] > row["match_correct"] + 0.03  # the filter clearly above matching alone
+
+
+def test_a_restored_controller_goes_on_exactly_as_the_one_it_was_taken_from():
+    from swarm.arena.engine import ArenaEngine
+    from swarm.arena.fingerprint import tour_scenario
+    from swarm.arena.scenario import controller_params
+
+    s = tour_scenario("office", "mapping", "low", 0)
+    a = ArenaEngine(s)
+    a.step(400)
+    state = json.loads(json.dumps(a.controllers[0].snapshot()))  # plain data: it can be saved and sent
+    b = ArenaEngine(s)
+    b.world.restore(a.world.snapshot())
+    c = b.controllers[0]
+    c.reset(s.seed, 0, controller_params(s, 0))
+    c.restore(state)
+    a.step(300)
+    b.step(300)
+    ra, rb = a.controllers[0], b.controllers[0]
+    assert ra.log == rb.log
+    assert [to_string(n.mean.codes) for n in ra.map.nodes] == [to_string(n.mean.codes) for n in rb.map.nodes]
+    assert np.array_equal(ra.map.belief, rb.map.belief)
+
+
+def test_localize_mode_needs_a_map_and_says_so():
+    from swarm.arena.engine import ArenaEngine
+    from swarm.arena.fingerprint import tour_scenario
+
+    with pytest.raises(ValueError, match="needs a map"):
+        ArenaEngine(tour_scenario("office", "mapping", "low", 0, {"mode": "localize"}))
+
+
+def test_a_malformed_map_is_refused_in_one_line():
+    from agents.controllers.fingerprint.signatures import FingerprintSignatures, map_from_data
+
+    with pytest.raises(ValueError, match="malformed"):
+        map_from_data({"nodes": [{"mean": "x"}], "links": []}, FingerprintSignatures(Matcher()), MapParams())
+
+
+def test_a_bad_fingerprint_table_names_the_field(tmp_path):
+    from swarm.scenario import BUNDLED_DIR
+
+    path = tmp_path / "office.toml"
+
+    path.write_text((BUNDLED_DIR / "office.toml").read_text() + "\n[fingerprint]\nspacing = 0.1\ntheta = 3\n")
+    r = run_cli("run", str(path), "--controller", "fingerprint", "--max-ticks", "5")
+    assert r.returncode == 2
+    assert "0 < theta < 1" in r.stderr and "Traceback" not in r.stderr
+    with pytest.raises(ScenarioError):
+        load_scenario(str(tmp_path / "missing.toml"))
+
+
+def test_swarm_run_office_with_the_fingerprint_controller_prints_its_map():
+    r = run_cli("run", "office", "--controller", "fingerprint", "--max-ticks", "300")
+    assert r.returncode in (0, 1), r.stderr
+    assert "map:" in r.stdout and "fingerprints" in r.stdout and "nodes" in r.stdout
+
+
+def test_the_recording_holds_the_map_as_graph_nodes_and_edges(tmp_path):
+    from swarm.arena.engine import ArenaEngine
+    from swarm.arena.fingerprint import tour_scenario
+    from swarm.recording_arena import ArenaRecorder
+
+    s = tour_scenario("office", "mapping", "low", 0)
+    engine = ArenaEngine(s)
+    path = tmp_path / "fp.rrd"
+    rec = ArenaRecorder(path, engine.world, {"run_id": "fp", "runtime": "in-process"}, controllers=engine.controllers)
+    engine.step(600, rec)
+    rec.close()
+    from rerun.chunk import RrdReader
+
+    entities = {c.entity_path.lstrip("/") for c in RrdReader(path).stream()}
+    assert {"map/0", "map/0/belief", "map/0/fingerprint", "world/map/0/nodes", "world/map/0/links"} <= entities
+
+
+def test_the_matching_probability_is_calibrated_as_the_defaults_say():
+    """`swarm experiment fingerprint-calibrate` fits the defaults of AlignParams."""
+    from swarm.arena.fingerprint import calibration_pairs, fit_logistic
+
+    d, same = calibration_pairs("office", "low", 0)
+    centre, width = fit_logistic(d, same)
+    p = AlignParams()
+    assert centre == pytest.approx(p.centre, abs=0.01) and width == pytest.approx(p.width, abs=0.01)
+    assert np.median(d[same]) < p.centre < np.median(d[~same])
