@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from agents.controllers.arena import make_controller
+from agents.controllers.arena import deliver, make_controller, publications
 from agents.runtime import AgentRuntime
 from swarm import protocol as proto
 from swarm import protocol_arena as arena_proto
@@ -22,6 +22,7 @@ class ArenaAgentRuntime(AgentRuntime):
     def _prepare(self, count: int) -> None:
         self.brains: list = [None] * count
         self.sent_plans: dict[int, tuple] = {}  # agent -> (length, first, last point) of the last plan sent
+        self.refused_shared = 0  # other robots' publications this process's controllers refused
 
     def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
         brain = make_controller(msg.get("controller", self.controller))
@@ -33,13 +34,17 @@ class ArenaAgentRuntime(AgentRuntime):
 
     def _answer(self, obs: arena_proto.ArenaObs) -> int:
         agents, wheels = [], []
+        mine = [(a, self.brains[self.slot_of[a]]) for a in obs.agents.tolist() if a in self.slot_of]
+        if obs.shared and not self.null:  # what every robot published last tick, before this tick's step
+            self.refused_shared += deliver([b for _, b in mine], [a for a, _ in mine], list(obs.shared))
         for agent, reading in zip(obs.agents.tolist(), obs.perceptions, strict=True):
             slot = self.slot_of.get(agent)
             if slot is None:
                 continue
             agents.append(agent)
             wheels.append(np.zeros(2) if self.null else self.brains[slot].step(reading))
-        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 2))
+        shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
+        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 2), shared)
         self.act_publisher.put(payload)
         if not self.null:
             self._send_plans(obs.tick, agents)

@@ -22,7 +22,7 @@ from swarm.errors import RecordingError, RunError, raise_interrupt
 from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
 
 CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
-FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize")
+FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize", "fingerprint-together")
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -478,6 +478,15 @@ def cmd_report(args) -> int:
 
 
 def cmd_experiment(args) -> int:
+    if args.name == "fingerprint-together":
+        if args.scenario:
+            raise ScenarioError("command line", "--scenario", "fingerprint-together surveys office")
+        from swarm.arena.fingerprint_team import run_team_experiment
+
+        result = run_team_experiment(args.reps, args.jobs, args.seed, args.out)
+        print(result["markdown"])
+        print(f"wrote {result['out']}/runs.csv, table.md, plot.png")
+        return 0
     if args.name in FINGERPRINT_EXPERIMENTS:
         from swarm.arena.fingerprint import run_fingerprint_experiment
 

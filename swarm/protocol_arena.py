@@ -2,7 +2,12 @@
 
     obs/<group>   world -> agent process: for one tick, every agent's sensor
                   readings, each array as [dtype, shape, little-endian bytes]
-    act/<group>   agent process -> world: their wheel speeds (K x 2 float64, m/s)
+    act/<group>   agent process -> world: their wheel speeds (K x 2 float64, m/s), and what
+                  their controllers publish to a shared key space this tick (`shared`:
+                  [agent, share, msgpack payload], opaque to the world); the world puts each
+                  on <share>/<agent> and hands them to every agent process with the next
+                  tick's observations (`shared` there too), so in lock-step every robot reads
+                  tick t's writes at tick t + 1, as in the in-process engine
     plans/<group> agent process -> world: one agent's planned path (P x 2 float64, m), once
                   per new plan, at most MAX_PLAN_POINTS points (the recording's, not the controller's)
 
@@ -35,11 +40,16 @@ MAX_SENSORS, MAX_DIMS = 32, 4
 MAX_PLAN_POINTS = 2000  # 32 KB: a plan message stays under the world's message limit
 
 
+MAX_SHARED = 4 * 1024 * 1024  # bytes of shared payloads in one message
+Shared = list[tuple[int, str, bytes]]  # (agent, share, payload)
+
+
 @dataclass(frozen=True)
 class ArenaObs:
     tick: int
     agents: np.ndarray  # (K,)
     perceptions: list[dict[str, np.ndarray]]
+    shared: Shared = ()  # what every robot published last tick
 
 
 @dataclass(frozen=True)
@@ -47,6 +57,28 @@ class ArenaActs:
     tick: int
     agents: np.ndarray  # (K,)
     wheels: np.ndarray  # (K, 2), not yet judged
+    shared: Shared = ()  # what these agents publish this tick, not yet judged
+
+
+def _shared_field(shared: Shared) -> list:
+    return [[int(a), str(s), bytes(p)] for a, s, p in shared]
+
+
+def parse_shared(raw) -> Shared | Rejected:
+    if raw is None:
+        return []
+    if not isinstance(raw, list):
+        return Rejected("shared: expected a list of [agent, share, bytes]")
+    out, total = [], 0
+    for item in raw:
+        if not (isinstance(item, list) and len(item) == 3 and isinstance(item[0], int) and not isinstance(item[0], bool)
+                and isinstance(item[1], str) and isinstance(item[2], bytes)):  # fmt: skip
+            return Rejected("shared: expected [agent, share, bytes]")
+        total += len(item[2])
+        if total > MAX_SHARED:
+            return Rejected(f"shared: more than {MAX_SHARED} bytes")
+        out.append((item[0], item[1], item[2]))
+    return out
 
 
 def _encode(value) -> list:
@@ -58,14 +90,20 @@ def _encode(value) -> list:
     return [kind, list(a.shape), np.ascontiguousarray(a, dtype=DTYPES[kind]).astype(kind).tobytes()]
 
 
-def observations(tick: int, agents, perceptions: list[dict[str, np.ndarray]]) -> bytes:
-    return pack({"type": "obs", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
-                 "perceptions": [{k: _encode(v) for k, v in p.items()} for p in perceptions]})  # fmt: skip
+def observations(tick: int, agents, perceptions: list[dict[str, np.ndarray]], shared: Shared = ()) -> bytes:
+    m = {"type": "obs", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
+         "perceptions": [{k: _encode(v) for k, v in p.items()} for p in perceptions]}  # fmt: skip
+    if shared:
+        m["shared"] = _shared_field(shared)
+    return pack(m)
 
 
-def actions(tick: int, agents, wheels: np.ndarray) -> bytes:
-    return pack({"type": "act", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
-                 "wheels": np.asarray(wheels, np.float64).astype("<f8").tobytes()})  # fmt: skip
+def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = ()) -> bytes:
+    m = {"type": "act", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
+         "wheels": np.asarray(wheels, np.float64).astype("<f8").tobytes()}  # fmt: skip
+    if shared:
+        m["shared"] = _shared_field(shared)
+    return pack(m)
 
 
 def _decode(entry) -> np.ndarray | Rejected:
@@ -102,7 +140,10 @@ def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
         if bad := first_rejection(*decoded.values()):
             return bad
         perceptions.append(decoded)
-    return ArenaObs(tick, agents, perceptions)
+    shared = parse_shared(m.get("shared"))
+    if isinstance(shared, Rejected):
+        return shared
+    return ArenaObs(tick, agents, perceptions, shared)
 
 
 def parse_acts(data: bytes) -> ArenaActs | Rejected:
@@ -116,7 +157,11 @@ def parse_acts(data: bytes) -> ArenaActs | Rejected:
     raw = m.get("wheels")
     if not isinstance(raw, bytes) or len(raw) != 16 * len(agents):
         return Rejected(f"wheels: expected {len(agents)}x2 binary float64")
-    return ArenaActs(tick, agents, np.frombuffer(raw, dtype="<f8").reshape(len(agents), 2).astype(np.float64))
+    shared = parse_shared(m.get("shared"))
+    if isinstance(shared, Rejected):
+        return shared
+    wheels = np.frombuffer(raw, dtype="<f8").reshape(len(agents), 2).astype(np.float64)
+    return ArenaActs(tick, agents, wheels, shared)
 
 
 @dataclass(frozen=True)

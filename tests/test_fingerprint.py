@@ -354,3 +354,118 @@ def test_the_matching_probability_is_calibrated_as_the_defaults_say():
     p = AlignParams()
     assert centre == pytest.approx(p.centre, abs=0.01) and width == pytest.approx(p.width, abs=0.01)
     assert np.median(d[same]) < p.centre < np.median(d[~same])
+
+
+# ---------------------------------------------------------- mapping together
+
+
+def shared_pair():
+    from agents.controllers.navigation.mapshare import SharedMap
+
+    def ident(x):
+        return x
+
+    return [SharedMap(TopoMap(Labels(), MapParams(theta=0.3)), k, ident, ident) for k in (0, 1)]
+
+
+def walk(m, labels: str, start: float = 0.0) -> None:
+    pos = start
+    for label in labels:
+        for _ in range(3):
+            m.observe(label, np.array([pos, 0.0]), np.array([0.5, 0.0]))
+            pos += 0.5
+        pos += 0.5
+
+
+def test_robots_merge_each_others_places_one_node_per_place():
+    a, b = shared_pair()
+    walk(a.map, "ax")  # robot 0 maps a, x
+    walk(b.map, "xby", start=10.0)  # robot 1 maps x (the same place), b, y
+    b.receive(1, a.publish())  # its own publication is ignored
+    a.receive(1, json.loads(json.dumps(b.publish())))  # plain data, as over the wire
+    assert [n.mean for n in a.map.nodes] == list("axby")  # robot 1's x is robot 0's x: merged, not added
+    assert a.merged == 1 and a.added == 2
+    x, b_, y = a.local[(1, 0)], a.local[(1, 1)], a.local[(1, 2)]
+    assert x == 1 and {(x, b_), (b_, y)} <= set(a.map.links)  # robot 1's links came over through the alias
+    assert a.publish()["nodes"] == []  # nothing of its own changed: it sends no one else's nodes
+    a.map.observe("b", np.array([30.0, 0.0]), np.array([0.5, 0.0]))  # robot 0 now at b (a loop into robot 1's node)
+    a.adopt(a.map.current)
+    assert a.map.current == b_ and b_ in a.adopted
+
+
+def test_a_malformed_map_from_another_robot_is_refused_and_merges_nothing():
+    a, b = shared_pair()
+    walk(b.map, "xb")
+    good = b.publish()
+    for bad in ({"nodes": "x"}, {"nodes": [[0, "a", [1.0], 1, 1]], "links": []},
+                {"nodes": [[0, "a", [0.0, float("nan")], 1, 1]], "links": []},
+                {**good, "links": [[1, 0, 1, 1, 0.5, "x", 1]]}):  # fmt: skip
+        with pytest.raises(ValueError, match="a map from agent 1: malformed"):
+            a.receive(1, bad)
+    assert a.map.nodes == []
+    from agents.controllers.arena import deliver
+    from swarm.protocol import pack
+
+    class Robot:
+        shares = "map"
+
+        def __init__(self, shared):
+            self.shared = shared
+
+        def receive(self, sender, data):
+            self.shared.receive(sender, data)
+
+    robots = [Robot(a), Robot(b)]
+    refused = deliver(
+        robots, [0, 1], [(1, "map", b"\xc1garbage"), (1, "map", pack({"nodes": 1})), (1, "map", pack(good))]
+    )
+    assert refused == 2 and len(a.map.nodes) == 2
+
+
+def test_shared_items_on_the_wire_are_checked():
+    from swarm import protocol_arena as arena_proto
+    from swarm.protocol import Rejected
+
+    msg = arena_proto.parse_acts(arena_proto.actions(3, [0], np.zeros((1, 2)), [(0, "map", b"x")]))
+    assert msg.shared == [(0, "map", b"x")]
+    for bad in ("x", [[0, "map"]], [[True, "map", b""]], [[0, 1, b""]], [[0, "map", "text"]]):
+        assert isinstance(arena_proto.parse_shared(bad), Rejected)
+
+
+@pytest.mark.parametrize(("processes", "per_process"), [(2, 1), (1, 2)])
+def test_mapping_together_lockstep_equals_in_process(processes, per_process):
+    from swarm import protocol as proto
+    from swarm.arena.engine import ArenaEngine
+    from swarm.arena.fingerprint_team import team_scenario
+    from swarm.bus import open_client
+    from tests.distributed import run_world
+
+    scenario = team_scenario(2, "low", 0).with_overrides(max_ticks=400)
+    engine = ArenaEngine(scenario)
+    expected = engine.run()
+    assert engine.controllers[0].shared.added > 0  # robot 0 has robot 1's places by then
+    held: dict[int, list] = {}
+
+    def read_key_space(endpoint, keys):  # any client can get what the robots wrote
+        import time
+
+        session = open_client(endpoint)
+        try:
+            for _ in range(300):
+                for reply in session.get(f"{keys.prefix}/map/**", timeout=2.0):
+                    if reply.ok is not None:
+                        m = proto.unpack(reply.ok.payload.to_bytes(), 1 << 26)
+                        held[m["agent"]] = m["updates"]
+                if len(held) == 2:
+                    return
+                time.sleep(0.1)
+        finally:
+            session.close()
+
+    run_id = f"fp-team-{processes}"
+    summary, world = run_world(scenario, run_id, [("fingerprint", processes, per_process)], read_key_space,
+                               deadline=20.0)  # fmt: skip
+    np.testing.assert_array_equal(world.pose, engine.world.pose)
+    assert [r["shared"] for r in summary["robots"]] == [r["shared"] for r in expected["robots"]]
+    assert summary["rejected_messages"] == 0
+    assert set(held) == {0, 1} and all(held.values())

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from agents.controllers.arena import SHARES, ShareLog
 from swarm import protocol as proto
 from swarm import protocol_arena as arena_proto
 from swarm.arena.engine import arena_summary
@@ -36,6 +37,10 @@ class ArenaServer(WorldServer):
         self.wheels = np.zeros((self.world.n, 2))
         self.ok = np.zeros(self.world.n, np.bool_)
         self.readings: list[dict[str, np.ndarray]] = []
+        self.pending_shared: dict[int, tuple[str, bytes]] = {}  # this tick's publications, by agent
+        self.shared_out: list[tuple[int, str, bytes]] = []  # last tick's, going out with this tick's observations
+        self.shared_history: dict[tuple[str, int], list[bytes]] = {}  # every publication, for `get <share>/**`
+        self.shares = ShareLog()
         self.state_file = Path(self.state_dir) / f"{self.keys.run}.arena.npz" if self.state_dir else None
 
     # ------------------------------------------------------------ persistence
@@ -69,9 +74,16 @@ class ArenaServer(WorldServer):
                             {"scenario": self.scenario.describe(), "stats": stats})  # fmt: skip
 
     def _declare_shared(self, put) -> list:
-        return [self.session.declare_subscriber(self.keys.plans, lambda s: put(("plan", s)))]
+        out = [self.session.declare_subscriber(self.keys.plans, lambda s: put(("plan", s)))]
+        for share in sorted({SHARES[c] for c in set(self.controllers.tolist()) if c in SHARES}):
+            out.append(self.session.declare_queryable(f"{self.keys.prefix}/{share}/**",
+                                                      lambda q, share=share: put(("shared?", (share, q)))))  # fmt: skip
+        return out
 
     def _handle_shared(self, kind: str, item) -> None:
+        if kind == "shared?":
+            self._on_shared_query(*item)
+            return
         if kind != "plan":
             return
         received = self._receive(item, arena_proto.parse_plan, "plan")
@@ -121,12 +133,13 @@ class ArenaServer(WorldServer):
         self.world.enter(np.flatnonzero(self.slots == ACTIVE))  # late joiners come in beside the others
         self.ok[:] = False
         self.wheels[:] = 0.0
+        self._pass_on_shared()
         if not self.null:
             self.readings = self.world.perceive()
 
     def _observe(self, tick: int, agents: np.ndarray) -> bytes:
         readings = [{} for _ in agents] if self.null else [self.readings[a] for a in agents]
-        return arena_proto.observations(tick, agents, readings)
+        return arena_proto.observations(tick, agents, readings, self.shared_out)
 
     def _on_act(self, sample) -> None:
         received = self._receive(sample, arena_proto.parse_acts, "act")
@@ -142,6 +155,39 @@ class ArenaServer(WorldServer):
                 self.wheels[a] = wheels
                 self.ok[a] = True
                 self.acted[a] = True
+        if msg.shared:
+            self._take_shared(msg, group)
+
+    def _take_shared(self, msg, group: str) -> None:
+        """Publications of agents whose action this tick was taken; the rest is counted and dropped."""
+        for a, share, payload in msg.shared:
+            if not (0 <= a < len(self.slots)) or self.group_of.get(a) != group or a not in set(msg.agents.tolist()):
+                self.stats.reject("shared: names an agent of another process")
+            elif share != SHARES.get(str(self.controllers[a])):
+                self.stats.reject("shared: not this controller's key space")
+            elif not self.acted[a]:
+                self.stats.reject("shared: its agent's action was refused")
+            else:
+                self.pending_shared[a] = (share, payload)
+
+    def _pass_on_shared(self) -> None:
+        """Last tick's publications: on their keys, and out with this tick's observations."""
+        self.shared_out = [(a, *self.pending_shared[a]) for a in sorted(self.pending_shared)]
+        self.pending_shared = {}
+        if self.shared_out:
+            self.shares.add(self.tick - 1, self.shared_out)
+        for a, share, payload in self.shared_out:
+            self.shared_history.setdefault((share, a), []).append(payload)
+            self.session.put(f"{self.keys.prefix}/{share}/{a}", payload)
+
+    def _on_shared_query(self, share: str, query) -> None:
+        """Every publication of every agent in the key space, one reply per agent."""
+        try:
+            for (s, a), history in sorted(self.shared_history.items()):
+                if s == share:
+                    query.reply(f"{self.keys.prefix}/{share}/{a}", proto.pack({"agent": a, "updates": history}))
+        finally:
+            query.drop()
 
     def _resolve(self, tick: int) -> None:
         self.world.apply(self.wheels, self.ok)
@@ -159,4 +205,7 @@ class ArenaServer(WorldServer):
         out = arena_summary(self.world, 0.0, "distributed")
         for key in ("wall_seconds", "ticks_per_second"):  # the runtime's own, below
             out.pop(key)
+        for robot in out["robots"]:
+            if (shared := self.shares.of(robot["agent"])) is not None:
+                robot["shared"] = shared
         return {**out, "until": self.until}

@@ -12,6 +12,7 @@ process holds K.
 
 from __future__ import annotations
 
+import hashlib
 import importlib
 from typing import Any, Protocol
 
@@ -29,6 +30,10 @@ TABLES = {
     "wander": "agents.controllers.wander.controller:WanderParams.from_table",
     "fingerprint": "agents.controllers.fingerprint.controller:check_table",
 }
+# Controllers that write a shared key space (swarm/<run>/<share>/<agent>), and which: what one robot
+# publishes at tick t every other robot of the same share receives before it steps tick t + 1.
+SHARES = {"fingerprint": "map"}
+MAX_SHARE_BYTES = 4 * 1024 * 1024
 # What a controller needs its robot to sense (checked when a scenario is loaded).
 REQUIRES = {"carrot": ("position", "compass"), "wander": (), "fingerprint": ("camera", "laser", "odometry", "compass")}
 
@@ -57,3 +62,60 @@ def check_table(name: str, table: dict[str, Any]) -> None:
 def make_controller(name: str) -> ArenaController:
     module, cls = REGISTRY[name].split(":")
     return getattr(importlib.import_module(module), cls)()
+
+
+def publications(controllers, agents) -> list[tuple[int, str, bytes]]:
+    """(agent, share, msgpack payload) of every controller that has something to publish, in agent order."""
+    from swarm.protocol import pack
+
+    out = []
+    for a, c in zip(agents, controllers, strict=True):
+        share = getattr(c, "shares", None)
+        if share and (data := c.publish()) is not None:
+            out.append((int(a), share, pack(data)))
+    return out
+
+
+def deliver(controllers, agents, shared: list[tuple[int, str, bytes]]) -> int:
+    """Hand every controller what the others of its share published (not its own), in agent order.
+    Returns the payloads refused (undecodable or malformed: counted, nothing of them merged)."""
+    from swarm.protocol import Rejected, unpack
+
+    refused = 0
+    for a, c in zip(agents, controllers, strict=True):
+        share = getattr(c, "shares", None)
+        if not share:
+            continue
+        for sender, s, payload in shared:
+            if s != share or sender == a:
+                continue
+            data = unpack(payload, MAX_SHARE_BYTES)
+            if isinstance(data, Rejected):
+                refused += 1
+                continue
+            try:
+                c.receive(sender, data)
+            except ValueError:
+                refused += 1
+    return refused
+
+
+class ShareLog:
+    """Per agent, how many publications and a digest of them in order: equal in
+    both runtimes when every robot published the same bytes at the same ticks."""
+
+    def __init__(self) -> None:
+        self.count: dict[int, int] = {}
+        self.hash: dict[int, Any] = {}
+
+    def add(self, tick: int, shared: list[tuple[int, str, bytes]]) -> None:
+        for a, share, payload in shared:
+            h = self.hash.setdefault(a, hashlib.sha1())
+            h.update(f"{tick}:{share}:{len(payload)}:".encode())
+            h.update(payload)
+            self.count[a] = self.count.get(a, 0) + 1
+
+    def of(self, agent: int) -> dict[str, Any] | None:
+        if agent not in self.count:
+            return None
+        return {"messages": self.count[agent], "digest": self.hash[agent].hexdigest()[:16]}

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from agents.controllers.arena import make_controller
+from agents.controllers.arena import ShareLog, deliver, make_controller, publications
 from agents.controllers.navigation.astar import Planner
 from swarm.arena.scenario import ArenaScenario, controller_params
 from swarm.stepper import step_world
@@ -61,6 +61,9 @@ class ArenaEngine:
             self.controllers.append(c)
         self.wall_seconds = 0.0
         self.actions = np.zeros((self.world.n, 2))
+        self.agent_ids = list(range(len(self.controllers)))
+        self.shares = ShareLog()
+        self.refused_shared = 0
 
     @property
     def tick(self) -> int:
@@ -76,6 +79,10 @@ class ArenaEngine:
         def decide(perceptions, tick: int) -> np.ndarray:
             for a, (c, p) in enumerate(zip(self.controllers, perceptions, strict=True)):
                 self.actions[a] = c.step(p)
+            shared = publications(self.controllers, self.agent_ids)
+            if shared:  # what each wrote this tick, every other robot of its share reads before the next
+                self.shares.add(tick, shared)
+                self.refused_shared += deliver(self.controllers, self.agent_ids, shared)
             return self.actions
 
         def record() -> None:
@@ -108,6 +115,9 @@ class ArenaEngine:
         for robot, c in zip(out["robots"], self.controllers, strict=True):
             if hasattr(c, "summary"):  # what a controller learned (a map), beside what its body did
                 robot.update(c.summary())
+            if (shared := self.shares.of(robot["agent"])) is not None:
+                robot["shared"] = shared
+        out["rejected_shared"] = self.refused_shared
         return out
 
 

@@ -18,7 +18,14 @@ import numpy as np
 
 from agents.controllers.fingerprint.align import AlignParams, Matcher
 from agents.controllers.fingerprint.features import FeatureParams, Fingerprint, fingerprint
-from agents.controllers.fingerprint.signatures import FingerprintSignatures, map_from_data, map_to_data
+from agents.controllers.fingerprint.signatures import (
+    FingerprintSignatures,
+    fingerprint_data,
+    fingerprint_from_data,
+    map_from_data,  # fmt: skip
+    map_to_data,
+)
+from agents.controllers.navigation.mapshare import SharedMap
 from agents.controllers.navigation.topomap import MapParams, TopoMap
 
 DRIVES = ("route", "explore")
@@ -72,6 +79,7 @@ def _plain(value: Any) -> Any:
 
 class FingerprintController:
     keeps_map = True  # the recorder draws its topological map
+    shares = "map"  # it publishes its map to swarm/<run>/map/<agent> and merges the others' (mapshare.py)
 
     def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
         table = params.get("fingerprint") or {}
@@ -98,6 +106,8 @@ class FingerprintController:
 
             self.driver = WanderController()
         self.driver.reset(seed, agent, params)
+        self.agent = agent
+        self.shared = SharedMap(self.map, agent, fingerprint_data, fingerprint_from_data)
         self.laser_range = float(params["robot"].get("laser_range") or 8.0)
         self.tick = 0
         self.position = np.zeros(2)  # odometric frame
@@ -136,6 +146,7 @@ class FingerprintController:
         self.last_position = self.position.copy()
         if self.p.mode == "map":
             self.believed = self.map.observe(self.current, self.position, moved)
+            self.shared.adopt(self.believed)
             likelihood = self.map.likelihood
         else:
             likelihood, belief = self.map.localize(self.current, moved)
@@ -143,24 +154,35 @@ class FingerprintController:
         self.matched = int(np.argmax(likelihood)) if len(likelihood) else self.believed
         self.log.append((self.tick, self.believed, self.matched, len(self.map.nodes)))
 
+    def publish(self) -> dict[str, Any] | None:
+        """What changed in the map this tick, for the other robots (mapping only)."""
+        return self.shared.publish() if self.p.mode == "map" else None
+
+    def receive(self, sender: int, data: Any) -> None:
+        """Merge another robot's publication into the map (ValueError if malformed)."""
+        self.shared.receive(sender, data)
+
     def map_data(self) -> dict[str, Any]:
         """The map as plain data (to save, to send, to localize on later)."""
         return map_to_data(self.map)
 
     def summary(self) -> dict[str, Any]:
         return {"map": {"fingerprints": len(self.log), "nodes": len(self.map.nodes), "links": len(self.map.links),
-                        "loops_closed": self.map.closures}}  # fmt: skip
+                        "loops_closed": self.map.closures, "from_others": self.shared.added,
+                        "merged_with_ours": self.shared.merged}}  # fmt: skip
 
     def snapshot(self) -> dict[str, Any]:
         return {"tick": self.tick, "position": self.position.tolist(), "last_position": self.last_position.tolist(),
                 "since": self.since, "map": self.map_data(), "log": [list(r) for r in self.log],
-                "driver": _plain(self.driver.snapshot()),
+                "driver": _plain(self.driver.snapshot()), "shared": self.shared.to_data(),
                 "params": asdict(self.p)}  # fmt: skip
 
     def restore(self, state: dict[str, Any]) -> None:
         self.tick, self.since = int(state["tick"]), float(state["since"])
         self.position, self.last_position = np.array(state["position"]), np.array(state["last_position"])
         self.map = map_from_data(state["map"], self.signatures, self.map.params)
+        self.shared = SharedMap(self.map, self.agent, fingerprint_data, fingerprint_from_data)
+        self.shared.restore(state["shared"])
         self.log = [tuple(row) for row in state["log"]]
         self.driver.restore(state["driver"])
 

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from agents.controllers.fingerprint.align import Matcher, paper_length
+from agents.controllers.fingerprint.align import MAX_LENGTH, SYMBOLS, Matcher, paper_length
 from agents.controllers.fingerprint.features import Fingerprint
 from agents.controllers.navigation.topomap import Link, MapParams, Node, TopoMap
 
@@ -52,18 +52,25 @@ class FingerprintSignatures:
         return members[int(np.argmin(cost.sum(axis=1)))]
 
 
-def _fp_data(f: Fingerprint) -> list:
+def fingerprint_data(f: Fingerprint) -> list:
     return [f.codes.tolist(), f.bearings.tolist()]
 
 
-def _fp(data: list) -> Fingerprint:
-    return Fingerprint(np.array(data[0], np.int8), np.array(data[1], np.float64))
+def fingerprint_from_data(data: list) -> Fingerprint:
+    """A fingerprint from plain data, checked (symbols, lengths, finite bearings): ValueError if not one."""
+    codes = np.array(data[0], np.int64)
+    bearings = np.array(data[1], np.float64)
+    if not (codes.ndim == bearings.ndim == 1 and len(codes) == len(bearings) and 0 < len(codes) <= MAX_LENGTH
+            and ((codes >= 0) & (codes < SYMBOLS)).all() and np.isfinite(bearings).all()):  # fmt: skip
+        raise ValueError(f"not a fingerprint: expected [symbols 0-{SYMBOLS - 1}, bearings] as long, "
+                         f"1 to {MAX_LENGTH} of them")  # fmt: skip
+    return Fingerprint(codes.astype(np.int8), bearings)
 
 
 def map_to_data(m: TopoMap) -> dict[str, Any]:
     """A fingerprint map as plain data (msgpack- and JSON-safe)."""
     return {
-        "nodes": [{"mean": _fp_data(n.mean), "members": [_fp_data(f) for f in n.members],
+        "nodes": [{"mean": fingerprint_data(n.mean), "members": [fingerprint_data(f) for f in n.members],
                    "position": n.position.tolist(), "observations": n.observations, "visits": n.visits,
                    "seen_at": [list(p) for p in n.seen_at]}
                   for n in m.nodes],
@@ -77,8 +84,8 @@ def map_from_data(data: dict[str, Any], signatures: FingerprintSignatures, param
     try:
         nodes = []
         for n in data["nodes"]:
-            members = [_fp(f) for f in n["members"]]
-            mean = _fp(n["mean"])
+            members = [fingerprint_from_data(f) for f in n["members"]]
+            mean = fingerprint_from_data(n["mean"])
             # the mean is one of the members: keep it the same object, as the live map does
             same = [f for f in members if np.array_equal(f.codes, mean.codes)]
             nodes.append(Node(same[0] if same else mean, members, np.array(n["position"], np.float64),

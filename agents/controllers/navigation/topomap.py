@@ -23,7 +23,8 @@ everything else is here:
   when its dissimilarity (1 - P(match)) to the node's mean is below theta;
   else, if the belief given that the robot has left the current node puts
   at least `closure` on one known node and the observation matches that
-  node within theta, the robot is there again (a loop closed: link to it
+  node with P >= `closure_match` (stricter than joining: a wrong loop bends
+  the map's topology, a missed one only adds a node), the robot is there again (a loop closed: link to it
   and go on there); else it starts a new node;
 - Markov (POMDP) localization: a belief over nodes, predicted with the
   odometry since the last observation (stay for as long as visits there
@@ -88,6 +89,8 @@ class MapParams:
     theta: float = 0.5  # the largest dissimilarity at which an observation joins a node
     keep: int = 30  # observations a node keeps to compute its mean from
     closure: float = 0.5  # a loop closes when the belief, the current node left out, gives a known node this
+    closure_match: float = 0.9  # ... and the observation matches it this well (a wrong loop costs more than a node)
+    merge_match: float = 0.9  # another robot's node is one of ours when it matches this well (no odometry to help)
     near: float = 1.5  # a new node is linked to every node observed this close (odometry) as well ...
     recent: float = 20.0  # ... within this much travel (odometry drifts: farther back, near means little)
     kappa: float = 2.0  # concentration of the link direction model (von Mises)
@@ -182,8 +185,9 @@ class TopoMap:
         moving `displacement`: updates the belief, leaves the map unchanged."""
         likelihood = self.signatures.likelihoods(observation, self.means()) if self.nodes else np.zeros(0)
         self.likelihood = likelihood
-        if len(self.belief) != len(self.nodes):  # first fix, or the map grew: start from the matching alone
+        if len(self.belief) == 0:  # first fix: start from the matching alone
             self.belief = np.full(len(self.nodes), 1.0 / max(len(self.nodes), 1))
+        self._grow_belief()
         self.belief = self.correct(self.predict(displacement), likelihood) if self.nodes else self.belief
         return likelihood, self.belief
 
@@ -200,8 +204,9 @@ class TopoMap:
             return self._new_node(observation, position)
         likelihood = self.signatures.likelihoods(observation, self.means())
         self.likelihood = likelihood
-        if len(self.belief) != len(self.nodes):
+        if len(self.belief) == 0:
             self.belief = np.eye(len(self.nodes))[self.current]
+        self._grow_belief()
         self.belief = self.correct(self.predict(displacement), likelihood)
         if 1.0 - likelihood[self.current] < self.params.theta:
             self._join(self.current, observation, position)
@@ -210,11 +215,33 @@ class TopoMap:
         others[self.current] = 0.0
         best = int(np.argmax(others))
         share = others[best] / others.sum() if others.sum() > 0 else 0.0
-        if share >= self.params.closure and 1.0 - likelihood[best] < self.params.theta:
+        if share >= self.params.closure and likelihood[best] >= self.params.closure_match:
             self.closures += 1
             self._move(best, observation, position)
             return best
         return self._new_node(observation, position)
+
+    # ------------------------------------------------- maps of other robots
+
+    def _grow_belief(self) -> None:
+        """Nodes added since the belief was last updated start with none of it."""
+        if 0 < len(self.belief) < len(self.nodes):
+            self.belief = np.concatenate((self.belief, np.zeros(len(self.nodes) - len(self.belief))))
+
+    def add_node(self, mean: Any, position: np.ndarray, observations: int = 1, visits: int = 1) -> int:
+        """A node learned from elsewhere (another robot's map): no observation of
+        this robot's yet, so it is never linked by nearness."""
+        self.nodes.append(Node(mean, [mean], np.asarray(position, np.float64).copy(), observations, visits))
+        self._grow_belief()
+        return len(self.nodes) - 1
+
+    def put_link(self, a: int, b: int, displacement: np.ndarray, count: int = 1) -> bool:
+        """A link learned from elsewhere; one this robot drove itself is kept.  True if new."""
+        key, sign = ((a, b), 1.0) if a < b else ((b, a), -1.0)
+        if a == b or key in self.links:
+            return False
+        self.links[key] = Link(sign * np.asarray(displacement, np.float64), count)
+        return True
 
     def _join(self, i: int, observation: Any, position: np.ndarray) -> None:
         node = self.nodes[i]
