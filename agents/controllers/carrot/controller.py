@@ -9,13 +9,14 @@ robot stops once its sensor puts it within `arrive` of the last point.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 
 from agents.controllers.navigation.astar import Planner
 from agents.controllers.navigation.follow import CarrotFollower
+from agents.controllers.tables import params_from_table
 
 
 @dataclass(frozen=True)
@@ -30,12 +31,7 @@ class CarrotParams:
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> CarrotParams:
-        table = table or {}
-        known = {f.name: f.type for f in fields(cls)}
-        unknown = sorted(set(table) - set(known))
-        if unknown:
-            raise ValueError(f"[carrot]: unknown field {unknown[0]!r}; expected one of {', '.join(known)}")
-        return cls(**{k: (int(v) if k == "window" else float(v)) for k, v in table.items()})
+        return params_from_table(cls, table, "carrot", ints=("window",))
 
 
 class CarrotController:

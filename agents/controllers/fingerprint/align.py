@@ -26,10 +26,12 @@ in one compiled call.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+
+from agents.controllers.tables import params_from_table
 
 HUES = 16  # symbols 0..15: hue bins 'A'..'P'
 V, C, N = 16, 17, 18  # vertical edge, laser corner; N + k - 1: a run of k empty-space quanta
@@ -77,12 +79,7 @@ class AlignParams:
 
     @classmethod
     def from_table(cls, table: dict | None) -> AlignParams:
-        table = table or {}
-        known = {f.name for f in fields(cls)}
-        if unknown := sorted(set(table) - known):
-            raise ValueError(f"[fingerprint.align]: unknown field {unknown[0]!r}; expected one of "
-                             f"{', '.join(sorted(known))}")  # fmt: skip
-        return cls(**{k: float(v) for k, v in table.items()})
+        return params_from_table(cls, table, "fingerprint.align")
 
     def tables(self) -> tuple[np.ndarray, np.ndarray]:
         """(substitution costs SYMBOLS x SYMBOLS, gap cost per symbol), integers of SCALE.

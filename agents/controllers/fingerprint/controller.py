@@ -11,7 +11,7 @@ compass heading into the odometric frame in which nodes and links live.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -27,6 +27,7 @@ from agents.controllers.fingerprint.signatures import (
 )
 from agents.controllers.navigation.mapshare import SharedMap
 from agents.controllers.navigation.topomap import MapParams, TopoMap
+from agents.controllers.tables import params_from_table
 
 DRIVES = ("route", "explore")
 MODES = ("map", "localize")
@@ -43,12 +44,8 @@ class FingerprintParams:
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> FingerprintParams:
-        table = {k: v for k, v in (table or {}).items() if k not in ("features", "align")}
-        known = {f.name for f in fields(cls)}
-        if unknown := sorted(set(table) - known):
-            raise ValueError(f"[fingerprint]: unknown field {unknown[0]!r}; expected one of "
-                             f"{', '.join(sorted(known | {'features', 'align'}))}")  # fmt: skip
-        p = cls(**{k: (v if k in ("drive", "mode") else int(v) if k == "keep" else float(v)) for k, v in table.items()})
+        p = params_from_table(cls, table, "fingerprint", ints=("keep",), texts=("drive", "mode"),
+                              nested=("features", "align"))  # fmt: skip
         if p.drive not in DRIVES:
             raise ValueError(f"[fingerprint].drive: {p.drive!r}; expected one of {', '.join(DRIVES)}")
         if p.mode not in MODES:

@@ -20,11 +20,12 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
 from agents.controllers.fingerprint.align import HUES, MAX_RUN, C, N, V, paper_length, to_string
+from agents.controllers.tables import params_from_table
 
 TWO_PI = 2 * math.pi
 
@@ -44,12 +45,7 @@ class FeatureParams:
 
     @classmethod
     def from_table(cls, table: dict | None) -> FeatureParams:
-        table = table or {}
-        known = {f.name for f in fields(cls)}
-        if unknown := sorted(set(table) - known):
-            raise ValueError(f"[fingerprint.features]: unknown field {unknown[0]!r}; expected one of "
-                             f"{', '.join(sorted(known))}")  # fmt: skip
-        return cls(**{k: (int(v) if k == "min_patch" else float(v)) for k, v in table.items()})
+        return params_from_table(cls, table, "fingerprint.features", ints=("min_patch",))
 
 
 @dataclass(frozen=True)

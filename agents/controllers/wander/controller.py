@@ -14,11 +14,12 @@ mixed arenas.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 
+from agents.controllers.tables import params_from_table
 from swarm.arena.models import IR_DISTANCE, IR_VALUE
 from swarm.rng import draw_unit
 
@@ -32,11 +33,7 @@ class WanderParams:
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> WanderParams:
-        table = table or {}
-        known = {f.name for f in fields(cls)}
-        if unknown := sorted(set(table) - known):
-            raise ValueError(f"[wander]: unknown field {unknown[0]!r}; expected one of {', '.join(sorted(known))}")
-        return cls(**{k: (int(v) if k == "turn_ticks" else float(v)) for k, v in table.items()})
+        return params_from_table(cls, table, "wander", ints=("turn_ticks",))
 
 
 FRONT = math.radians(60)
