@@ -49,13 +49,14 @@ class MapLog:
         rr, rec = self.rr, self.rec
         rec.set_time("tick", sequence=tick)
         sums = self.sums[agent]
-        ids = sorted(sums)
+        folded = set(np.asarray(record.get("folded", []), np.int64).tolist())
+        ids = [k for k in sorted(sums) if k not in folded]
         where = {k: sums[k][:2] / sums[k][2] for k in ids}
         colour = self.colours[agent] if agent < len(self.colours) else (200, 200, 200)
         pts = flip(np.array([where[k] for k in ids]))
         rec.log(f"world/map/{agent}/nodes", rr.Points2D(pts, radii=0.12, colors=[colour], labels=[f"n{k}" for k in ids],
                                                         draw_order=6.0))  # fmt: skip
-        shown = [(a, b) for a, b in links.tolist() if a in where and b in where]
+        shown = [(a, b) for a, b in links.tolist() if a in ids and b in ids]
         strips = [flip(np.array([where[a], where[b]])) for a, b in shown]
         rec.log(
             f"world/map/{agent}/links", rr.LineStrips2D(strips, colors=[(60, 110, 220)], radii=0.03, draw_order=5.5)

@@ -469,3 +469,18 @@ def test_mapping_together_lockstep_equals_in_process(processes, per_process):
     assert [r["shared"] for r in summary["robots"]] == [r["shared"] for r in expected["robots"]]
     assert summary["rejected_messages"] == 0
     assert set(held) == {0, 1} and all(held.values())
+
+
+def test_a_young_node_that_turns_out_to_be_a_known_place_is_folded_into_it():
+    """Coming back to a through a view that matched nothing ('d', a door), the
+    next observations match a: the young node d folds into a (a loop closed late)."""
+    m = corridor_map()
+    places = m.size
+    m.observe("d", np.array([20.0, 0.0]), np.array([0.5, 0.0]))  # a new node, young
+    young = m.current
+    assert m.size == places + 1
+    m.observe("a", np.array([20.5, 0.0]), np.array([0.5, 0.0]))
+    assert m.folded == {young: 0} and m.current == 0 and m.size == places
+    assert m.resolve(young) == 0 and all(young not in link for link in m.links)
+    assert (0, 3) in m.links  # y, where the robot came from, is now linked to a
+    assert np.isclose(m.likelihood[young], 0.0) or m._likelihoods("d")[young] == 0.0

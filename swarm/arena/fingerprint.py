@@ -102,9 +102,11 @@ def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000) -> dict[
             truth.append(before)
             likelihoods.append(np.asarray(c.map.likelihood, np.float64).copy())
     log = np.array(c.log, np.int64).reshape(-1, 4)
-    return {"ticks": engine.tick, "truth": np.array(truth).reshape(-1, 3), "believed": log[:, 1],
-            "matched": log[:, 2], "likelihoods": likelihoods, "map": c.map_data(), "closures": c.map.closures,
-            "finished": c.finished, "wall_seconds": engine.wall_seconds}  # fmt: skip
+    resolve = np.vectorize(c.map.resolve, otypes=[np.int64])  # a node folded later stands for the one it joined
+    believed, matched = (resolve(log[:, 1]), resolve(log[:, 2])) if len(log) else (log[:, 1], log[:, 2])
+    return {"ticks": engine.tick, "truth": np.array(truth).reshape(-1, 3), "believed": believed,
+            "matched": matched, "size": c.map.size, "likelihoods": likelihoods, "map": c.map_data(),
+            "closures": c.map.closures, "finished": c.finished, "wall_seconds": engine.wall_seconds}  # fmt: skip
 
 
 def node_places(run: dict, zones: list) -> np.ndarray:
@@ -121,10 +123,11 @@ def judge_map(run: dict, zones: list) -> dict[str, Any]:
     truth = np.array([place_of(xy, zones) for xy in run["truth"][:, :2]])
     visited = set(truth.tolist())
     pure = np.mean(labels[run["believed"]] == truth) if len(truth) else math.nan
-    per_place = np.bincount(labels, minlength=len(zones))
-    return {"fingerprints": len(truth), "nodes": len(labels), "places_visited": len(visited),
+    live = np.setdiff1d(np.arange(len(labels)), [a for a, _ in run["map"].get("folded", [])])
+    per_place = np.bincount(labels[live], minlength=len(zones))
+    return {"fingerprints": len(truth), "nodes": run["size"], "places_visited": len(visited),
             "places_with_node": int(sum(per_place[p] > 0 for p in visited)),
-            "nodes_per_place": round(len(labels) / max(len(visited), 1), 2), "purity": round(float(pure), 4),
+            "nodes_per_place": round(run["size"] / max(len(visited), 1), 2), "purity": round(float(pure), 4),
             "links": len(run["map"]["links"]), "closures": run["closures"]}  # fmt: skip
 
 
@@ -153,7 +156,7 @@ def localize_job(job: tuple) -> dict:
     name, noise, seed = job
     s = tour_scenario(name, "mapping", noise, seed)
     mapped = drive_tour(s)
-    k = len(mapped["map"]["nodes"])
+    k = mapped["size"]
     loc = drive_tour(tour_scenario(name, "localize", noise, seed + 1000), topomap=mapped["map"])
     by_match, by_markov, ranks, chance, off = [], [], [], [], 0
     for xy, matched, believed, like in zip(loc["truth"][:, :2], loc["matched"], loc["believed"], loc["likelihoods"],
@@ -398,11 +401,13 @@ def draw_map(ax, s, run: dict) -> None:
             ax.plot([c[0], c[2]], [c[1], c[3]], color=np.array(wall.colour) / 255)
     xy, nodes = run["truth"][:, :2], run["believed"]
     ax.plot(xy[:, 0], xy[:, 1], color="#bbb", lw=0.8, zorder=1)
-    k = len(run["map"]["nodes"])
-    centres = np.array([xy[nodes == i].mean(axis=0) for i in range(k)])
+    live = [i for i in range(len(run["map"]["nodes"])) if (nodes == i).any()]  # folded nodes hold none
+    centres = {i: xy[nodes == i].mean(axis=0) for i in live}
+    k = len(live)
     for a, b, *_ in run["map"]["links"]:
-        ax.plot(centres[[a, b], 0], centres[[a, b], 1], color="#36c", lw=1.2, zorder=2)
-    ax.scatter(centres[:, 0], centres[:, 1], s=40, color="#c33", zorder=3)
+        if a in centres and b in centres:
+            ax.plot([centres[a][0], centres[b][0]], [centres[a][1], centres[b][1]], color="#36c", lw=1.2, zorder=2)
+    ax.scatter([c[0] for c in centres.values()], [c[1] for c in centres.values()], s=40, color="#c33", zorder=3)
     ax.set(aspect="equal", xlim=(0, s.size[0]), ylim=(0, s.size[1]),
            title=f"{k} nodes over the floor plan (noise {s.noise.level}, theta 0.5)")  # fmt: skip
 

@@ -105,7 +105,15 @@ def team_job(job: tuple) -> dict:
 def known_places(lead, counts: list[dict]) -> set[int]:
     """Places of robot 0's nodes: its own by its fingerprints, copies by their maker's."""
     out = set()
+    own: dict[int, dict] = {}  # robot 0's fingerprints by the node they stand in now (folds resolved)
+    for node, tally in counts[0].items():
+        mine = own.setdefault(lead.map.resolve(node), {})
+        for p, n in tally.items():
+            mine[p] = mine.get(p, 0) + n
+    counts = [own, *counts[1:]]
     for i in range(len(lead.map.nodes)):
+        if i in lead.map.folded:
+            continue
         robot, node = lead.shared.origin.get(i, (0, i))
         tally = dict(counts[robot].get(node, {}))
         if robot != 0:  # a copy robot 0 has since observed at: its own fingerprints count too

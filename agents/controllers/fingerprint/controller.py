@@ -164,7 +164,7 @@ class FingerprintController:
         return map_to_data(self.map)
 
     def summary(self) -> dict[str, Any]:
-        return {"map": {"fingerprints": len(self.log), "nodes": len(self.map.nodes), "links": len(self.map.links),
+        return {"map": {"fingerprints": len(self.log), "nodes": self.map.size, "links": len(self.map.links),
                         "loops_closed": self.map.closures, "from_others": self.shared.added,
                         "merged_with_ours": self.shared.merged}}  # fmt: skip
 
@@ -187,7 +187,8 @@ class FingerprintController:
         out = {k: v for k, v in self.driver.record().items() if k == "path"}
         out["node"] = np.array(self.believed)
         out["matched"] = np.array(self.matched)
-        out["nodes"] = np.array(len(self.map.nodes))
+        out["nodes"] = np.array(self.map.size)
+        out["folded"] = np.array(sorted(self.map.folded), np.int64)
         out["links"] = np.array(list(self.map.links), np.int64).reshape(-1, 2)
         out["belief"] = np.asarray(self.map.belief, np.float64)
         if self.current is not None:

@@ -76,7 +76,7 @@ def map_to_data(m: TopoMap) -> dict[str, Any]:
                   for n in m.nodes],
         "links": [[a, b, link.displacement.tolist(), link.count] for (a, b), link in m.links.items()],
         "current": m.current, "belief": np.asarray(m.belief).tolist(), "closures": m.closures,
-        "odometer": m.odometer,
+        "odometer": m.odometer, "folded": [[a, b] for a, b in m.folded.items()],
     }  # fmt: skip
 
 
@@ -94,7 +94,8 @@ def map_from_data(data: dict[str, Any], signatures: FingerprintSignatures, param
         links = {(int(a), int(b)): Link(np.array(d, np.float64), int(c)) for a, b, d, c in data["links"]}
         m = TopoMap(signatures, params, nodes, links, int(data.get("current", -1)),
                     np.array(data.get("belief", []), np.float64), int(data.get("closures", 0)),
-                    odometer=float(data.get("odometer", 0.0)))  # fmt: skip
+                    odometer=float(data.get("odometer", 0.0)),
+                    folded={int(a): int(b) for a, b in data.get("folded", [])})  # fmt: skip
     except (KeyError, TypeError, ValueError, IndexError) as e:
         raise ValueError(
             f"a fingerprint map: malformed ({type(e).__name__}: {e}); "

@@ -70,7 +70,7 @@ class SharedMap:
         """What changed since the last publication, or None."""
         m, nodes = self.map, []
         for i, node in enumerate(m.nodes):
-            if i in self.origin:
+            if i in self.origin or i in m.folded:  # others' nodes are theirs to send; a folded one is no place
                 continue
             stamp = (node.observations, node.visits)
             if self.sent_nodes.get(i) != stamp:

@@ -24,8 +24,13 @@ everything else is here:
   else, if the belief given that the robot has left the current node puts
   at least `closure` on one known node and the observation matches that
   node with P >= `closure_match` (stricter than joining: a wrong loop bends
-  the map's topology, a missed one only adds a node), the robot is there again (a loop closed: link to it
-  and go on there); else it starts a new node;
+  the map's topology, a missed one only adds a node), the robot is there
+  again (a loop closed: link to it and go on there); else it starts a new node;
+- late closing: while a node is young (its first `young` observations), an
+  observation that matches a known node that well, and about as well as the
+  young one, folds the young node into it (its observations and links go
+  there, it stands for no place any more): the robot came back to a place
+  whose first view on entering did not match, as a door's view seldom does;
 - Markov (POMDP) localization: a belief over nodes, predicted with the
   odometry since the last observation (stay for as long as visits there
   last, or move along a link whose direction agrees with the motion), then
@@ -90,6 +95,7 @@ class MapParams:
     keep: int = 30  # observations a node keeps to compute its mean from
     closure: float = 0.5  # a loop closes when the belief, the current node left out, gives a known node this
     closure_match: float = 0.9  # ... and the observation matches it this well (a wrong loop costs more than a node)
+    young: int = 5  # a node this young (observations, first visit) folds into a known one it turns out to be
     merge_match: float = 0.9  # another robot's node is one of ours when it matches this well (no odometry to help)
     near: float = 1.5  # a new node is linked to every node observed this close (odometry) as well ...
     recent: float = 20.0  # ... within this much travel (odometry drifts: farther back, near means little)
@@ -109,6 +115,24 @@ class TopoMap:
     closures: int = 0
     likelihood: np.ndarray = field(default_factory=lambda: np.zeros(0))  # of the last observation
     odometer: float = 0.0  # distance travelled, for `recent`
+    folded: dict[int, int] = field(default_factory=dict)  # young nodes found to be a known one: node -> that one
+
+    @property
+    def size(self) -> int:
+        """Nodes that stand for a place (folded ones do not)."""
+        return len(self.nodes) - len(self.folded)
+
+    def resolve(self, node: int) -> int:
+        """The node a (possibly folded) node stands for."""
+        while node in self.folded:
+            node = self.folded[node]
+        return node
+
+    def _likelihoods(self, observation: Any) -> np.ndarray:
+        likelihood = self.signatures.likelihoods(observation, self.means())
+        if self.folded:
+            likelihood[list(self.folded)] = 0.0  # a folded node is never where the robot is
+        return likelihood
 
     # -------------------------------------------------------------- queries
 
@@ -183,7 +207,7 @@ class TopoMap:
     def localize(self, observation: Any, displacement: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(likelihood, belief) of every node for an observation made after
         moving `displacement`: updates the belief, leaves the map unchanged."""
-        likelihood = self.signatures.likelihoods(observation, self.means()) if self.nodes else np.zeros(0)
+        likelihood = self._likelihoods(observation) if self.nodes else np.zeros(0)
         self.likelihood = likelihood
         if len(self.belief) == 0:  # first fix: start from the matching alone
             self.belief = np.full(len(self.nodes), 1.0 / max(len(self.nodes), 1))
@@ -202,12 +226,21 @@ class TopoMap:
         if not self.nodes:
             self.likelihood = np.ones(1)
             return self._new_node(observation, position)
-        likelihood = self.signatures.likelihoods(observation, self.means())
+        likelihood = self._likelihoods(observation)
         self.likelihood = likelihood
         if len(self.belief) == 0:
             self.belief = np.eye(len(self.nodes))[self.current]
         self._grow_belief()
         self.belief = self.correct(self.predict(displacement), likelihood)
+        young = self.nodes[self.current]
+        if young.visits == 1 and young.observations <= self.params.young and len(self.nodes) > 1:
+            others = likelihood.copy()
+            others[self.current] = -1.0
+            known = int(np.argmax(others))
+            if others[known] >= self.params.closure_match and others[known] >= likelihood[self.current] - 0.05:
+                self.closures += 1  # the node just started is a place known before: a loop closed late
+                self._fold(self.current, known, observation, position)
+                return known
         if 1.0 - likelihood[self.current] < self.params.theta:
             self._join(self.current, observation, position)
             return self.current
@@ -260,6 +293,30 @@ class TopoMap:
             link.count += 1
         else:
             self.links[key] = Link(d)
+
+    def _fold(self, young: int, known: int, observation: Any, position: np.ndarray) -> None:
+        """The young node is the known one: its observations and links go there, and it is no place any more."""
+        y, k = self.nodes[young], self.nodes[known]
+        self.folded[young] = known
+        k.members = [*k.members, *y.members][-self.params.keep :]
+        k.position = k.position + (y.position - k.position) * y.observations / (k.observations + y.observations)
+        k.observations += y.observations
+        k.seen_at += y.seen_at
+        k.visits += 1
+        for (a, b), link in list(self.links.items()):
+            if young in (a, b):
+                del self.links[(a, b)]
+                other = b if a == young else a
+                if other == known:
+                    continue
+                if (min(other, known), max(other, known)) in self.links:
+                    self._link(other, known)  # driven once more
+                else:
+                    self.put_link(other, known, link.displacement if a == other else -link.displacement)
+        self.belief = np.eye(len(self.nodes))[known]
+        self.current = known
+        self._join(known, observation, position)
+        self._edge_key = None
 
     def _move(self, i: int, observation: Any, position: np.ndarray) -> None:
         self._join(i, observation, position)
