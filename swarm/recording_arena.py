@@ -101,6 +101,7 @@ class ArenaRecorder:
         self._obstacles_on: tuple | None = None
         self._plans_logged: set[int] = set()
         self._maps = None
+        self._published = None
         self._static_done = False
 
     def _log_static(self) -> None:
@@ -224,6 +225,18 @@ class ArenaRecorder:
 
                 self._maps = MapLog(self.rr, self.rec, self.colours)
             self._maps.capture(tick, a, c.record(), self.world.pose[a, :2])
+
+    def log_published_map(self, tick: int, agent: int, data) -> None:
+        """Distributed: a robot's map from its publication on the map key space."""
+        from swarm.recording_topomap import MapLog, PublishedMaps
+
+        if self._maps is None:
+            self._maps = MapLog(self.rr, self.rec, self.colours)
+        if self._published is None:
+            self._published = PublishedMaps()
+        record = self._published.update(agent, data)
+        if record is not None:
+            self._maps.capture(tick, agent, record, self.world.pose[agent, :2])
 
     def log_plan(self, tick: int, agent: int, path: np.ndarray) -> None:
         """A controller's planned path, at the tick it was planned."""

@@ -4,7 +4,8 @@ and may give `belief` and `fingerprint`), over the floor plan.
 
 A node is drawn where the robot truly was, on average, while that node was
 its current one: ground truth for display only (the controller knows only
-its odometry).
+its odometry).  In process the recorder asks the controllers; in a
+distributed run the world reads the robots' publications (PublishedMaps).
 
     world/map/<agent>/nodes   points, one per node, labelled n<k>
     world/map/<agent>/links   line strips between linked nodes
@@ -23,6 +24,38 @@ def flip(xy: np.ndarray) -> np.ndarray:
     out = np.array(xy, np.float32).reshape(-1, 2)
     out[:, 1] *= -1
     return out
+
+
+class PublishedMaps:
+    """Distributed runs: the world sees each robot's map only as its publications
+    (agents.controllers.navigation.mapshare).  From them it keeps what MapLog
+    draws: the robot's own nodes, its links between them, and as the current
+    node the one whose observations grew this tick (where the fingerprint was
+    taken).  Links to other robots' nodes are not drawn."""
+
+    def __init__(self) -> None:
+        self.observations: dict[int, dict[int, int]] = {}
+        self.links: dict[int, set[tuple[int, int]]] = {}
+        self.current: dict[int, int] = {}
+
+    def update(self, agent: int, data) -> dict | None:
+        """The record() MapLog needs, or None for a publication it cannot read."""
+        try:
+            seen = self.observations.setdefault(agent, {})
+            grown = [(int(obs) - seen.get(int(n), 0), int(n)) for n, _, _, obs, _ in data["nodes"]]
+            for n, _, _, obs, _ in data["nodes"]:
+                seen[int(n)] = int(obs)
+            links = self.links.setdefault(agent, set())
+            for a0, a1, b0, b1, *_ in data["links"]:
+                if int(a0) == int(b0) == agent:
+                    links.add((int(a1), int(b1)))
+        except (KeyError, TypeError, ValueError):
+            return None
+        if grown:
+            self.current[agent] = max(grown)[1]
+        if agent not in self.current:
+            return None
+        return {"node": self.current[agent], "nodes": len(seen), "links": np.array(sorted(links)).reshape(-1, 2)}
 
 
 class MapLog:

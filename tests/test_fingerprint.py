@@ -433,7 +433,7 @@ def test_shared_items_on_the_wire_are_checked():
 
 
 @pytest.mark.parametrize(("processes", "per_process"), [(2, 1), (1, 2)])
-def test_mapping_together_lockstep_equals_in_process(processes, per_process):
+def test_mapping_together_lockstep_equals_in_process(processes, per_process, tmp_path):
     from swarm import protocol as proto
     from swarm.arena.engine import ArenaEngine
     from swarm.arena.fingerprint_team import team_scenario
@@ -463,12 +463,17 @@ def test_mapping_together_lockstep_equals_in_process(processes, per_process):
             session.close()
 
     run_id = f"fp-team-{processes}"
+    rrd = tmp_path / "team.rrd"
     summary, world = run_world(scenario, run_id, [("fingerprint", processes, per_process)], read_key_space,
-                               deadline=20.0)  # fmt: skip
+                               deadline=20.0, record=str(rrd))  # fmt: skip
     np.testing.assert_array_equal(world.pose, engine.world.pose)
     assert [r["shared"] for r in summary["robots"]] == [r["shared"] for r in expected["robots"]]
     assert summary["rejected_messages"] == 0
     assert set(held) == {0, 1} and all(held.values())
+    from rerun.chunk import RrdReader
+
+    entities = {c.entity_path.lstrip("/") for c in RrdReader(rrd).stream()}  # the world drew both maps
+    assert {"map/0", "map/1", "world/map/0/nodes", "world/map/1/links"} <= entities
 
 
 def test_a_young_node_that_turns_out_to_be_a_known_place_is_folded_into_it():

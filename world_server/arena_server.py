@@ -179,6 +179,10 @@ class ArenaServer(WorldServer):
         for a, share, payload in self.shared_out:
             self.shared_history.setdefault((share, a), []).append(payload)
             self.session.put(f"{self.keys.prefix}/{share}/{a}", payload)
+            if self.recorder is not None and share == "map":
+                data = proto.unpack(payload, len(payload) + 1)
+                if not isinstance(data, proto.Rejected):
+                    self.recorder.log_published_map(self.tick - 1, a, data)
 
     def _on_shared_query(self, share: str, query) -> None:
         """Every publication of every agent in the key space, one reply per agent."""
