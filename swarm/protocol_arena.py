@@ -140,9 +140,8 @@ def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
         if bad := first_rejection(*decoded.values()):
             return bad
         perceptions.append(decoded)
-    shared = parse_shared(m.get("shared"))
-    if isinstance(shared, Rejected):
-        return shared
+    if bad := first_rejection(shared := parse_shared(m.get("shared"))):
+        return bad
     return ArenaObs(tick, agents, perceptions, shared)
 
 
@@ -157,9 +156,8 @@ def parse_acts(data: bytes) -> ArenaActs | Rejected:
     raw = m.get("wheels")
     if not isinstance(raw, bytes) or len(raw) != 16 * len(agents):
         return Rejected(f"wheels: expected {len(agents)}x2 binary float64")
-    shared = parse_shared(m.get("shared"))
-    if isinstance(shared, Rejected):
-        return shared
+    if bad := first_rejection(shared := parse_shared(m.get("shared"))):
+        return bad
     wheels = np.frombuffer(raw, dtype="<f8").reshape(len(agents), 2).astype(np.float64)
     return ArenaActs(tick, agents, wheels, shared)
 

@@ -160,8 +160,9 @@ class ArenaServer(WorldServer):
 
     def _take_shared(self, msg, group: str) -> None:
         """Publications of agents whose action this tick was taken; the rest is counted and dropped."""
+        named = set(msg.agents.tolist())
         for a, share, payload in msg.shared:
-            if not (0 <= a < len(self.slots)) or self.group_of.get(a) != group or a not in set(msg.agents.tolist()):
+            if not (0 <= a < len(self.slots)) or self.group_of.get(a) != group or a not in named:
                 self.stats.reject("shared: names an agent of another process")
             elif share != SHARES.get(str(self.controllers[a])):
                 self.stats.reject("shared: not this controller's key space")

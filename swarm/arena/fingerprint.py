@@ -93,7 +93,7 @@ def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000) -> dict[
         params["fingerprint"] = {**params.get("fingerprint", {}), "mode": "localize"}
         params["topomap"] = topomap
         c.reset(s.seed, 0, params)
-    truth, likelihoods = [], []
+    truth, likelihoods, prints = [], [], []
     while not c.finished and engine.tick < max_ticks:
         before = engine.world.pose[0].copy()
         seen = len(c.log)
@@ -101,12 +101,14 @@ def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000) -> dict[
         if len(c.log) > seen:
             truth.append(before)
             likelihoods.append(np.asarray(c.map.likelihood, np.float64).copy())
+            prints.append(c.current)
     log = np.array(c.log, np.int64).reshape(-1, 4)
     resolve = np.vectorize(c.map.resolve, otypes=[np.int64])  # a node folded later stands for the one it joined
     believed, matched = (resolve(log[:, 1]), resolve(log[:, 2])) if len(log) else (log[:, 1], log[:, 2])
     return {"ticks": engine.tick, "truth": np.array(truth).reshape(-1, 3), "believed": believed,
             "matched": matched, "size": c.map.size, "likelihoods": likelihoods, "map": c.map_data(),
-            "closures": c.map.closures, "finished": c.finished, "wall_seconds": engine.wall_seconds}  # fmt: skip
+            "closures": c.map.closures, "fingerprints": prints, "finished": c.finished,
+            "wall_seconds": engine.wall_seconds}  # fmt: skip
 
 
 def node_places(run: dict, zones: list) -> np.ndarray:
@@ -183,20 +185,12 @@ def localize_job(job: tuple) -> dict:
 def calibration_pairs(name: str, noise: str, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """(cost per character, same place) of every pair of the mapping tour's fingerprints."""
     from agents.controllers.fingerprint.align import Matcher, paper_length
-    from swarm.arena.engine import ArenaEngine
 
     s = tour_scenario(name, "mapping", noise, seed)
     zones = places(s)
-    engine = ArenaEngine(s)
-    c = engine.controllers[0]
-    prints, where = [], []
-    while not c.finished and engine.tick < 40_000:
-        before = engine.world.pose[0, :2].copy()
-        seen = len(c.log)
-        engine.step(1)
-        if len(c.log) > seen:
-            prints.append(c.current)
-            where.append(place_of(before, zones))
+    run = drive_tour(s)
+    prints = run["fingerprints"]
+    where = [place_of(xy, zones) for xy in run["truth"][:, :2]]
     m = Matcher()
     d, same = [], []
     for i in range(len(prints)):

@@ -34,6 +34,8 @@ class FingerprintSignatures:
         self.matcher = matcher
         self._means: list[Fingerprint] = []
         self._packed = pack([])
+        self._costs: dict[tuple[int, int], float] = {}  # alignment costs between members, kept across joins
+        self._held: dict[int, Fingerprint] = {}  # the fingerprints those ids name (held, so no id is reused)
 
     def likelihoods(self, observation: Fingerprint, means: list[Fingerprint]) -> np.ndarray:
         same = len(means) == len(self._means) and all(a is b for a, b in zip(means, self._means, strict=True))
@@ -48,8 +50,16 @@ class FingerprintSignatures:
         cost = np.zeros((k, k))
         for i in range(k):
             for j in range(i + 1, k):
-                cost[i, j] = cost[j, i] = self.matcher.cost(members[i].codes, members[j].codes)
+                cost[i, j] = cost[j, i] = self._cost(members[i], members[j])
         return members[int(np.argmin(cost.sum(axis=1)))]
+
+    def _cost(self, a: Fingerprint, b: Fingerprint) -> float:
+        """A node's members are compared again at every join: each pair is aligned once."""
+        key = (id(a), id(b))
+        if key not in self._costs:
+            self._held[id(a)], self._held[id(b)] = a, b
+            self._costs[key] = self.matcher.cost(a.codes, b.codes)
+        return self._costs[key]
 
 
 def fingerprint_data(f: Fingerprint) -> list:
