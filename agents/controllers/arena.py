@@ -22,6 +22,7 @@ REGISTRY = {
     "carrot": "agents.controllers.carrot:CarrotController",
     "wander": "agents.controllers.wander:WanderController",
     "fingerprint": "agents.controllers.fingerprint:FingerprintController",
+    "dft": "agents.controllers.dft:DftController",
 }
 ARENA_CONTROLLERS = tuple(REGISTRY)
 # Each controller's own scenario table, checked when a scenario is loaded (a callable raising ValueError).
@@ -29,13 +30,15 @@ TABLES = {
     "carrot": "agents.controllers.carrot:CarrotParams.from_table",
     "wander": "agents.controllers.wander.controller:WanderParams.from_table",
     "fingerprint": "agents.controllers.fingerprint.controller:check_table",
+    "dft": "agents.controllers.dft.controller:check_table",
 }
 # Controllers that write a shared key space (swarm/<run>/<share>/<agent>), and which: what one robot
 # publishes at tick t every other robot of the same share receives before it steps tick t + 1.
 SHARES = {"fingerprint": "map"}
 MAX_SHARE_BYTES = 4 * 1024 * 1024
 # What a controller needs its robot to sense (checked when a scenario is loaded).
-REQUIRES = {"carrot": ("position", "compass"), "wander": (), "fingerprint": ("camera", "laser", "odometry", "compass")}
+REQUIRES = {"carrot": ("position", "compass"), "wander": (), "fingerprint": ("camera", "laser", "odometry", "compass"),
+            "dft": ("position", "compass", "ir")}
 
 
 class ArenaController(Protocol):

@@ -1,0 +1,154 @@
+"""The dft controller: simultaneous planning and action with dynamic neural fields.
+
+Each tick the robot's sensors write the input layers (goal, the map it is
+given as context, its noisy position every `position_every` ticks, its
+heading, its proximity sensors), the engine steps every field once, and the
+action fields give the wheel speeds.  Planning and acting are the same
+dynamics: activity spreads back from the goal through M and P while the
+robot already turns and drives where an intention has formed.
+
+Obstacles.  The robot's map is the scenario's static walls.  With
+`obstacles = "told"` (the paper's case 3) the map also holds every scheduled
+obstacle while it is present, as the original supervisor wrote it into the
+map when it appeared and cleared it when it went.  With "unknown" the robot
+learns of them only through its proximity sensors' action-field inhibition.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from agents.controllers.dft.architecture import EBS, SpaParams, spa_architecture
+from agents.controllers.dft.fields import Engine, fill_noise, noise_key
+from agents.controllers.dft.robot import Interface, gaussian_2d
+from agents.controllers.navigation.astar import occupancy
+from agents.controllers.tables import params_from_table
+
+FIELD_STREAM, MAP_STREAM = 1, 2
+MAP_NOISE = {"none": 0.005, "low": 0.05, "high": 1.0}  # std per map cell, a wall being 1 (original code)
+
+
+@dataclass(frozen=True)
+class DftParams:
+    cell: float = 0.01  # field cell, m (paper: 1 cm)
+    border: int = 5  # wall cells the map adds round the field (the code: 5 north and west, 6 south and east)
+    goal_peak: float = 10.0  # gamma: a plain Gaussian on the goal, cells
+    goal_sigma: float = 3.0
+    position_sigma: float = 3.0  # robot position image (peak 1, 1.2 at high noise), into C with gain c8
+    position_every: int = 2  # ticks between position readings used (the original got one per 128 ms)
+    wheel_unit: float = 0.1288e-3  # m/s per e-puck wheel unit (1000 steps/s = 12.88 cm/s)
+    obstacles: str = "told"  # told | unknown
+
+    @classmethod
+    def from_table(cls, table: dict[str, Any] | None) -> DftParams:
+        p = params_from_table(cls, table, "dft", ints=("border", "position_every"), texts=("obstacles",))
+        if p.obstacles not in ("told", "unknown"):
+            raise ValueError(f"[dft]: obstacles is 'told' or 'unknown', not {p.obstacles!r}")
+        if p.cell <= 0 or p.position_every < 1 or p.border < 0:
+            raise ValueError("[dft]: cell must be > 0, position_every >= 1 and border >= 0")
+        return p
+
+
+def check_table(table: dict[str, Any]) -> None:
+    DftParams.from_table(table)
+
+
+class DftController:
+    def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
+        self.seed, self.agent = seed, agent
+        self.p = DftParams.from_table(params.get("dft"))
+        self.iface = Interface()
+        robot = params["robot"]
+        self.max_wheel = float(robot["max_wheel_speed"])
+        m = params["map"]
+        self.size = tuple(float(v) for v in m["size"])
+        walls = occupancy(self.size, self.p.cell, np.asarray(m["rects"], np.float64).reshape(-1, 4),
+                          np.asarray(m["segments"], np.float64).reshape(-1, 4))  # fmt: skip
+        b = self.p.border
+        if b:
+            walls[: b + 1, :] = walls[-b:, :] = True  # south (one more, as the code) and north
+            walls[:, :b] = walls[:, -(b + 1) :] = True  # west and east (one more)
+        self.shape = walls.shape
+        self.walls = walls
+        self.obstacle_rects = []
+        if self.p.obstacles == "told":
+            for o in params.get("obstacles") or []:
+                self.obstacle_rects.append((tuple(o["rect"]), int(o["appear"]), o.get("vanish")))
+        self.noise_level = params.get("noise", "low")
+        self.map_noise = MAP_NOISE[self.noise_level]
+        self.position_peak = 1.2 if self.noise_level == "high" else 1.0
+        self.engine = Engine(spa_architecture(self.shape, SpaParams()))
+        goal = params.get("goal")
+        self.goal = None if goal is None else (float(goal[0]), float(goal[1]))
+        if self.goal is not None:
+            cj, ci = self._cell(*self.goal)
+            self.engine.set_input("goal", gaussian_2d(self.shape, cj, ci, self.p.goal_sigma, self.p.goal_peak))
+        self.tick = 0
+        self.known = -1  # bit mask of the told obstacles now in the map
+        self.map_base = np.zeros(self.shape, np.float32)
+        self.noise_buf = np.empty(self.shape, np.float32)
+        self.last_wheels = np.zeros(2)
+
+    def _cell(self, x: float, y: float) -> tuple[float, float]:
+        """Continuous field coordinates (j, i) of a point: cell centres are integers."""
+        return y / self.p.cell - 0.5, x / self.p.cell - 0.5
+
+    def _context(self) -> np.ndarray:
+        """-1 on walls and known obstacles, plus map noise (fresh every tick)."""
+        known = 0
+        for k, (_, appear, vanish) in enumerate(self.obstacle_rects):
+            if self.tick >= appear and (vanish is None or self.tick < vanish):
+                known |= 1 << k
+        if known != self.known:
+            self.known = known
+            rects = np.array([r for k, (r, _, _) in enumerate(self.obstacle_rects) if known >> k & 1],
+                             np.float64).reshape(-1, 4)  # fmt: skip
+            blocked = self.walls | occupancy(self.size, self.p.cell, rects, np.zeros((0, 4)))
+            self.map_base = -blocked.astype(np.float32)
+        fill_noise(np.uint64(noise_key(self.seed, self.agent, self.tick, MAP_STREAM)), self.noise_buf.ravel())
+        return self.map_base + np.float32(self.map_noise) * self.noise_buf
+
+    def step(self, perception: dict[str, np.ndarray]) -> np.ndarray:
+        for need in ("position", "compass", "ir"):
+            if need not in perception:
+                raise ValueError("dft needs the position, compass and ir sensors (the epuck has them)")
+        e = self.engine
+        if self.tick % self.p.position_every == 0:
+            x, y = (float(v) for v in perception["position"])
+            cj, ci = self._cell(x, y)
+            e.set_input("position", gaussian_2d(self.shape, cj, ci, self.p.position_sigma, self.position_peak))
+        for d, img in self.iface.heading_images(float(perception["compass"])).items():
+            e.set_input(f"heading_{d}", img)
+        e.set_input("ir", self.iface.ir_image(perception["ir"]))
+        e.set_input("context", self._context())
+        e.step(noise_key(self.seed, self.agent, self.tick, FIELD_STREAM))
+        self.tick += 1
+        left, right = self.iface.wheels({d: e.output(f"A_{d}") for d in EBS})
+        wheels = np.clip(np.array([left, right]) * self.p.wheel_unit, -self.max_wheel, self.max_wheel)
+        self.last_wheels = wheels
+        return wheels
+
+    # ----------------------------------------------------------- review
+
+    def intentions(self) -> dict[str, float]:
+        return {d: float(self.engine.output(f"I_{d}").max()) for d in EBS}
+
+    def snapshot(self) -> dict[str, Any]:
+        return {"tick": self.tick, "fields": self.engine.state(), "params": asdict(self.p)}
+
+    def restore(self, state: dict[str, Any]) -> None:
+        self.tick = int(state["tick"])
+        self.engine.restore(state["fields"])
+        self.known = -1
+
+    def record(self) -> dict[str, np.ndarray]:
+        e = self.engine
+        return {
+            "motivation": np.stack([e.u(f"M_{d}") for d in EBS]),
+            "intention": np.stack([e.u(f"I_{d}") for d in EBS]),
+            "intention_max": np.array([self.intentions()[d] for d in EBS]),
+            "action": np.stack([e.output(f"A_{d}") for d in EBS]),
+        }
