@@ -16,6 +16,7 @@ learns of them only through its proximity sensors' action-field inhibition.
 
 from __future__ import annotations
 
+import time
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -111,7 +112,10 @@ class DftController:
         fill_noise(np.uint64(noise_key(self.seed, self.agent, self.tick, MAP_STREAM)), self.noise_buf.ravel())
         return self.map_base + np.float32(self.map_noise) * self.noise_buf
 
-    def step(self, perception: dict[str, np.ndarray]) -> np.ndarray:
+    def step(self, perception: dict[str, np.ndarray], times: dict[str, float] | None = None) -> np.ndarray:
+        """Wheel speeds (m/s) for this tick; `times`, if given, accumulates seconds per part (swarm bench dft)."""
+        clock = time.perf_counter if times is not None else None
+        t0 = clock() if clock else 0.0
         for need in ("position", "compass", "ir"):
             if need not in perception:
                 raise ValueError("dft needs the position, compass and ir sensors (the epuck has them)")
@@ -124,11 +128,17 @@ class DftController:
             e.set_input(f"heading_{d}", img)
         e.set_input("ir", self.iface.ir_image(perception["ir"]))
         e.set_input("context", self._context())
-        e.step(noise_key(self.seed, self.agent, self.tick, FIELD_STREAM))
+        if clock:
+            t1 = clock()
+            times["sensor inputs"] = times.get("sensor inputs", 0.0) + t1 - t0
+        e.step(noise_key(self.seed, self.agent, self.tick, FIELD_STREAM), times)
         self.tick += 1
+        t0 = clock() if clock else 0.0
         left, right = self.iface.wheels({d: e.output(f"A_{d}") for d in EBS})
         wheels = np.clip(np.array([left, right]) * self.p.wheel_unit, -self.max_wheel, self.max_wheel)
         self.last_wheels = wheels
+        if clock:
+            times["wheels"] = times.get("wheels", 0.0) + clock() - t0
         return wheels
 
     # ----------------------------------------------------------- review

@@ -26,6 +26,7 @@ Conventions (COSIVINA's, docs/dft.md):
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -214,6 +215,7 @@ class _Group:
 
     def __init__(self, shape: tuple[int, ...], fields: list[Field], inputs: list[Input], couplings: list[Coupling]):
         self.shape, self.fields, self.inputs = shape, fields, inputs
+        self.label = "x".join(map(str, shape))
         self.axes = tuple(range(1, len(shape) + 1))
         self.size = int(np.prod(shape))
         fi = {f.name: k for k, f in enumerate(fields)}
@@ -269,9 +271,10 @@ class _Group:
         if len(self.src) == 0:
             self.inp[:] = 0
             return
-        if self.dirty.any():
-            for k in np.flatnonzero(self.dirty):
-                self.ext_spec[k] = self._spectrum(self.images[k].reshape(1, *self.shape))[0].ravel()
+        if self.dirty.any():  # inputs whose image changed: transformed together
+            changed = np.flatnonzero(self.dirty)
+            self.ext_spec[changed] = self._spectrum(self.images[changed].reshape(-1, *self.shape)).reshape(
+                len(changed), -1)  # fmt: skip
             self.dirty[:] = False
         dyn = self._spectrum(self.out.reshape(-1, *self.shape)).reshape(len(self.fields), -1)
         _mac(self.acc, dyn, self.ext_spec, self.src, self.is_ext, self.tgt, self.transfer)
@@ -318,18 +321,30 @@ class Engine:
         grp.images[k] = np.asarray(image, DTYPE).ravel()
         grp.dirty[k] = True
 
-    def step(self, key) -> None:
-        """One step of every field (key: a 64-bit word from noise_key; each field draws its own noise)."""
+    def step(self, key, times: dict[str, float] | None = None) -> None:
+        """One step of every field (key: a 64-bit word from noise_key; each field draws its own noise).
+        `times`, if given, accumulates seconds per shape group: couplings (transforms, kernels, the
+        transforms back, reductions) and fields (the Euler step, noise and outputs)."""
+        clock = time.perf_counter if times is not None else None
+        t0 = clock() if clock else 0.0
         for grp in self.groups:
             grp.uniform[:] = 0
         for (gs, ks, ext), (gt, kt, _), amp, how in self.reductions:
             src = self.groups[gs].images[ks] if ext else self.groups[gs].out[ks]
             value = src.max() if how == "max" else src.sum(dtype=np.float64)
             self.groups[gt].uniform[kt] += DTYPE(amp * value)
-        for grp in self.groups:
+        for g, grp in enumerate(self.groups):
             grp.inputs_from_couplings()
+            if clock:
+                t1 = clock()
+                times[f"couplings {grp.label}"] = times.get(f"couplings {grp.label}", 0.0) + t1 - t0
+                t0 = t1
         for g, grp in enumerate(self.groups):
             grp.update(np.uint64(mix64(np.uint64(key) ^ np.uint64(g + 1))))
+            if clock:
+                t1 = clock()
+                times[f"fields {grp.label}"] = times.get(f"fields {grp.label}", 0.0) + t1 - t0
+                t0 = t1
 
     # ------------------------------------------------------------ access
 
@@ -346,8 +361,7 @@ class Engine:
         return self._view(name, "out")
 
     def input_of(self, name: str) -> np.ndarray:
-        """What the field received from its couplings in the last step (without reductions: those are added
-        in place during the update)."""
+        """Everything the field received in the last step (couplings, inputs and reductions; not the noise)."""
         return self._view(name, "inp")
 
     def state(self) -> dict[str, np.ndarray]:

@@ -1,0 +1,345 @@
+"""The dft controller (Billing et al. 2015): the field engine against direct
+convolution, the field dynamics the paper relies on (one peak over the
+stronger bump, self-stabilised but not self-sustained peaks, back-chaining
+along a shortest route, release and execution, replanning around an
+obstacle), and the robot in the Z-maze, in process and over zenoh."""
+
+from __future__ import annotations
+
+import collections
+import json
+
+import numpy as np
+import pytest
+
+from agents.controllers.dft.architecture import EBS, TRAVEL, spa_architecture
+from agents.controllers.dft.controller import DftController, DftParams
+from agents.controllers.dft.fields import (
+    Architecture,
+    Coupling,
+    Engine,
+    Field,
+    Input,
+    Lateral,
+    fill_noise,
+    gauss_1d,
+    kernel_image,
+)
+from agents.controllers.dft.robot import Interface, gaussian_2d
+from swarm.arena.engine import ArenaEngine
+from swarm.scenario import ScenarioError, load_scenario, parse_scenario_text
+from tests.arena_helpers import arena, box
+
+# ------------------------------------------------------------------ engine
+
+
+def test_gaussian_kernels_are_normalised_and_truncated_at_five_sigma():
+    g = gauss_1d(100, 2.0)
+    assert g.sum() == pytest.approx(1.0)
+    assert np.count_nonzero(g) == 21  # +-ceil(5 sigma) cells
+    assert gauss_1d(100, 12.0).sum() == pytest.approx(1.0)  # capped at half the axis
+
+
+def test_couplings_in_the_frequency_domain_equal_direct_circular_convolution():
+    shape = (12, 16)
+    arch = Architecture(
+        (Field("a", shape, 5, -5, 4), Field("b", shape, 5, -5, 4, lateral=Lateral(3.0, 1.0, 1.0, 2.0, -0.1))),
+        (Input("s", shape),),
+        (Coupling("a", "b", 2.0, 1.5, (2, -3)), Coupling("s", "b", -1.0, None, (1, 0)), Coupling("s", "a", 0.5)),
+    )
+    e = Engine(arch)
+    rng = np.random.default_rng(0)
+    stim = rng.normal(size=shape)
+    e.set_input("s", stim)
+    e.groups[0].u[:] = rng.normal(size=e.groups[0].u.shape).astype(np.float32)
+    e.groups[0]._outputs()
+    fa, fb = e.output("a").astype(np.float64), e.output("b").astype(np.float64)
+    e.groups[0].inputs_from_couplings()
+
+    def conv(x, k):
+        out = np.zeros(shape)
+        for q in np.ndindex(shape):
+            out += x[q] * np.roll(k, q, axis=(0, 1))
+        return out
+
+    from agents.controllers.dft.fields import lateral_image
+
+    want_b = (conv(fa, kernel_image(shape, 2.0, 1.5, (2, -3))) + conv(stim, kernel_image(shape, -1.0, None, (1, 0)))
+              + conv(fb, lateral_image(shape, Lateral(3.0, 1.0, 1.0, 2.0, -0.1))))  # fmt: skip
+    np.testing.assert_allclose(e.input_of("b"), want_b, atol=2e-5)
+    np.testing.assert_allclose(e.input_of("a"), 0.5 * stim, atol=2e-5)
+
+
+def test_a_shift_moves_activity_by_its_cells():
+    shape = (20, 20)
+    e = Engine(Architecture((Field("b", shape, 5, -5, 4),), (Input("s", shape),), (Coupling("s", "b", 1.0, None, (3, -2)),)))
+    img = np.zeros(shape)
+    img[5, 5] = 1.0
+    e.set_input("s", img)
+    e.groups[0].inputs_from_couplings()
+    assert np.unravel_index(np.argmax(e.input_of("b")), shape) == (8, 3)
+
+
+def test_an_architecture_that_cannot_be_stepped_is_refused_in_one_line():
+    a, b = Field("a", (10,), 5, -5, 4), Field("b", (10, 10), 5, -5, 4)
+    with pytest.raises(ValueError, match="joins shapes"):
+        Engine(Architecture((a, b), (), (Coupling("a", "b", 1.0),)))
+    with pytest.raises(ValueError, match="must be a field or input"):
+        Engine(Architecture((a,), (), (Coupling("x", "a", 1.0),)))
+    Engine(Architecture((a, b), (), (Coupling("b", "a", 1.0, reduce="max"),)))  # a reduction joins any shapes
+
+
+def test_field_noise_is_standard_and_keyed():
+    a, b = np.empty(200_000, np.float32), np.empty(200_000, np.float32)
+    fill_noise(np.uint64(7), a)
+    fill_noise(np.uint64(7), b)
+    np.testing.assert_array_equal(a, b)
+    assert abs(a.mean()) < 0.01 and a.std() == pytest.approx(1.0, abs=0.01)
+    fill_noise(np.uint64(8), b)
+    assert np.corrcoef(a, b)[0, 1] < 0.01
+
+
+# ------------------------------------------------------- field dynamics
+
+
+def _selection_field(n=100):
+    """A 1D field with local excitation, broader inhibition and global inhibition (Figure 1)."""
+    return Engine(Architecture((Field("u", (n,), 5, -5, 4, 0.5, Lateral(20.0, 3.0, 10.0, 8.0, -0.5)),),
+                               (Input("s", (n,)),), (Coupling("s", "u", 1.0),)))  # fmt: skip
+
+
+def test_two_bumps_make_one_peak_over_the_stronger():
+    e = _selection_field()
+    x = np.arange(100)
+    e.set_input("s", 6.5 * np.exp(-((x - 30) ** 2) / 18) + 5.5 * np.exp(-((x - 70) ** 2) / 18))
+    for t in range(300):
+        e.step(np.uint64(t))
+    u = e.u("u")
+    assert u[25:36].max() > 0  # a peak over the stronger bump
+    assert u[60:81].max() < 0  # the weaker one is suppressed, though its input alone would lift it
+    assert (u > 0).sum() < 15  # one localised peak
+
+
+def test_a_motivation_peak_is_self_stabilised_but_not_self_sustained():
+    shape = (40, 40)
+    lat = spa_architecture(shape).fields[0].lateral  # the M fields' kernel
+    e = Engine(Architecture((Field("m", shape, 5, -5, 4, 1.0, lat),), (Input("s", shape),),
+                            (Coupling("s", "m", 1.0),)))  # fmt: skip
+    e.set_input("s", gaussian_2d(shape, 20, 20, 3.0, 4.5))  # alone it would leave the field at -0.5
+    centre = []
+    for t in range(250):
+        e.step(np.uint64(t))
+        centre.append(float(e.u("m")[20, 20]))
+    assert min(centre[100:]) > 1.5  # the lateral excitation lifts a peak and holds it through the noise
+    assert (e.u("m") > 0).sum() < 60  # localised
+    e.set_input("s", np.zeros(shape))  # the input goes: the peak decays
+    for t in range(250, 350):
+        e.step(np.uint64(t))
+    assert e.u("m").max() < -2.0
+
+
+def _bfs(free: np.ndarray, goal) -> np.ndarray:
+    d = np.full(free.shape, -1)
+    d[goal] = 0
+    q = collections.deque([goal])
+    while q:
+        j, i = q.popleft()
+        for dj, di in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+            a, b = j + dj, i + di
+            if 0 <= a < free.shape[0] and 0 <= b < free.shape[1] and free[a, b] and d[a, b] < 0:
+                d[a, b] = d[j, i] + 1
+                q.append((a, b))
+    return d
+
+
+SHAPE = (60, 60)
+GOAL = (30, 48)
+
+
+def _two_route_map() -> np.ndarray:
+    """A 60 x 60 cell map: the border of the original code and a wall down the middle with gaps at both ends."""
+    walls = np.zeros(SHAPE, bool)
+    walls[:6] = walls[-5:] = True
+    walls[:, :5] = walls[:, -6:] = True
+    walls[12:48, 27:33] = True
+    return walls
+
+
+def _planner(walls, position=None) -> Engine:
+    e = Engine(spa_architecture(SHAPE))
+    e.set_input("goal", gaussian_2d(SHAPE, *GOAL, 3.0, 10.0))
+    e.set_input("context", -walls.astype(np.float32))
+    if position is not None:
+        e.set_input("position", gaussian_2d(SHAPE, *position, 3.0, 1.0))
+    return e
+
+
+def _motivation(e: Engine) -> np.ndarray:
+    return np.max([e.u(f"M_{d}") for d in EBS], axis=0)
+
+
+def test_back_chaining_reaches_the_start_later_on_longer_paths_along_a_shortest_route():
+    """The wave moves in steps of delta (5 cells: M -> P and P -> M are both shifted), so its front is a
+    chain of islands that fill in later; the route is measured in the covered cells, bridged over gaps of
+    up to delta (a closing) and kept off the walls."""
+    from scipy.ndimage import binary_closing, binary_dilation
+
+    walls = _two_route_map()
+    free = _bfs(~binary_dilation(walls, iterations=2), GOAL)  # path lengths with 2 cells of clearance
+    starts = [(50, 40), (10, 15), (36, 10)]  # 28, 55 and 72 cells from the goal
+    arrived = {}
+    e = _planner(walls)
+    reached = np.zeros(SHAPE, bool)  # cells the supra-threshold motivation has covered so far
+    for t in range(400):
+        e.step(np.uint64(1000 + t))
+        reached |= _motivation(e) > 0
+        for s in starts:
+            if s not in arrived and reached[s]:
+                bridged = binary_closing(reached, np.ones((7, 7), bool)) & ~walls
+                arrived[s] = (t, _bfs(bridged, GOAL)[s])  # the shortest way inside what the wave covered
+    assert set(arrived) == set(starts)
+    times = [arrived[s][0] for s in starts]
+    assert times == sorted(times) and times[-1] > 2 * times[0]
+    for s in starts:
+        # a shortest route, within 10% (it may hug the walls closer than the 2-cell clearance of the reference)
+        assert 0.85 * free[s] <= arrived[s][1] <= 1.1 * free[s], (s, arrived[s], free[s])
+
+
+def _intention_near(e: Engine, where, d: str, radius: int = 8) -> float:
+    j, i = where
+    return float(e.output(f"I_{d}")[j - radius : j + radius + 1, i - radius : i + radius + 1].max())
+
+
+def test_an_obstacle_on_the_active_route_makes_its_motivation_decay_and_the_other_route_win():
+    walls = _two_route_map()
+    start = (36, 10)  # nearer the north gap
+    e = _planner(walls, position=start)
+    for t in range(400):
+        e.step(np.uint64(2000 + t))
+    gap_north = (slice(49, 54), slice(27, 33))
+    assert _intention_near(e, start, "N") > 0.9 and _intention_near(e, start, "S") < 0.1
+    assert _motivation(e)[gap_north].max() > 0
+    blocked = walls.copy()
+    blocked[48:55, 27:33] = True
+    e.set_input("context", -blocked.astype(np.float32))
+    for t in range(400, 550):
+        e.step(np.uint64(2000 + t))
+    assert _motivation(e)[gap_north].max() < 0  # the cut route's motivation decays
+    for t in range(550, 1000):
+        e.step(np.uint64(2000 + t))
+    assert _intention_near(e, start, "S") > 0.9 and _intention_near(e, start, "N") < 0.1
+
+
+def test_release_raises_an_intention_ahead_the_robot_moves_and_satisfaction_forms_at_the_next_place():
+    scenario = arena('[[group]]\ncount = 1\ncontroller = "dft"\nstart = [0.15, 0.25, 0.0]\ngoal = [0.4, 0.25]\n',
+                     w=0.55, h=0.5, max_ticks=800)  # fmt: skip
+    engine = ArenaEngine(scenario)
+    c = engine.controllers[0]
+    seen_intention = seen_satisfaction = False
+    for _ in range(800):
+        engine.step()
+        x, y, _ = engine.world.pose[0]
+        here = (y / 0.01 - 0.5, x / 0.01 - 0.5)
+        f_i = c.engine.output("I_E")
+        if f_i.max() > 0.5:
+            j, i = np.unravel_index(np.argmax(f_i), f_i.shape)
+            if not seen_intention and abs(j - here[0]) < 4 and 2 < i - here[1] < 10:
+                seen_intention = True  # the intention peak lies just east of the robot, where it will go
+        if seen_intention and c.engine.u("C_E")[f_i.shape[0] // 2 - 5 : f_i.shape[0] // 2 + 5].max() > 0:
+            seen_satisfaction = True
+        if engine.world.done():
+            break
+    assert seen_intention and seen_satisfaction
+    robot = engine.summary()["robots"][0]
+    assert robot["reached"] and robot["distance"] > 0.2
+
+
+# ------------------------------------------------------------- the robot
+
+
+def test_the_e_puck_interface_follows_the_original_code():
+    iface = Interface()
+    lw, rw = iface.wheel_profiles()
+    assert (round(lw[49], 1), round(rw[49], 1)) == (416.5, 433.0)  # cell 50 (1-based), as parameters.md says
+    head = iface.heading_images(np.pi / 2)  # facing north: the north action field's input peaks at cell 50
+    assert int(np.argmax(head["N"])) == 49 and head["N"].max() == pytest.approx(4.0)
+    assert int(np.argmax(head["E"])) > 49  # east lies to the robot's right: cells above 50
+    ir = iface.ir_image(np.array([1000.0, 0, 0, 0, 0, 0, 0, 0]))  # ps0, front right
+    assert int(np.argmax(ir)) == 54 and ir.max() == pytest.approx(5 * np.log1p(1000 / 50))
+    one = {d: np.zeros(100) for d in EBS}
+    one["N"][60] = 1.0  # a peak right of straight ahead turns the robot right
+    left, right = iface.wheels(one)
+    assert left > right and abs(left - right) <= 400
+
+
+def test_the_robot_reaches_its_goal_in_the_z_maze():
+    s = load_scenario("zmaze").with_overrides(controller="dft", noise="low", seed=1)
+    summary = ArenaEngine(s).run()
+    r = summary["robots"][0]
+    assert r["reached"] and r["collisions"] == 0
+    assert 1.0 <= r["path_ratio"] < 1.3
+    assert 150 < r["ticks_to_goal"] < 1200  # it plans first (about 200 steps in the paper), then drives
+
+
+def test_snapshot_and_restore_continue_bit_for_bit():
+    s = load_scenario("zmaze").with_overrides(controller="dft", noise="high", max_ticks=260)
+    engine = ArenaEngine(s)
+    engine.step(220)
+    state = json.loads(json.dumps(engine.controllers[0].snapshot(), default=lambda a: a.tolist()))
+    perceptions = [engine.world.perceive_all()[0] for _ in range(1)]
+    twin = DftController()
+    from swarm.arena.scenario import controller_params
+
+    twin.reset(s.seed, 0, controller_params(s, 0))
+    twin.restore(state)
+    for _ in range(30):
+        np.testing.assert_array_equal(engine.controllers[0].step(perceptions[0]), twin.step(perceptions[0]))
+    np.testing.assert_array_equal(engine.controllers[0].engine.u("M_N"), twin.engine.u("M_N"))
+
+
+def test_told_obstacles_enter_the_map_while_present():
+    body = ('[[obstacle]]\nrect = [0.3, 0.3, 0.4, 0.4]\nappear = 5\nvanish = 10\n'
+            '[[group]]\ncount = 1\ncontroller = "dft"\nstart = [0.15, 0.15, 0.0]\ngoal = [0.8, 0.8]\n')  # fmt: skip
+    scenario = arena(body, max_ticks=20)
+    engine = ArenaEngine(scenario)
+    c = engine.controllers[0]
+    inside = (35, 35)
+    seen = []
+    for _ in range(12):
+        engine.step()
+        seen.append(c.map_base[inside])
+    assert seen[:5] == [0.0] * 5 and seen[5:10] == [-1.0] * 5 and seen[10:] == [0.0] * 2
+    unknown = parse_scenario_text(box(body + '[dft]\nobstacles = "unknown"\n', max_ticks=20), "u.toml")
+    engine = ArenaEngine(unknown)
+    engine.step(8)
+    assert engine.controllers[0].map_base[inside] == 0.0
+
+
+def test_a_bad_dft_table_is_refused_in_one_line():
+    with pytest.raises(ValueError, match=r"\[dft\]: unknown field 'speed'"):
+        DftParams.from_table({"speed": 1})
+    with pytest.raises(ValueError, match="obstacles is 'told' or 'unknown'"):
+        DftParams.from_table({"obstacles": "psychic"})
+    with pytest.raises(ScenarioError, match="dft"):
+        parse_scenario_text(box('[[group]]\ncount = 1\ncontroller = "dft"\n[dft]\ncell = "big"\n'), "bad.toml")
+    with pytest.raises(ScenarioError, match="ir"):  # the animat has no IR sensors
+        parse_scenario_text(box('[[group]]\ncount = 1\ncontroller = "dft"\nrobot = "animat"\n', w=3, h=3), "a.toml")
+
+
+def test_travel_directions_match_the_shifts():
+    """The north EB back-chains southwards: its motivation spreads opposite its travel."""
+    assert TRAVEL["N"] == (1, 0) and TRAVEL["E"] == (0, 1)
+
+
+# ------------------------------------------------------------ distributed
+
+
+def test_lockstep_dft_equals_in_process_bit_for_bit():
+    from tests.distributed import run_world
+
+    scenario = load_scenario("zmaze").with_overrides(controller="dft", noise="high", seed=2, max_ticks=240)
+    engine = ArenaEngine(scenario)
+    expected = engine.run()
+    summary, world = run_world(scenario, "dft-lockstep", [("dft", 1, 1)], deadline=60.0)
+    np.testing.assert_array_equal(world.pose, engine.world.pose)
+    assert summary["robots"] == expected["robots"] and summary["rejected_messages"] == 0
