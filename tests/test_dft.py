@@ -72,7 +72,8 @@ def test_couplings_in_the_frequency_domain_equal_direct_circular_convolution():
 
 def test_a_shift_moves_activity_by_its_cells():
     shape = (20, 20)
-    e = Engine(Architecture((Field("b", shape, 5, -5, 4),), (Input("s", shape),), (Coupling("s", "b", 1.0, None, (3, -2)),)))
+    shifted = Coupling("s", "b", 1.0, None, (3, -2))
+    e = Engine(Architecture((Field("b", shape, 5, -5, 4),), (Input("s", shape),), (shifted,)))
     img = np.zeros(shape)
     img[5, 5] = 1.0
     e.set_input("s", img)

@@ -24,6 +24,11 @@ HEADING = {"N": math.pi / 2, "S": 3 * math.pi / 2, "W": math.pi, "E": 0.0}
 OPPOSITE = {"N": "S", "S": "N", "W": "E", "E": "W"}
 ORTHOGONAL = {"N": ("W", "E"), "S": ("W", "E"), "W": ("N", "S"), "E": ("N", "S")}
 ANGLES = 100  # cells of the action and proximity fields over [-pi, pi)
+# Lateral kernels of the EB fields (c_exc, s_exc, c_inh, s_inh): the code and Table 2 agree.
+LATERAL_M = Lateral(7.0, 2.0, 2.0, 4.0)
+LATERAL_P = Lateral(4.0, 2.0, 2.0, 4.0)
+LATERAL_I = Lateral(9.0, 2.0)
+LATERAL_C = Lateral(2.0, 2.0, 2.0, 4.0)
 
 
 @dataclass(frozen=True)
@@ -34,10 +39,10 @@ class SpaParams:
     h: float = -5.0
     beta: float = 4.0
     field_noise: float = 1.0
-    lateral_m: Lateral = Lateral(7.0, 2.0, 2.0, 4.0)
-    lateral_p: Lateral = Lateral(4.0, 2.0, 2.0, 4.0)
-    lateral_i: Lateral = Lateral(9.0, 2.0)
-    lateral_c: Lateral = Lateral(2.0, 2.0, 2.0, 4.0)
+    lateral_m: Lateral = LATERAL_M
+    lateral_p: Lateral = LATERAL_P
+    lateral_i: Lateral = LATERAL_I
+    lateral_c: Lateral = LATERAL_C
     shift: int = 5  # delta, cells
     sigma: float = 2.0  # kernel of the Gaussian couplings
     c1: float = 12.0  # M -> P, shifted backward

@@ -333,7 +333,7 @@ class Engine:
             src = self.groups[gs].images[ks] if ext else self.groups[gs].out[ks]
             value = src.max() if how == "max" else src.sum(dtype=np.float64)
             self.groups[gt].uniform[kt] += DTYPE(amp * value)
-        for g, grp in enumerate(self.groups):
+        for grp in self.groups:
             grp.inputs_from_couplings()
             if clock:
                 t1 = clock()
