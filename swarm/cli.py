@@ -23,6 +23,7 @@ from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled
 
 CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
 FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize", "fingerprint-together")
+DFT_EXPERIMENTS = ("dft-case1", "dft-case2", "dft-case3")
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -107,7 +108,12 @@ def build_parser() -> argparse.ArgumentParser:
         "; fingerprint-calibrate | fingerprint-map | fingerprint-localize: topological mapping and "
         "localization with fingerprints of places on office (Tapus et al. 2006)"
     )
-    exp.add_argument("name", choices=[*EXPERIMENTS, "carrot", *FINGERPRINT_EXPERIMENTS], metavar="NAME",
+    names_help += (
+        "; dft-case1 | dft-case2 | dft-case3: the dft controller (Billing et al. 2015) in zmaze and large-maze "
+        "beside follow the carrot, and replanning round an obstacle"
+    )
+    exp.add_argument("name", choices=[*EXPERIMENTS, "carrot", *FINGERPRINT_EXPERIMENTS, *DFT_EXPERIMENTS],
+                     metavar="NAME",
                      help=names_help)  # fmt: skip
     exp.add_argument(
         "--scenario",
@@ -115,6 +121,9 @@ def build_parser() -> argparse.ArgumentParser:
         "'mapping' and 'localize' routes and place zones (default office)",
     )
     exp.add_argument("--reps", type=_positive, help="runs per configuration (default per experiment)")
+    exp.add_argument("--noise", choices=["none", "low", "high"], help="dft-*: only the conditions at this noise level")
+    exp.add_argument("--max-steps", type=_positive, metavar="T",
+                     help="dft-*: run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)")
     exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
     exp.add_argument("--seed", type=_seed, default=0, help="first seed (runs use seed..seed+reps-1)")
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
@@ -495,6 +504,16 @@ def cmd_experiment(args) -> int:
         print(f"wrote {result['out']}/runs.csv, table.md" + ("" if args.name.endswith("calibrate") else
                                                              ", summary.csv, plot.png"))  # fmt: skip
         return 0
+    if args.name in DFT_EXPERIMENTS:
+        from swarm.arena.dft_experiments import run_dft_experiment
+
+        result = run_dft_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
+                                    noise=args.noise, max_ticks=args.max_steps)  # fmt: skip
+        print(result["markdown"])
+        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
+        return 0
+    if args.noise or args.max_steps:
+        raise ScenarioError("command line", "--noise/--max-steps", "these are for the dft-* experiments")
     if args.name == "carrot":
         from swarm.arena.experiments import run_carrot_experiment
 

@@ -29,7 +29,7 @@ SCENARIOS = ("zmaze", "large-maze")
 PAIR_STREAM = 0x50414952
 LARGE_HEADING = 4.983
 CLEARANCE = 0.04
-RUN_FIELDS = ["scenario", "noise", "pair", "start_x", "start_y", "goal_x", "goal_y", "reached", "ticks",
+RUN_FIELDS = ["scenario", "controller", "noise", "pair", "start_x", "start_y", "goal_x", "goal_y", "reached", "ticks",
               "ticks_to_goal", "path_length", "optimal_length", "path_ratio", "collisions", "wall_seconds"]  # fmt: skip
 # The paper reports these results as bar charts only (Figures 7, 8; not available to us) and, in
 # its text, F of a one-way ANOVA over all five conditions (SPA and FTC) of path length.
@@ -69,14 +69,19 @@ def random_pairs(name: str, count: int, seed: int) -> list[tuple[int, float, flo
 
 
 def run_pair(job: tuple) -> dict:
+    """One start/goal run: (scenario, noise, pair, sx, sy, gx, gy, heading, seed[, controller, max_ticks])."""
     from swarm.arena.engine import ArenaEngine
     from swarm.scenario import load_scenario
 
-    name, noise, pair, sx, sy, gx, gy, heading, seed = job
-    s = load_scenario(name).with_overrides(start=(sx, sy, heading), goal=(gx, gy), noise=noise, seed=seed)
+    name, noise, pair, sx, sy, gx, gy, heading, seed, *rest = job
+    controller = rest[0] if rest else "carrot"
+    max_ticks = rest[1] if len(rest) > 1 else None
+    s = load_scenario(name).with_overrides(start=(sx, sy, heading), goal=(gx, gy), noise=noise, seed=seed,
+                                           controller=controller, max_ticks=max_ticks)  # fmt: skip
     summary = ArenaEngine(s).run()
     r = summary["robots"][0]
-    return {"scenario": name, "noise": noise, "pair": pair, "start_x": sx, "start_y": sy, "goal_x": gx, "goal_y": gy,
+    return {"scenario": name, "controller": controller, "noise": noise, "pair": pair, "start_x": sx, "start_y": sy,
+            "goal_x": gx, "goal_y": gy,
             "reached": r["reached"], "ticks": summary["ticks"], "ticks_to_goal": r["ticks_to_goal"],
             "path_length": r["path_length"], "optimal_length": r["optimal_length"], "path_ratio": r["path_ratio"],
             "collisions": r["collisions"], "wall_seconds": summary["wall_seconds"]}  # fmt: skip
