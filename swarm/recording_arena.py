@@ -13,6 +13,8 @@ Layout (timeline `tick`; the record at tick t shows the world after tick t):
     world/trajectories    line strips of every robot's path so far (logged at each flush)
     world/plans/<agent>   the path a controller planned (in process from its record(); distributed, sent
                           by its agent process on swarm/<run>/plans/<group>)
+    world/optimum/<agent> static: the A* optimum from the robot's start to its goal (L_o; not for routes)
+    fields/<agent>/…      a dft controller's fields and intentions (in process; swarm/recording_fields.py)
     world/map/<agent>/…,  a controller's topological map over the floor plan, its belief and current
     map/<agent>/…         fingerprint (in process; swarm/recording_topomap.py)
     metrics/<name>        reached, collisions, distance, agents_alive, tick_ms, rejected_messages
@@ -101,6 +103,7 @@ class ArenaRecorder:
         self._obstacles_on: tuple | None = None
         self._plans_logged: set[int] = set()
         self._maps = None
+        self._fields = None
         self._published = None
         self._static_done = False
 
@@ -166,6 +169,24 @@ class ArenaRecorder:
             )
         rec.log("world/robots", rr.Points2D.from_fields(radii=w.radius.astype(np.float32), colors=self.colours,
                                                         draw_order=5.0), static=True)  # fmt: skip
+        self._log_optimum(goals)
+
+    def _log_optimum(self, robots) -> None:
+        """The A* optimum (1 cm, 4 cm clearance: L_o) from each robot's start to its goal, for robots
+        driving to one goal (not a route)."""
+        from swarm.arena.engine import _planner
+
+        w, s = self.world, self.world.scenario
+        routed = [g.route is not None for g in s.groups for _ in range(g.count)]
+        planner = None
+        for a in robots:
+            if routed[a]:
+                continue
+            planner = planner or _planner(s.size, s.walls)
+            length, points = planner.plan(tuple(w.start_pose[a, :2]), tuple(w.goal[a]))
+            if np.isfinite(length) and len(points) > 1:
+                strip = self.rr.LineStrips2D([flip(points)], colors=[(160, 160, 160)], radii=0.0015, draw_order=2.5)
+                self.rec.log(f"world/optimum/{a}", strip, static=True)
 
     # -------------------------------------------------------------------- ticks
 
@@ -194,6 +215,7 @@ class ArenaRecorder:
         if self.controllers is not None:
             self._log_plans(tick)
             self._log_maps(tick)
+            self._log_fields(tick)
         if len(self._ticks) >= self.flush_every:
             self.flush()
 
@@ -225,6 +247,17 @@ class ArenaRecorder:
 
                 self._maps = MapLog(self.rr, self.rec, self.colours)
             self._maps.capture(tick, a, c.record(), self.world.pose[a, :2])
+
+    def _log_fields(self, tick: int) -> None:
+        """The neural fields of each controller that keeps them (swarm.recording_fields)."""
+        for a, c in enumerate(self.controllers):
+            if not getattr(c, "keeps_fields", False):
+                continue
+            if self._fields is None:
+                from swarm.recording_fields import FieldLog
+
+                self._fields = FieldLog(self.rr, self.rec)
+            self._fields.capture(tick, a, c.record())
 
     def log_published_map(self, tick: int, agent: int, data) -> None:
         """Distributed: a robot's map from its publication on the map key space."""
@@ -282,6 +315,8 @@ class ArenaRecorder:
                              columns=rr.Scalars.columns(scalars=values).partition([n] * len(ticks)))  # fmt: skip
             self._robots[name] = []
         self._paths = paths = np.concatenate([self._paths, pose[..., :2].transpose(1, 0, 2)], axis=1)
+        if self._fields is not None:
+            self._fields.flush()
         rec.set_time("tick", sequence=int(ticks[-1]))
         rec.log("world/trajectories", rr.LineStrips2D([flip(p) for p in paths], colors=self.colours, radii=0.002,
                                                       draw_order=4.0))  # fmt: skip

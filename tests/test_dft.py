@@ -344,3 +344,22 @@ def test_lockstep_dft_equals_in_process_bit_for_bit():
     summary, world = run_world(scenario, "dft-lockstep", [("dft", 1, 1)], deadline=60.0)
     np.testing.assert_array_equal(world.pose, engine.world.pose)
     assert summary["robots"] == expected["robots"] and summary["rejected_messages"] == 0
+
+
+def test_a_recording_holds_the_fields_the_intentions_and_the_optimum(tmp_path):
+    from rerun.chunk import RrdReader
+
+    from swarm.recording_arena import ArenaRecorder
+
+    s = load_scenario("zmaze").with_overrides(controller="dft", max_ticks=60)
+    engine = ArenaEngine(s)
+    path = tmp_path / "dft.rrd"
+    recorder = ArenaRecorder(path, engine.world, {"run_id": "dft"}, controllers=engine.controllers)
+    recorder.close(engine.run(recorder=recorder))
+    rows: dict[str, int] = {}
+    for chunk in RrdReader(path).stream():
+        rows[chunk.entity_path.lstrip("/")] = rows.get(chunk.entity_path.lstrip("/"), 0) + chunk.num_rows
+    for d in EBS:
+        assert rows[f"fields/0/M/{d}"] == rows[f"fields/0/I/{d}"] == 3  # ticks 0, 20, 40
+        assert rows[f"fields/0/intention/{d}"] == rows[f"fields/0/action/{d}"] == 60
+    assert rows["world/optimum/0"] == 1
