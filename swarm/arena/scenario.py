@@ -705,6 +705,7 @@ def controller_params(s: ArenaScenario, agent: int) -> dict[str, Any]:
             "max_speed": m.max_speed,
             "max_turn_rate": m.max_turn_rate,
             "laser_range": m.sensors.laser.range if m.sensors.laser else None,
+            "ir_bearings": list(m.sensors.ir.bearings) if m.sensors.ir else None,
         },
         "control_period": s.control_period,
         "noise": s.noise.level,

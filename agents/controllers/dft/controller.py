@@ -10,8 +10,11 @@ robot already turns and drives where an intention has formed.
 Obstacles.  The robot's map is the scenario's static walls.  With
 `obstacles = "told"` (the paper's case 3) the map also holds every scheduled
 obstacle while it is present, as the original supervisor wrote it into the
-map when it appeared and cleared it when it went.  With "unknown" the robot
-learns of them only through its proximity sensors' action-field inhibition.
+map when it appeared and cleared it when it went.  With "sensed" the robot
+marks on its map what its proximity sensors meet off the map, and shares it
+with the other dft robots over swarm/<run>/context/** (context.py).  With
+"unknown" obstacles reach it only through the action fields' proximity
+inhibition.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from agents.controllers.dft.architecture import EBS, SpaParams, spa_architecture
+from agents.controllers.dft.context import SensedContext
 from agents.controllers.dft.fields import Engine, fill_noise, noise_key
 from agents.controllers.dft.robot import Interface, gaussian_2d
 from agents.controllers.navigation.astar import occupancy
@@ -41,15 +45,19 @@ class DftParams:
     position_sigma: float = 3.0  # robot position image (peak 1, 1.2 at high noise), into C with gain c8
     position_every: int = 2  # ticks between position readings used (the original got one per 128 ms)
     wheel_unit: float = 0.1288e-3  # m/s per e-puck wheel unit (1000 steps/s = 12.88 cm/s)
-    obstacles: str = "told"  # told | unknown
+    obstacles: str = "told"  # told | sensed | unknown
+    sense_margin: float = 0.03  # sensed: a point this close to a wall of the map is the wall
+    mark_radius: float = 0.02  # sensed: the disc a point marks
+    memory: int = 300  # sensed: ticks a mark lasts unless seen again (about 19 s)
+    min_reading: float = 120.0  # sensed: IR readings from this up count (about 5 cm from the rim)
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> DftParams:
-        p = params_from_table(cls, table, "dft", ints=("border", "position_every"), texts=("obstacles",))
-        if p.obstacles not in ("told", "unknown"):
-            raise ValueError(f"[dft]: obstacles is 'told' or 'unknown', not {p.obstacles!r}")
-        if p.cell <= 0 or p.position_every < 1 or p.border < 0:
-            raise ValueError("[dft]: cell must be > 0, position_every >= 1 and border >= 0")
+        p = params_from_table(cls, table, "dft", ints=("border", "position_every", "memory"), texts=("obstacles",))
+        if p.obstacles not in ("told", "sensed", "unknown"):
+            raise ValueError(f"[dft]: obstacles is 'told', 'sensed' or 'unknown', not {p.obstacles!r}")
+        if p.cell <= 0 or p.position_every < 1 or p.border < 0 or p.memory < 1:
+            raise ValueError("[dft]: cell must be > 0, position_every and memory >= 1, border >= 0")
         return p
 
 
@@ -84,6 +92,14 @@ class DftController:
         self.map_noise = MAP_NOISE[self.noise_level]
         self.position_peak = 1.2 if self.noise_level == "high" else 1.0
         self.engine = Engine(spa_architecture(self.shape, SpaParams()))
+        self.sensed: SensedContext | None = None
+        self.shares = None
+        self.received = 0  # cells other robots marked that reached this one
+        if self.p.obstacles == "sensed":
+            self.sensed = SensedContext(walls, self.p.cell, float(robot["radius"]), robot["ir_bearings"],
+                                        self.p.sense_margin, self.p.mark_radius, self.p.memory,
+                                        self.p.min_reading)  # fmt: skip
+            self.shares = "context"
         goal = params.get("goal")
         self.goal = None if goal is None else (float(goal[0]), float(goal[1]))
         if self.goal is not None:
@@ -105,11 +121,13 @@ class DftController:
         for k, (_, appear, vanish) in enumerate(self.obstacle_rects):
             if self.tick >= appear and (vanish is None or self.tick < vanish):
                 known |= 1 << k
-        if known != self.known:
+        if known != self.known or self.sensed is not None:
             self.known = known
             rects = np.array([r for k, (r, _, _) in enumerate(self.obstacle_rects) if known >> k & 1],
                              np.float64).reshape(-1, 4)  # fmt: skip
-            blocked = self.walls | occupancy(self.size, self.p.cell, rects, np.zeros((0, 4)))
+            blocked = self.walls | occupancy(self.size, self.p.cell, rects, np.zeros((0, 4))) if known else self.walls
+            if self.sensed is not None:
+                blocked = blocked | self.sensed.blocked(self.tick)
             self.map_base = -blocked.astype(np.float32)
         fill_noise(np.uint64(noise_key(self.seed, self.agent, self.tick, MAP_STREAM)), self.noise_buf.ravel())
         return self.map_base + np.float32(self.map_noise) * self.noise_buf
@@ -129,6 +147,8 @@ class DftController:
         for d, img in self.iface.heading_images(float(perception["compass"])).items():
             e.set_input(f"heading_{d}", img)
         e.set_input("ir", self.iface.ir_image(perception["ir"]))
+        if self.sensed is not None:
+            self.sensed.sense(perception["position"], float(perception["compass"]), perception["ir"], self.tick)
         e.set_input("context", self._context())
         if clock:
             t1 = clock()
@@ -143,17 +163,38 @@ class DftController:
             times["wheels"] = times.get("wheels", 0.0) + clock() - t0
         return wheels
 
+    # ------------------------------------------------------------ sharing
+
+    def publish(self) -> dict[str, Any] | None:
+        """What this robot marked and cleared in its last step (sensed obstacles only)."""
+        return None if self.sensed is None else self.sensed.publish(self.tick - 1)
+
+    def receive(self, sender: int, data: Any) -> None:
+        """Another robot's marks (ValueError if malformed)."""
+        if self.sensed is not None:
+            self.sensed.receive(data)
+            self.received += len(data["marked"]) // 2
+
+    def summary(self) -> dict[str, Any]:
+        if self.sensed is None:
+            return {}
+        return {"context": {"marked_now": int(self.sensed.blocked(self.tick).sum()), "received": self.received}}
+
     # ----------------------------------------------------------- review
 
     def intentions(self) -> dict[str, float]:
         return {d: float(self.engine.output(f"I_{d}").max()) for d in EBS}
 
     def snapshot(self) -> dict[str, Any]:
-        return {"tick": self.tick, "fields": self.engine.state(), "params": asdict(self.p)}
+        return {"tick": self.tick, "fields": self.engine.state(), "params": asdict(self.p), "received": self.received,
+                "context": None if self.sensed is None else self.sensed.snapshot()}  # fmt: skip
 
     def restore(self, state: dict[str, Any]) -> None:
         self.tick = int(state["tick"])
         self.engine.restore(state["fields"])
+        self.received = int(state.get("received", 0))
+        if self.sensed is not None and state.get("context") is not None:
+            self.sensed.restore(state["context"])
         self.known = -1
 
     def record(self) -> dict[str, np.ndarray]:
