@@ -23,7 +23,7 @@ from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled
 
 CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
 FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize", "fingerprint-together")
-DFT_EXPERIMENTS = ("dft-case1", "dft-case2", "dft-case3")
+DFT_EXPERIMENTS = ("dft-case1", "dft-case2", "dft-case3", "dft-together")
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -112,7 +112,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     names_help += (
         "; dft-case1 | dft-case2 | dft-case3: the dft controller (Billing et al. 2015) in zmaze and large-maze "
-        "beside follow the carrot, and replanning round an obstacle"
+        "beside follow the carrot, and replanning round an obstacle; dft-together: a scout shares the obstacle "
+        "it meets over the context key space"
     )
     exp.add_argument("name", choices=[*EXPERIMENTS, "carrot", *FINGERPRINT_EXPERIMENTS, *DFT_EXPERIMENTS],
                      metavar="NAME",

@@ -363,3 +363,55 @@ def test_a_recording_holds_the_fields_the_intentions_and_the_optimum(tmp_path):
         assert rows[f"fields/0/M/{d}"] == rows[f"fields/0/I/{d}"] == 3  # ticks 0, 20, 40
         assert rows[f"fields/0/intention/{d}"] == rows[f"fields/0/action/{d}"] == 60
     assert rows["world/optimum/0"] == 1
+
+
+# ------------------------------------------------------- sensing and sharing
+
+
+def test_a_robot_marks_what_its_sensors_meet_off_the_map_and_the_others_receive_it():
+    body = ('[[obstacle]]\nrect = [0.3, 0.1, 0.34, 0.4]\n'
+            '[[group]]\ncount = 2\ncontroller = "dft"\nstarts = [[0.15, 0.25, 0.0], [0.15, 0.8, 0.0]]\n'
+            'goals = [[0.6, 0.25], [0.6, 0.8]]\n[dft]\nobstacles = "sensed"\n')  # fmt: skip
+    engine = ArenaEngine(arena(body, w=1.0, h=1.0, max_ticks=400))
+    a, b = engine.controllers
+    engine.step(400)
+    x_face = int(0.3 / 0.01)
+    mine, theirs = a.sensed.blocked(a.tick), b.sensed.blocked(b.tick)
+    assert mine[15:35, x_face - 3 : x_face + 3].sum() > 10  # robot 0 met the box's west face and marked it
+    assert theirs[15:35, x_face - 3 : x_face + 3].sum() > 10  # and robot 1 got it over the context key space
+    assert b.received > 0 and engine.shares.of(0)["messages"] > 0
+    assert not mine[:, :6].any() and not mine[:6, :].any()  # walls it was given are not marked again
+
+
+def test_malformed_context_is_refused_whole():
+    from agents.controllers.arena import deliver
+
+    s = load_scenario("zmaze").with_overrides(agents=2, controller="dft")
+    from dataclasses import replace
+
+    s = replace(s, controller_params={"dft": {"obstacles": "sensed"}})
+    engine = ArenaEngine(s)
+    c = engine.controllers[1]
+    bad_ones = ({"tick": 1, "marked": [1], "cleared": []}, {"tick": 1, "marked": [5, 99999], "cleared": []},
+                {"tick": "x", "marked": [], "cleared": []}, [1, 2], {"tick": 1, "marked": [1.5, 2], "cleared": []})
+    for bad in bad_ones:
+        with pytest.raises(ValueError):
+            c.receive(0, bad)
+    assert not c.sensed.blocked(1).any()
+    from swarm.protocol import pack
+
+    assert deliver(engine.controllers, [0, 1], [(0, "context", b"\xc1garbage"), (0, "context", pack({"tick": 0}))]) == 2
+
+
+def test_lockstep_sharing_dft_robots_equal_in_process_bit_for_bit():
+    from swarm.arena.dft_experiments import together_scenario
+    from tests.distributed import run_world
+
+    scenario = together_scenario("scout-sensed", 40, 500, "low", 3, 280)
+    engine = ArenaEngine(scenario)
+    engine.run()
+    assert engine.shares.of(1)["messages"] > 0  # the scout met the box and wrote it
+    summary, world = run_world(scenario, "dft-share", [("dft", 2, 1)], deadline=60.0)
+    np.testing.assert_array_equal(world.pose, engine.world.pose)
+    assert [r.get("shared") for r in summary["robots"]] == [engine.shares.of(a) for a in (0, 1)]
+    assert summary["rejected_messages"] == 0

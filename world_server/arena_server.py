@@ -137,6 +137,9 @@ class ArenaServer(WorldServer):
         if not self.null:
             self.readings = self.world.perceive()
 
+    def _finish(self) -> None:
+        self._pass_on_shared()  # the last tick's publications go on their keys too: nothing written is lost
+
     def _observe(self, tick: int, agents: np.ndarray) -> bytes:
         readings = [{} for _ in agents] if self.null else [self.readings[a] for a in agents]
         return arena_proto.observations(tick, agents, readings, self.shared_out)

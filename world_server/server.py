@@ -192,6 +192,9 @@ class WorldServer:
     def _begin_tick(self) -> None:
         """Before the tick's observations go out."""
 
+    def _finish(self) -> None:
+        """After the last tick, before the state is saved (what the last tick left to pass on)."""
+
     def _observe(self, tick: int, agents: np.ndarray) -> bytes:
         """The observation message of one agent process."""
         raise NotImplementedError
@@ -451,6 +454,7 @@ class WorldServer:
                 self._wait_for_any_agent()  # a world with nobody in it does not tick on alone
             self.step()
         self._drain(0.0)
+        self._finish()
         self.save_state()
         self.final = summary = self.summary()
         self._close_recording(summary)

@@ -39,9 +39,10 @@ class SensedContext:
         dj, di = np.mgrid[-r : r + 1, -r : r + 1]
         inside = dj**2 + di**2 <= r * r
         self.disc = np.column_stack([dj[inside], di[inside]])
-        b = math.ceil(radius / cell)
+        own = radius + mark_radius  # marks others put on this robot's rim reach this far from its centre
+        b = math.ceil(own / cell)
         dj, di = np.mgrid[-b : b + 1, -b : b + 1]
-        inside = (dj * cell) ** 2 + (di * cell) ** 2 <= radius**2
+        inside = (dj * cell) ** 2 + (di * cell) ** 2 <= own**2
         self.body = np.column_stack([dj[inside], di[inside]])
         self.seen = np.full(self.shape, NEVER, np.int64)  # tick each cell was last seen blocked
         self.marked: list[tuple[int, int]] = []
@@ -77,6 +78,8 @@ class SensedContext:
             points = np.column_stack([(x + steps[None, :] * np.cos(a)).ravel(),
                                       (y + steps[None, :] * np.sin(a)).ravel()])  # fmt: skip
             cleared = self._cells(points, np.zeros((1, 2), np.int64))
+        if len(cleared):  # only what was marked is news to the others
+            cleared = cleared[self.seen[cleared[:, 0], cleared[:, 1]] != NEVER]
         body = self._cells(np.array([[x, y]]), self.body)
         self._apply(marked, np.concatenate([cleared, body]), tick)
         self.marked = [tuple(c) for c in marked.tolist()]

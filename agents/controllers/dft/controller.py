@@ -47,7 +47,7 @@ class DftParams:
     wheel_unit: float = 0.1288e-3  # m/s per e-puck wheel unit (1000 steps/s = 12.88 cm/s)
     obstacles: str = "told"  # told | sensed | unknown
     sense_margin: float = 0.03  # sensed: a point this close to a wall of the map is the wall
-    mark_radius: float = 0.02  # sensed: the disc a point marks
+    mark_radius: float = 0.04  # sensed: the disc a point marks (the robot's radius: the room it takes from one passing)
     memory: int = 300  # sensed: ticks a mark lasts unless seen again (about 19 s)
     min_reading: float = 120.0  # sensed: IR readings from this up count (about 5 cm from the rim)
 
