@@ -514,7 +514,8 @@ def cmd_experiment(args) -> int:
         result = run_dft_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
                                     noise=args.noise, max_ticks=args.max_steps)  # fmt: skip
         print(result["markdown"])
-        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
+        extra = ", paths.png, paths.npz" if args.name == "dft-case3" else ""
+        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png{extra}")
         return 0
     if args.noise or args.max_steps:
         raise ScenarioError("command line", "--noise/--max-steps", "these are for the dft-* experiments")

@@ -36,6 +36,7 @@ CASE3_START = (0.695, 0.605, 0.0)
 CASE3_GOAL = (0.395, 0.605)
 CASE3_BOXES = {"full": (0.345, 0.755, 0.445, 0.955), "partial": (0.245, 0.705, 0.545, 0.855)}
 CASE3_APPEAR, CASE3_DURATION = (30, 700), (2, 500)
+PATH_EVERY = 4  # ticks between the path points kept for the plots
 NORTH_Y, SOUTH_Y = 0.705, 0.505  # pathSelection.m: north once row < 30, south once row > 50
 CASE3_STREAM = 0x43415333
 CASE3_FIELDS = ["obstacle", "noise", "run", "appear", "duration", "route", "reached", "ticks", "ticks_to_goal",
@@ -153,12 +154,14 @@ def run_case3(job: tuple) -> dict:
     box = Obstacle(CASE3_BOXES[kind], appear=appear, vanish=appear + duration, colour=(150, 110, 70), name=kind)
     s = replace(s, obstacles=(*s.obstacles, box))
     engine = ArenaEngine(s)
-    ys, speeds, on_robot = [], [], False
+    ys, speeds, on_robot, path = [], [], False, [engine.world.pose[0, :2].copy()]
     w = engine.world
     while not w.done():
         before = w.pose[0, :2].copy()
         engine.step()
         ys.append(float(w.pose[0, 1]))
+        if w.tick % PATH_EVERY == 0:
+            path.append(w.pose[0, :2].copy())
         speeds.append(float(np.hypot(*(w.pose[0, :2] - before))) / s.control_period)
         if w.tick == appear:  # the paper dropped runs where the box met the robot; we count them
             x0, y0, x1, y1 = box.rect
@@ -173,7 +176,7 @@ def run_case3(job: tuple) -> dict:
             "route": classify(np.array(ys)), "reached": robot["reached"], "ticks": summary["ticks"],
             "ticks_to_goal": robot["ticks_to_goal"], "path_length": robot["path_length"], "stalled_ticks": stalled,
             "collisions": robot["collisions"], "on_robot": on_robot,
-            "wall_seconds": summary["wall_seconds"]}  # fmt: skip
+            "wall_seconds": summary["wall_seconds"], "path": np.array(path, np.float32)}  # fmt: skip
 
 
 def summarise_case3(rows: list[dict]) -> tuple[list[dict], str]:
@@ -209,6 +212,34 @@ def summarise_case3(rows: list[dict]) -> tuple[list[dict], str]:
             "late planning or early execution (200 < t_i < 500) makes it switch north to south (red) after a "
             "period of near-zero speed; after t_i > 500 the robot always keeps the north route.\n")  # fmt: skip
     return summary, head + "\n".join(lines) + "\n" + tail
+
+
+def plot_case3_paths(rows: list[dict], path: Path) -> None:
+    """Figure 13: every run's path over the maze, coloured by the route it took; the box in grey."""
+    from swarm.scenario import load_scenario
+
+    plt = _pyplot()
+    walls = load_scenario("zmaze").walls
+    kinds = list(CASE3_BOXES)
+    noises = list(dict.fromkeys(r["noise"] for r in rows))
+    fig, axes = plt.subplots(len(noises), len(kinds), figsize=(5 * len(kinds), 5 * len(noises)), squeeze=False)
+    for i, noise in enumerate(noises):
+        for j, kind in enumerate(kinds):
+            ax = axes[i, j]
+            for wall in walls:
+                x0, y0, x1, y1 = wall.coords
+                ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, color="#8a6a46"))
+            x0, y0, x1, y1 = CASE3_BOXES[kind]
+            ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, color="#bbb", alpha=0.7))
+            for r in rows:
+                if r["obstacle"] == kind and r["noise"] == noise and not r["on_robot"] and r.get("path") is not None:
+                    ax.plot(r["path"][:, 0], r["path"][:, 1], lw=0.5, alpha=0.5, c=ROUTE_COLOUR[r["route"]])
+            ax.plot(*CASE3_START[:2], "ko", ms=4)
+            ax.plot(*CASE3_GOAL, "kx", ms=7)
+            ax.set(title=f"{kind} obstacle, {noise} noise (Figure 13)", xlim=(0, 1), ylim=(0, 1), aspect="equal")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def plot_case3(rows: list[dict], path: Path) -> None:
@@ -420,6 +451,8 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
         summary, md = summarise_case3(rows)
         _write(out, "runs.csv", CASE3_FIELDS, rows, summary)
         plot_case3(rows, out / "plot.png")
+        plot_case3_paths(rows, out / "paths.png")
+        np.savez_compressed(out / "paths.npz", **{f"{r['obstacle']}_{r['noise']}_{r['run']}": r["path"] for r in rows})
         title = f"# Case 3 (Billing et al. 2015): an obstacle across the north route\n\n{reps} runs per obstacle " \
                 f"type and noise level; seed {seed}.\n\n"
     else:
