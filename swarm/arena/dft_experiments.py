@@ -109,9 +109,7 @@ def plot_pairs(rows: list[dict], path: Path) -> None:
     ratios = [[r["path_ratio"] for r in s if r["path_ratio"] not in (None, "")] or [math.nan] for s in sel]
     axes[1].boxplot(ratios, tick_labels=labels)
     axes[1].set(title="L_p / L_o, reached runs (Figure 8)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(plt, fig, path)
 
 
 # -------------------------------------------------------------------- case 3
@@ -214,52 +212,58 @@ def summarise_case3(rows: list[dict]) -> tuple[list[dict], str]:
     return summary, head + "\n".join(lines) + "\n" + tail
 
 
+def _case3_panels(rows: list[dict], side: float):
+    """One panel per (noise, obstacle type) of the rows: (pyplot, figure, [(axes, noise, kind), ...])."""
+    plt = _pyplot()
+    kinds = list(CASE3_BOXES)
+    noises = list(dict.fromkeys(r["noise"] for r in rows))
+    fig, axes = plt.subplots(len(noises), len(kinds), figsize=(5 * len(kinds), side * len(noises)), squeeze=False)
+    return plt, fig, [(axes[i, j], noise, kind) for i, noise in enumerate(noises) for j, kind in enumerate(kinds)]
+
+
+def _save(plt, fig, path: Path) -> None:
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def plot_case3_paths(rows: list[dict], path: Path) -> None:
     """Figure 13: every run's path over the maze, coloured by the route it took; the box in grey."""
     from swarm.scenario import load_scenario
 
-    plt = _pyplot()
     walls = load_scenario("zmaze").walls
-    kinds = list(CASE3_BOXES)
-    noises = list(dict.fromkeys(r["noise"] for r in rows))
-    fig, axes = plt.subplots(len(noises), len(kinds), figsize=(5 * len(kinds), 5 * len(noises)), squeeze=False)
-    for i, noise in enumerate(noises):
-        for j, kind in enumerate(kinds):
-            ax = axes[i, j]
-            for wall in walls:
-                x0, y0, x1, y1 = wall.coords
-                ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, color="#8a6a46"))
-            x0, y0, x1, y1 = CASE3_BOXES[kind]
-            ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, color="#bbb", alpha=0.7))
-            for r in rows:
-                if r["obstacle"] == kind and r["noise"] == noise and not r["on_robot"] and r.get("path") is not None:
-                    ax.plot(r["path"][:, 0], r["path"][:, 1], lw=0.5, alpha=0.5, c=ROUTE_COLOUR[r["route"]])
-            ax.plot(*CASE3_START[:2], "ko", ms=4)
-            ax.plot(*CASE3_GOAL, "kx", ms=7)
-            ax.set(title=f"{kind} obstacle, {noise} noise (Figure 13)", xlim=(0, 1), ylim=(0, 1), aspect="equal")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    plt, fig, panels = _case3_panels(rows, 5)
+    for ax, noise, kind in panels:
+        for wall in walls:
+            x0, y0, x1, y1 = wall.coords
+            ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, color="#8a6a46"))
+        x0, y0, x1, y1 = CASE3_BOXES[kind]
+        ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, color="#bbb", alpha=0.7))
+        for r in rows:
+            if r["obstacle"] == kind and r["noise"] == noise and not r["on_robot"] and r.get("path") is not None:
+                ax.plot(r["path"][:, 0], r["path"][:, 1], lw=0.5, alpha=0.5, c=ROUTE_COLOUR[r["route"]])
+        ax.plot(*CASE3_START[:2], "ko", ms=4)
+        ax.plot(*CASE3_GOAL, "kx", ms=7)
+        ax.set(title=f"{kind} obstacle, {noise} noise (Figure 13)", xlim=(0, 1), ylim=(0, 1), aspect="equal")
+    _save(plt, fig, path)
+
+
+def _scatter_routes(ax, rows: list[dict], title: str) -> None:
+    """t_i against t_p, one colour per route (Figures 15, 16)."""
+    for route, colour in ROUTE_COLOUR.items():
+        sel = [r for r in rows if r["route"] == route]
+        if sel:
+            ax.scatter([r["appear"] for r in sel], [r["duration"] for r in sel], s=12, c=colour, label=route)
+    ax.set(title=title, xlabel="t_i (steps)", ylabel="t_p (steps)")
+    ax.legend(fontsize=7)
 
 
 def plot_case3(rows: list[dict], path: Path) -> None:
-    plt = _pyplot()
-    kinds = list(CASE3_BOXES)
-    noises = list(dict.fromkeys(r["noise"] for r in rows))
-    fig, axes = plt.subplots(len(noises), len(kinds), figsize=(5 * len(kinds), 4 * len(noises)), squeeze=False)
-    for i, noise in enumerate(noises):
-        for j, kind in enumerate(kinds):
-            ax = axes[i, j]
-            for route, colour in ROUTE_COLOUR.items():
-                sel = [r for r in rows if r["obstacle"] == kind and r["noise"] == noise and r["route"] == route]
-                if sel:
-                    ax.scatter([r["appear"] for r in sel], [r["duration"] for r in sel], s=12, c=colour, label=route)
-            ax.set(title=f"{kind} obstacle, {noise} noise (Figures 15, 16)", xlabel="t_i (steps)",
-                   ylabel="t_p (steps)")  # fmt: skip
-            ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    plt, fig, panels = _case3_panels(rows, 4)
+    for ax, noise, kind in panels:
+        sel = [r for r in rows if r["obstacle"] == kind and r["noise"] == noise]
+        _scatter_routes(ax, sel, f"{kind} obstacle, {noise} noise (Figures 15, 16)")
+    _save(plt, fig, path)
 
 
 # ------------------------------------------------------- the swarm (item 4)
@@ -382,15 +386,8 @@ def plot_together(rows: list[dict], path: Path) -> None:
     plt = _pyplot()
     fig, axes = plt.subplots(1, len(TOGETHER), figsize=(5 * len(TOGETHER), 4), squeeze=False)
     for ax, c in zip(axes[0], TOGETHER, strict=True):
-        for route, colour in ROUTE_COLOUR.items():
-            sel = [r for r in rows if r["condition"] == c and r["route"] == route]
-            if sel:
-                ax.scatter([r["appear"] for r in sel], [r["duration"] for r in sel], s=12, c=colour, label=route)
-        ax.set(title=f"robot 0, {c}", xlabel="t_i (steps)", ylabel="t_p (steps)")
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+        _scatter_routes(ax, [r for r in rows if r["condition"] == c], f"robot 0, {c}")
+    _save(plt, fig, path)
 
 
 def _pyplot():
