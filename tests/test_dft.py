@@ -415,3 +415,46 @@ def test_lockstep_sharing_dft_robots_equal_in_process_bit_for_bit():
     np.testing.assert_array_equal(world.pose, engine.world.pose)
     assert [r.get("shared") for r in summary["robots"]] == [engine.shares.of(a) for a in (0, 1)]
     assert summary["rejected_messages"] == 0
+
+
+# ------------------------------------------------------------- experiments
+
+
+def test_runs_are_classified_by_the_route_they_took():
+    from swarm.arena.dft_experiments import classify
+
+    assert classify(np.array([0.6, 0.65, 0.72, 0.8, 0.6])) == "north"
+    assert classify(np.array([0.6, 0.55, 0.5, 0.3, 0.6])) == "south"
+    assert classify(np.array([0.6, 0.72, 0.6, 0.5, 0.3])) == "north-then-south"
+    assert classify(np.array([0.6, 0.62, 0.58])) == "neither"
+
+
+def test_case_tables_put_the_papers_f_beside_ours(tmp_path):
+    from swarm.arena.dft_experiments import run_dft_experiment, summarise_pairs
+
+    rows = [{"scenario": "zmaze", "controller": c, "noise": n, "pair": k, "reached": True, "ticks_to_goal": 300 + k,
+             "path_ratio": (1.1 if c == "dft" else 1.0) + 0.01 * k, "collisions": 0}
+            for c, n in (("dft", "low"), ("dft", "high"), ("carrot", "none"), ("carrot", "low"), ("carrot", "high"))
+            for k in range(5)]  # fmt: skip
+    summary, md = summarise_pairs(rows)
+    assert [r["condition"] for r in summary] == ["SPA-LN", "SPA-HN", "FTC-NN", "FTC-LN", "FTC-HN"]
+    assert "paper F = 0.97" in md and "| SPA-LN | 5/5 | 1.120 ± 0.016 | 302 |" in md
+    result = run_dft_experiment("dft-case1", None, 1, 1, 0, tmp_path, noise="high", progress=False)
+    assert (tmp_path / "plot.png").exists() and "| SPA-HN | 1/1 |" in result["markdown"]
+
+
+def test_the_swarm_summary_measures_how_much_earlier_robot_0_replans():
+    from swarm.arena.dft_experiments import replan_tick, summarise_together
+
+    def row(c, k, route, south, turn):
+        return {"condition": c, "run": k, "route": route, "south_tick": south, "turn_tick": turn, "reached": True,
+                "ticks_to_goal": 900, "appear": 100, "duration": 600}  # fmt: skip
+
+    rows = [row("alone-told", 1, "south", 300, 270), row("alone-told", 2, "south", 300, 270),
+            row("alone-sensed", 1, "north-then-south", 800, 700), row("alone-sensed", 2, "north", None, 650),
+            row("scout-sensed", 1, "north-then-south", 550, 430), row("scout-sensed", 2, "north-then-south", 560, 440)]
+    assert replan_tick(rows[2]) == 700 and replan_tick(rows[3]) is None and replan_tick(rows[0]) == 300
+    summary, md = summarise_together(rows)
+    last = summary[-1]
+    assert (last["south_alone"], last["south_scout"], last["sooner_with_scout"]) == (1, 2, 2)
+    assert last["median_ticks_earlier"] == 270 and "a median of 270 ticks earlier" in md

@@ -67,11 +67,13 @@ def summarise_pairs(rows: list[dict]) -> tuple[list[dict], str]:
     from scipy.stats import f_oneway
 
     name = rows[0]["scenario"]
-    summary, lines, groups = [], [], []
+    summary, lines, groups = [], [], {}
     for controller, noise in CONDITIONS:
         sel = [r for r in rows if r["controller"] == controller and r["noise"] == noise]
+        if not sel:  # --noise leaves some conditions out
+            continue
         ratios = np.array([r["path_ratio"] for r in sel if r["path_ratio"] not in (None, "")], float)
-        groups.append(ratios)
+        groups[(controller, noise)] = ratios
         ok = sum(bool(r["reached"]) for r in sel)
         ticks = [r["ticks_to_goal"] for r in sel if r["ticks_to_goal"] not in (None, "")]
         summary.append({"scenario": name, "condition": label(controller, noise), "runs": len(sel), "reached": ok,
@@ -83,9 +85,9 @@ def summarise_pairs(rows: list[dict]) -> tuple[list[dict], str]:
                      f"{_fmt(ratios.mean() if len(ratios) else math.nan)} ± "
                      f"{_fmt(ratios.std(ddof=1) if len(ratios) > 1 else math.nan)} | "
                      f"{_fmt(float(np.median(ticks)) if ticks else math.nan, 0)} |")  # fmt: skip
-    usable = [g for g in groups if len(g) > 1]
+    usable = [g for g in groups.values() if len(g) > 1]
     f = f_oneway(*usable) if len(usable) > 1 else None
-    spa = [g for g in groups[:2] if len(g) > 1]
+    spa = [g for (c, _), g in groups.items() if c == "dft" and len(g) > 1]
     f_spa = f_oneway(*spa) if len(spa) == 2 else None
     head = ("| condition | reached | L_p / L_o (mean ± sd, reached runs) | median ticks to goal |\n"
             "|---|---|---|---|\n")  # fmt: skip
