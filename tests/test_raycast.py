@@ -58,12 +58,17 @@ def _one(body_extra: str, start: str, robot: str = "epuck", noise: str = "none")
     return ArenaWorld(arena(body, robot=robot, noise=noise)).perceive()[0]
 
 
-def test_ir_reads_the_response_curve_at_the_hand_computed_distance():
-    # A wall face at x = 0.55, the e-puck (radius 37 mm) at x = 0.5 facing it.
-    p = _one("[[wall]]\nrect = [0.55, 0.3, 0.6, 0.7]\n", "[0.5, 0.5, 0.0]")
+@pytest.mark.parametrize(("colour", "factor"), [
+    (255, 1.0), (128, 0.2 + 0.8 * 128 / 255), ("[150, 110, 70]", 0.2 + 0.8 * 150 / 255),
+])  # fmt: skip
+def test_ir_reads_the_response_curve_at_the_hand_computed_distance(colour, factor):
+    # A wall face at x = 0.55, the e-puck (radius 37 mm) at x = 0.5 facing it.  As Webots' infra-red
+    # sensors, a surface reflects by 0.2 + 0.8 * its red level: a white wall reads the curve at the true
+    # distance, a darker one as if farther.
+    p = _one(f"[[wall]]\nrect = [0.55, 0.3, 0.6, 0.7]\ncolour = {colour}\n", "[0.5, 0.5, 0.0]")
     for k, bearing in ((0, -0.30), (7, 0.30)):
         d = 0.05 / math.cos(bearing) - 0.037
-        assert p["ir"][k] == pytest.approx(np.interp(d, IR_DISTANCE, IR_VALUE), rel=1e-9)
+        assert p["ir"][k] == pytest.approx(np.interp(d / factor, IR_DISTANCE, IR_VALUE), rel=1e-9)
     assert p["ir"][1] > 0 and p["ir"][3] == 0.0 and p["ir"][4] == 0.0  # the back sees nothing within 7 cm
 
 

@@ -165,7 +165,11 @@ class Suite:
             out["sonar"] = np.clip(echo, 0.0, o.range)
         if s.ir:
             b = self.blocks["ir"]
-            reading = np.where(what[:, b] == -1, 0.0, ir_response(np.maximum(ranges[:, b], 0.0)))
+            distance = np.maximum(ranges[:, b], 0.0)
+            if s.ir.red_sensitivity:
+                red = state.hit_colours(what[:, b].ravel())[:, 0].reshape(n, -1) / 255.0
+                distance = distance + (distance / (0.2 + 0.8 * red) - distance) * s.ir.red_sensitivity
+            reading = np.where(what[:, b] == -1, 0.0, ir_response(distance))
             if s.ir.noise:
                 k = len(s.ir.bearings)
                 reading = reading * (1.0 + self._normal(S_IR, k, tick) * s.ir.noise * self.noise.factor("ir"))

@@ -55,6 +55,10 @@ class IR:
     bearings: tuple[float, ...] = (-0.30, -0.80, -1.57, -2.64, 2.64, 1.57, 0.80, 0.30)  # e-puck ps0..ps7
     range: float = 0.07
     noise: float = 0.0  # relative std of a reading
+    # Webots' infra-red model (the DFT paper's simulator): a surface reflects by f = 0.2 + 0.8 * red level,
+    # and the sensor reads the curve at d + (d / f - d) * red_sensitivity (Webots' redColorSensitivity,
+    # default 1): a dark or non-red surface seems farther.  0 reads the curve at the true distance.
+    red_sensitivity: float = 1.0
 
 
 @dataclass(frozen=True)
