@@ -169,7 +169,8 @@ class Suite:
             if s.ir.red_sensitivity:
                 red = state.hit_colours(what[:, b].ravel())[:, 0].reshape(n, -1) / 255.0
                 distance = distance + (distance / (0.2 + 0.8 * red) - distance) * s.ir.red_sensitivity
-            reading = np.where(what[:, b] == -1, 0.0, ir_response(distance))
+            # nothing within the curve's range reads 0 (ambient light subtracted), also when only the colour puts it out
+            reading = np.where((what[:, b] == -1) | (distance > IR_DISTANCE[-1]), 0.0, ir_response(distance))
             if s.ir.noise:
                 k = len(s.ir.bearings)
                 reading = reading * (1.0 + self._normal(S_IR, k, tick) * s.ir.noise * self.noise.factor("ir"))
