@@ -246,7 +246,13 @@ class _Group:
         self.taus = np.array([f.tau for f in fields], DTYPE)
         self.hs = np.array([f.h for f in fields], DTYPE)
         self.amps = np.array([f.noise for f in fields], DTYPE)
-        self.betas = [f.beta for f in fields]
+        # fields with the same beta side by side get their outputs in one vectorised call
+        self.beta_runs: list[tuple[int, int, float]] = []
+        for k, f in enumerate(fields):
+            if self.beta_runs and self.beta_runs[-1][2] == f.beta and self.beta_runs[-1][1] == k:
+                self.beta_runs[-1] = (self.beta_runs[-1][0], k + 1, f.beta)
+            else:
+                self.beta_runs.append((k, k + 1, f.beta))
         self.ids = np.arange(n, dtype=np.int64)
         self.images = np.zeros((len(inputs), self.size), DTYPE)
         self.ext_spec = np.zeros((len(inputs), int(np.prod(half))), CDTYPE)
@@ -263,8 +269,8 @@ class _Group:
         self._outputs()
 
     def _outputs(self) -> None:
-        for k, beta in enumerate(self.betas):
-            logistic(self.u[k], beta, self.out[k])
+        for start, stop, beta in self.beta_runs:
+            logistic(self.u[start:stop], beta, self.out[start:stop])
 
     def inputs_from_couplings(self) -> None:
         """Every field's input from the current outputs (before any field is updated)."""
@@ -279,7 +285,7 @@ class _Group:
         dyn = self._spectrum(self.out.reshape(-1, *self.shape)).reshape(len(self.fields), -1)
         _mac(self.acc, dyn, self.ext_spec, self.src, self.is_ext, self.tgt, self.transfer)
         back = sfft.irfftn(self.acc.reshape(-1, *self.half), s=self.shape, axes=self.axes)
-        self.inp[:] = back.reshape(len(self.fields), -1)
+        self.inp = back.reshape(len(self.fields), -1)  # float32, contiguous: used as it comes
 
     def update(self, key) -> None:
         self.inp += self.uniform[:, None]
