@@ -239,9 +239,11 @@ def test_ctrl_c_stops_swarm_up_and_every_child(tmp_path, signum):
     import sys
     import time
 
+    # real time at 20 ticks/s: the run cannot end on its own before the signal comes (lock-step can, on a fast day)
     up = subprocess.Popen([sys.executable, "-m", "swarm", "up", "setup1", "--agents", "4", "--seed", "1",
-                           "--run-id", f"ctrlc{signum}", "--listen", free_endpoint()], stdout=subprocess.PIPE,
-                          stderr=subprocess.PIPE, text=True, cwd=tmp_path)  # fmt: skip
+                           "--run-id", f"ctrlc{signum}", "--listen", free_endpoint(), "--mode", "realtime",
+                           "--rate", "20"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          cwd=tmp_path)  # fmt: skip
     try:
         deadline = time.monotonic() + 120
         while len(_children_alive(f"ctrlc{signum}")) < 5:  # the world and 4 agents

@@ -198,8 +198,10 @@ def test_the_live_viewer_stream_carries_the_same_run(tmp_path):
 
     port = int(free_endpoint().rsplit(":", 1)[1])
     live = tmp_path / "live.rrd"
+    # its own process group: the `rerun` entry point runs the viewer binary as a child, and Ctrl-C in a
+    # terminal reaches both; a signal to the entry point alone would leave the binary running
     server = subprocess.Popen([rerun_binary(), "--serve-grpc", "--port", str(port), "--save", str(live)],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)  # fmt: skip
     try:
         time.sleep(2)
         ran = _swarm("run", "maze", "--agents", "3", "--seed", "4", "--record", str(tmp_path / "file.rrd"),
@@ -207,8 +209,15 @@ def test_the_live_viewer_stream_carries_the_same_run(tmp_path):
         assert ran.returncode == 0, ran.stderr[-2000:]
         time.sleep(2)
     finally:
-        server.send_signal(2)  # Ctrl-C: the server finishes its file
-        server.wait(timeout=20)
+        import os
+        import signal
+
+        os.killpg(server.pid, signal.SIGINT)  # Ctrl-C: the server finishes its file (slow on a loaded machine)
+        try:
+            server.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            os.killpg(server.pid, signal.SIGKILL)
+            raise
     printed = json.loads(ran.stdout)
     read = summary_from(read_recording(live))
     for key in SHARED_KEYS:
