@@ -240,10 +240,11 @@ def test_ctrl_c_stops_swarm_up_and_every_child(tmp_path, signum):
     import time
 
     # real time at 20 ticks/s: the run cannot end on its own before the signal comes (lock-step can, on a fast day)
+    # SIGINT as a terminal's: a shell starts background jobs with it ignored, and that is inherited
     up = subprocess.Popen([sys.executable, "-m", "swarm", "up", "setup1", "--agents", "4", "--seed", "1",
                            "--run-id", f"ctrlc{signum}", "--listen", free_endpoint(), "--mode", "realtime",
                            "--rate", "20"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                          cwd=tmp_path)  # fmt: skip
+                          cwd=tmp_path, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # fmt: skip
     try:
         deadline = time.monotonic() + 120
         while len(_children_alive(f"ctrlc{signum}")) < 5:  # the world and 4 agents

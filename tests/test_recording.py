@@ -200,8 +200,13 @@ def test_the_live_viewer_stream_carries_the_same_run(tmp_path):
     live = tmp_path / "live.rrd"
     # its own process group: the `rerun` entry point runs the viewer binary as a child, and Ctrl-C in a
     # terminal reaches both; a signal to the entry point alone would leave the binary running
+    # (and SIGINT as a terminal's: a shell starts background jobs with it ignored, and that is inherited)
+    import os
+    import signal
+
     server = subprocess.Popen([rerun_binary(), "--serve-grpc", "--port", str(port), "--save", str(live)],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)  # fmt: skip
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+                              preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # fmt: skip
     try:
         time.sleep(2)
         ran = _swarm("run", "maze", "--agents", "3", "--seed", "4", "--record", str(tmp_path / "file.rrd"),
@@ -209,9 +214,6 @@ def test_the_live_viewer_stream_carries_the_same_run(tmp_path):
         assert ran.returncode == 0, ran.stderr[-2000:]
         time.sleep(2)
     finally:
-        import os
-        import signal
-
         os.killpg(server.pid, signal.SIGINT)  # Ctrl-C: the server finishes its file (slow on a loaded machine)
         try:
             server.wait(timeout=60)
