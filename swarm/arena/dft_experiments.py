@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from swarm.arena.experiments import LARGE_HEADING, _fmt, random_pairs, run_pair, zmaze_pairs
+from swarm.experiments import _pyplot, _save
 from swarm.scenario import ScenarioError
 
 CONDITIONS = (("dft", "low"), ("dft", "high"), ("carrot", "none"), ("carrot", "low"), ("carrot", "high"))
@@ -111,7 +112,7 @@ def plot_pairs(rows: list[dict], path: Path) -> None:
     ratios = [[r["path_ratio"] for r in s if r["path_ratio"] not in (None, "")] or [math.nan] for s in sel]
     axes[1].boxplot(ratios, tick_labels=labels)
     axes[1].set(title="L_p / L_o, reached runs (Figure 8)")
-    _save(plt, fig, path)
+    _save(fig, path)
 
 
 # -------------------------------------------------------------------- case 3
@@ -223,12 +224,6 @@ def _case3_panels(rows: list[dict], side: float):
     return plt, fig, [(axes[i, j], noise, kind) for i, noise in enumerate(noises) for j, kind in enumerate(kinds)]
 
 
-def _save(plt, fig, path: Path) -> None:
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
 def plot_case3_paths(rows: list[dict], path: Path) -> None:
     """Figure 13: every run's path over the maze, coloured by the route it took; the box in grey."""
     from swarm.scenario import load_scenario
@@ -247,7 +242,7 @@ def plot_case3_paths(rows: list[dict], path: Path) -> None:
         ax.plot(*CASE3_START[:2], "ko", ms=4)
         ax.plot(*CASE3_GOAL, "kx", ms=7)
         ax.set(title=f"{kind} obstacle, {noise} noise (Figure 13)", xlim=(0, 1), ylim=(0, 1), aspect="equal")
-    _save(plt, fig, path)
+    _save(fig, path)
 
 
 def _scatter_routes(ax, rows: list[dict], title: str) -> None:
@@ -261,11 +256,11 @@ def _scatter_routes(ax, rows: list[dict], title: str) -> None:
 
 
 def plot_case3(rows: list[dict], path: Path) -> None:
-    plt, fig, panels = _case3_panels(rows, 4)
+    _, fig, panels = _case3_panels(rows, 4)
     for ax, noise, kind in panels:
         sel = [r for r in rows if r["obstacle"] == kind and r["noise"] == noise]
         _scatter_routes(ax, sel, f"{kind} obstacle, {noise} noise (Figures 15, 16)")
-    _save(plt, fig, path)
+    _save(fig, path)
 
 
 # ------------------------------------------------------- the swarm (item 4)
@@ -389,16 +384,7 @@ def plot_together(rows: list[dict], path: Path) -> None:
     fig, axes = plt.subplots(1, len(TOGETHER), figsize=(5 * len(TOGETHER), 4), squeeze=False)
     for ax, c in zip(axes[0], TOGETHER, strict=True):
         _scatter_routes(ax, [r for r in rows if r["condition"] == c], f"robot 0, {c}")
-    _save(plt, fig, path)
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    _save(fig, path)
 
 
 def _pool(work: list[tuple], fn, jobs: int | None, desc: str, progress: bool) -> list[dict]:

@@ -107,6 +107,7 @@ class DftController:
             self.engine.set_input("goal", gaussian_2d(self.shape, cj, ci, self.p.goal_sigma, self.p.goal_peak))
         self.tick = 0
         self.known = -1  # bit mask of the told obstacles now in the map
+        self.told = walls  # walls and the told obstacles now present
         self.map_base = np.zeros(self.shape, np.float32)
         self.noise_buf = np.empty(self.shape, np.float32)
         self.last_wheels = np.zeros(2)
@@ -121,14 +122,14 @@ class DftController:
         for k, (_, appear, vanish) in enumerate(self.obstacle_rects):
             if self.tick >= appear and (vanish is None or self.tick < vanish):
                 known |= 1 << k
-        if known != self.known or self.sensed is not None:
+        if known != self.known:  # the told obstacles are rasterised only when their set changes
             self.known = known
             rects = np.array([r for k, (r, _, _) in enumerate(self.obstacle_rects) if known >> k & 1],
                              np.float64).reshape(-1, 4)  # fmt: skip
-            blocked = self.walls | occupancy(self.size, self.p.cell, rects, np.zeros((0, 4))) if known else self.walls
-            if self.sensed is not None:
-                blocked = blocked | self.sensed.blocked(self.tick)
-            self.map_base = -blocked.astype(np.float32)
+            self.told = self.walls | occupancy(self.size, self.p.cell, rects, np.zeros((0, 4))) if known else self.walls
+            self.map_base = -self.told.astype(np.float32)
+        if self.sensed is not None:  # sensed marks change every tick
+            self.map_base = -(self.told | self.sensed.blocked(self.tick)).astype(np.float32)
         fill_noise(np.uint64(noise_key(self.seed, self.agent, self.tick, MAP_STREAM)), self.noise_buf.ravel())
         return self.map_base + np.float32(self.map_noise) * self.noise_buf
 
@@ -202,6 +203,6 @@ class DftController:
         return {
             "motivation": np.stack([e.u(f"M_{d}") for d in EBS]),
             "intention": np.stack([e.u(f"I_{d}") for d in EBS]),
-            "intention_max": np.array([self.intentions()[d] for d in EBS]),
+            "intention_max": np.array(list(self.intentions().values())),
             "action": np.stack([e.output(f"A_{d}") for d in EBS]),
         }

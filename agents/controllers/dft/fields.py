@@ -182,11 +182,10 @@ def noise_key(seed, agent, tick, stream):
 
 
 @njit(cache=True)
-def _euler(u, inp, taus, hs, amps, key, field_ids):
-    """u[k] += (-u + h + input + amp * xi) / tau for the fields `field_ids` of a stack (F, n)."""
+def _euler(u, inp, taus, hs, amps, key):
+    """u[k] += (-u + h + input + amp * xi) / tau for every field k of a stack (F, n)."""
     n = u.shape[1]
-    for q in range(len(field_ids)):
-        k = field_ids[q]
+    for k in range(u.shape[0]):
         inv, h, amp = np.float32(1.0) / taus[k], hs[k], amps[k]
         fkey = mix64(key ^ (np.uint64(k + 1) * _GOLDEN))
         uk, ik = u[k], inp[k]
@@ -253,7 +252,6 @@ class _Group:
                 self.beta_runs[-1] = (self.beta_runs[-1][0], k + 1, f.beta)
             else:
                 self.beta_runs.append((k, k + 1, f.beta))
-        self.ids = np.arange(n, dtype=np.int64)
         self.images = np.zeros((len(inputs), self.size), DTYPE)
         self.ext_spec = np.zeros((len(inputs), int(np.prod(half))), CDTYPE)
         self.dirty = np.ones(len(inputs), np.bool_)
@@ -289,7 +287,7 @@ class _Group:
 
     def update(self, key) -> None:
         self.inp += self.uniform[:, None]
-        _euler(self.u, self.inp, self.taus, self.hs, self.amps, key, self.ids)
+        _euler(self.u, self.inp, self.taus, self.hs, self.amps, key)
         self._outputs()
 
 
