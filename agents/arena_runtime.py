@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from agents.controllers.arena import deliver, make_controller, publications
+from agents.controllers.arena import as_action, deliver, make_controller, publications
 from agents.runtime import AgentRuntime
 from swarm import protocol as proto
 from swarm import protocol_arena as arena_proto
@@ -42,9 +42,9 @@ class ArenaAgentRuntime(AgentRuntime):
             if slot is None:
                 continue
             agents.append(agent)
-            wheels.append(np.zeros(2) if self.null else self.brains[slot].step(reading))
+            wheels.append(np.zeros(3) if self.null else as_action(self.brains[slot].step(reading)))
         shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
-        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 2), shared)
+        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared)
         self.act_publisher.put(payload)
         if not self.null:
             self._send_plans(obs.tick, agents)

@@ -24,6 +24,7 @@ from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled
 CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
 FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize", "fingerprint-together")
 DFT_EXPERIMENTS = ("dft-case1", "dft-case2", "dft-case3", "dft-together")
+BG_EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze")
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -54,6 +55,19 @@ def _positive(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
     return value
+
+
+def _ratios(text: str) -> tuple[float, ...]:
+    from swarm.arena.bg_experiments import RATIOS
+
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if not values or any(v not in RATIOS for v in values):
+        raise argparse.ArgumentTypeError(f"expected some of {','.join(f'{r:g}' for r in RATIOS)} (the tmaze-R "
+                                         f"scenarios), got {text}")  # fmt: skip
+    return values
 
 
 def _seed(text: str) -> int:
@@ -115,7 +129,12 @@ def build_parser() -> argparse.ArgumentParser:
         "beside follow the carrot, and replanning round an obstacle; dft-together: a scout shares the obstacle "
         "it meets over the context key space"
     )
-    exp.add_argument("name", choices=[*EXPERIMENTS, "carrot", *FINGERPRINT_EXPERIMENTS, *DFT_EXPERIMENTS],
+    names_help += (
+        "; bg-survival | bg-choice | bg-forget | bg-fear | bg-tmaze: the basal-ganglia animat (Girard et al. "
+        "2005): survival with and without its map, a new resource, a removed one, fear against need, the T-maze"
+    )
+    exp.add_argument("name", choices=[*EXPERIMENTS, "carrot", *FINGERPRINT_EXPERIMENTS, *DFT_EXPERIMENTS,
+                                      *BG_EXPERIMENTS],
                      metavar="NAME",
                      help=names_help)  # fmt: skip
     exp.add_argument(
@@ -127,6 +146,8 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--noise", choices=["none", "low", "high"], help="dft-*: only the conditions at this noise level")
     exp.add_argument("--max-steps", type=_positive, metavar="T",
                      help="dft-*: run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)")
+    exp.add_argument("--ratios", type=_ratios, metavar="R,R,...",
+                     help="bg-tmaze: right / left branch length ratios to run (default 1,1.5,2: tmaze-R scenarios)")
     exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
     exp.add_argument("--seed", type=_seed, default=0, help="first seed (runs use seed..seed+reps-1)")
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
@@ -519,6 +540,16 @@ def cmd_experiment(args) -> int:
         return 0
     if args.noise or args.max_steps:
         raise ScenarioError("command line", "--noise/--max-steps", "these are for the dft-* experiments")
+    if args.name in BG_EXPERIMENTS:
+        from swarm.arena.bg_experiments import run_bg_experiment
+
+        result = run_bg_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
+                                   ratios=args.ratios)  # fmt: skip
+        print(result["markdown"])
+        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
+        return 0
+    if args.ratios:
+        raise ScenarioError("command line", "--ratios", "this is for bg-tmaze")
     if args.name == "carrot":
         from swarm.arena.experiments import run_carrot_experiment
 

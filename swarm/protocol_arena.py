@@ -56,7 +56,7 @@ class ArenaObs:
 class ArenaActs:
     tick: int
     agents: np.ndarray  # (K,)
-    wheels: np.ndarray  # (K, 2), not yet judged
+    wheels: np.ndarray  # (K, 2), or (K, 3) with acts; not yet judged
     shared: Shared = ()  # what these agents publish this tick, not yet judged
 
 
@@ -99,8 +99,14 @@ def observations(tick: int, agents, perceptions: list[dict[str, np.ndarray]], sh
 
 
 def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = ()) -> bytes:
+    """(K, 2) wheel speeds, or (K, 3) with a consummatory act each: the acts go
+    in their own field, and only when one is not 0 (the message of robots
+    without a metabolism stays as it was)."""
+    wheels = np.asarray(wheels, np.float64).reshape(len(agents), -1)
     m = {"type": "act", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
-         "wheels": np.asarray(wheels, np.float64).astype("<f8").tobytes()}  # fmt: skip
+         "wheels": np.ascontiguousarray(wheels[:, :2]).astype("<f8").tobytes()}  # fmt: skip
+    if wheels.shape[1] > 2 and np.any(wheels[:, 2] != 0):
+        m["acts"] = np.ascontiguousarray(wheels[:, 2]).astype("<f8").tobytes()
     if shared:
         m["shared"] = _shared_field(shared)
     return pack(m)
@@ -159,6 +165,11 @@ def parse_acts(data: bytes) -> ArenaActs | Rejected:
     if bad := first_rejection(shared := parse_shared(m.get("shared"))):
         return bad
     wheels = np.frombuffer(raw, dtype="<f8").reshape(len(agents), 2).astype(np.float64)
+    if "acts" in m:
+        acts = m["acts"]
+        if not isinstance(acts, bytes) or len(acts) != 8 * len(agents):
+            return Rejected(f"acts: expected {len(agents)} binary float64")
+        wheels = np.column_stack([wheels, np.frombuffer(acts, dtype="<f8").astype(np.float64)])
     return ArenaActs(tick, agents, wheels, shared)
 
 

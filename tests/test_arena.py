@@ -63,11 +63,12 @@ def test_bad_actions_are_counted_and_never_acted_on():
     before = w.pose.copy()
     w.apply(np.array([[math.nan, 0.1]]))
     w.apply(np.array([[10.0, 10.0]]))  # far over the e-puck's 12.9 cm/s
-    w.apply(np.array([[0.1, 0.1, 0.1]]))
+    w.apply(np.array([[0.1, 0.1, 0.1, 0.1]]))
+    w.apply(np.array([[0.1, 0.1, 1.0]]))  # a consummatory act where there is no metabolism
     w.apply(np.array([[math.inf, -math.inf]]))
     assert np.array_equal(w.pose, before)
-    assert w.rejected == {"not finite": 2, "over the wheel limit": 1, "wrong shape": 1}
-    assert w.tick == 4
+    assert w.rejected == {"not finite": 2, "over the wheel limit": 1, "wrong shape": 1, "unknown act": 1}
+    assert w.tick == 5
 
 
 def test_a_scheduled_obstacle_blocks_only_while_present():

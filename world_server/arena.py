@@ -16,11 +16,13 @@ import numpy as np
 
 from swarm.arena.scenario import ArenaScenario
 from world_server.drive import DiffDrive
+from world_server.metabolism import ACTS, Metabolism
 from world_server.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
 from world_server.sensors import ZONE_KINDS, Suite
 
 ACTION_LEN = 2  # left and right wheel speeds, m/s
-REJECT_REASONS = ("not finite", "over the wheel limit", "wrong shape")
+ACTION_WIDTH = 3  # ... and a consummatory act (world_server.metabolism.ACTS), optional: 0 when left out
+REJECT_REASONS = ("not finite", "over the wheel limit", "wrong shape", "unknown act")
 
 
 def rect_edges(rect) -> list[tuple[float, float, float, float]]:
@@ -104,6 +106,9 @@ class ArenaWorld:
         self.start_pose = start.copy()
         self.zones = np.zeros(self.n, np.int64)
         self._update_zones()
+        self.metabolism = None if s.metabolism is None else Metabolism(
+            self.n, s.metabolism, s.control_period,
+            [(o.name, o.zone, o.centre) for o in s.obstacles if o.zone is not None])  # fmt: skip
 
     # ------------------------------------------------------------- contract
 
@@ -194,29 +199,37 @@ class ArenaWorld:
         return rgb
 
     def _refusals(self, actions: np.ndarray, robots: np.ndarray) -> np.ndarray:
-        """Per row of (k, 2) wheel speeds for these robots: the index in
-        REJECT_REASONS of why it cannot be acted on, or -1."""
+        """Per row of (k, 2) wheel speeds, or (k, 3) with an act, for these
+        robots: the index in REJECT_REASONS of why it cannot be acted on, or -1."""
         finite = np.isfinite(actions).all(axis=1)
-        over = (np.abs(np.where(finite[:, None], actions, 0.0)) > self.max_wheel[robots, None] * (1 + 1e-9)).any(axis=1)
-        return np.where(~finite, 0, np.where(over, 1, -1))
+        wheels = np.where(finite[:, None], actions[:, :ACTION_LEN], 0.0)
+        over = (np.abs(wheels) > self.max_wheel[robots, None] * (1 + 1e-9)).any(axis=1)
+        why = np.where(~finite, 0, np.where(over, 1, -1))
+        if actions.shape[1] == ACTION_WIDTH:
+            act = np.where(finite, actions[:, -1], 0.0)
+            known = (act == np.round(act)) & (act >= 0) & (act < len(ACTS))
+            if self.metabolism is None:
+                known &= act == 0  # no metabolism here: no act means anything
+            why = np.where((why < 0) & ~known, 3, why)
+        return why
 
     def judge(self, agent: int, wheels: np.ndarray) -> str | None:
-        """Why one robot's wheel speeds cannot be acted on, or None."""
+        """Why one robot's action (wheel speeds, and an act or not) cannot be acted on, or None."""
         wheels = np.asarray(wheels, np.float64)
-        if wheels.shape != (ACTION_LEN,):
+        if wheels.shape not in ((ACTION_LEN,), (ACTION_WIDTH,)):
             return "wrong shape"
         k = int(self._refusals(wheels[None], np.array([agent]))[0])
         return None if k < 0 else REJECT_REASONS[k]
 
     def validate(self, actions: np.ndarray) -> np.ndarray:
-        """Which rows of (n, 2) wheel speeds may be acted on; the others are
-        counted by reason and their robots hold still this tick."""
+        """Which rows of (n, 2) wheel speeds, or (n, 3) with acts, may be acted
+        on; the others are counted by reason and their robots hold still this tick."""
         actions = np.asarray(actions, np.float64)
-        if actions.shape != (self.n, ACTION_LEN):
+        if actions.ndim != 2 or actions.shape[0] != self.n or actions.shape[1] not in (ACTION_LEN, ACTION_WIDTH):
             self.rejected["wrong shape"] += self.n
             return np.zeros(self.n, np.bool_)
         why = self._refusals(actions, np.arange(self.n))
-        for k in (0, 1):
+        for k in (0, 1, 3):
             self.rejected[REJECT_REASONS[k]] += int((why == k).sum())
         return why < 0
 
@@ -226,11 +239,19 @@ class ArenaWorld:
         if ok is None:
             ok = self.validate(actions)
         wheels = np.zeros((self.n, ACTION_LEN))
-        if np.shape(actions) == (self.n, ACTION_LEN):
-            wheels[ok] = np.asarray(actions, np.float64)[ok]
+        acts = np.zeros(self.n, np.int64)
+        if np.shape(actions) in ((self.n, ACTION_LEN), (self.n, ACTION_WIDTH)):
+            actions = np.asarray(actions, np.float64)
+            wheels[ok] = actions[ok, :ACTION_LEN]
+            if actions.shape[1] == ACTION_WIDTH:
+                acts[ok] = actions[ok, -1].astype(np.int64)
         wheels = self._limit(wheels)
         before = self.pose[:, :2].copy()
         moving = ok & ~self.finished & self.present & self.in_world
+        if self.metabolism is not None:  # the start-of-tick zones: where the robot was when it acted
+            self.metabolism.step(acts, self.zones, moving, self.pose[:, :2], self.tick,
+                                 lambda kind: 1 << ZONE_KINDS.index(kind))  # fmt: skip
+            self.finished |= ~self.metabolism.alive  # a dead robot stops, an obstacle to the others
         self.bodies.drive(wheels, self.axle, moving, pinned=~self.present & self.in_world)
         self.path_length += np.hypot(*(self.pose[:, :2] - before).T)
         self.tick += 1
@@ -284,6 +305,8 @@ class ArenaWorld:
     def done(self) -> bool:
         if self.tick >= self.scenario.max_ticks:
             return True
+        if self.metabolism is not None:
+            return self.metabolism.done()
         goals = self.has_goal & self.in_world
         return bool(goals.any()) and bool(self.finished[goals].all())
 
@@ -319,6 +342,8 @@ class ArenaWorld:
         out["sim_seconds"] = np.array(self.bodies.sim_seconds)
         out["optimum"] = np.array([np.nan if v is None else v for v in self.optimum])
         out["rejected"] = np.array([self.rejected[k] for k in REJECT_REASONS])
+        if self.metabolism is not None:
+            out.update(self.metabolism.snapshot())
         return out
 
     def restore(self, state: dict[str, np.ndarray]) -> None:
@@ -329,7 +354,10 @@ class ArenaWorld:
         self.tick = int(state["tick"])
         self.bodies.sim_seconds = float(state["sim_seconds"])
         self.optimum = [None if np.isnan(v) else float(v) for v in state["optimum"]]
-        self.rejected = {k: int(v) for k, v in zip(REJECT_REASONS, state["rejected"], strict=True)}
+        self.rejected = dict.fromkeys(REJECT_REASONS, 0)
+        self.rejected.update({k: int(v) for k, v in zip(REJECT_REASONS, state["rejected"], strict=False)})
+        if self.metabolism is not None:
+            self.metabolism.restore(state)
         for a in range(self.n):
             self.bodies.restore(a, state["pose"][a], state["velocity"][a], bool(self.in_world[a]))
         self._obstacles_at(self.tick)
@@ -376,6 +404,7 @@ class ArenaWorld:
                 "distance": round(float(self.bodies.distance[a]), 4),
                 "blocked_seconds": round(float(self.bodies.blocked_seconds[a]), 3),
                 "pose": [round(float(v), 5) for v in self.pose[a]],
+                **({} if self.metabolism is None else self.metabolism.summary(a, s.control_period, self.tick)),
             })  # fmt: skip
         return out
 

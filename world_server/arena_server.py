@@ -34,7 +34,7 @@ class ArenaServer(WorldServer):
         self.world = ArenaWorld(s, parked=True)  # robots come in as their agents join
         self.world.cast(np.zeros(1, np.int64), np.zeros(1), np.ones(1))  # compile the ray pass now, not in a deadline
         self.controllers = np.array([g.controller for g in s.groups for _ in range(g.count)])
-        self.wheels = np.zeros((self.world.n, 2))
+        self.wheels = np.zeros((self.world.n, 3))  # wheel speeds and an act
         self.ok = np.zeros(self.world.n, np.bool_)
         self.readings: list[dict[str, np.ndarray]] = []
         self.pending_shared: dict[int, tuple[str, bytes]] = {}  # this tick's publications, by agent
@@ -155,7 +155,8 @@ class ArenaServer(WorldServer):
             if (reason := self.world.judge(a, wheels)) is not None:
                 self.stats.reject(f"act: {reason}")
             else:
-                self.wheels[a] = wheels
+                self.wheels[a] = 0.0
+                self.wheels[a, : len(wheels)] = wheels
                 self.ok[a] = True
                 self.acted[a] = True
         if msg.shared:

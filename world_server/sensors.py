@@ -194,4 +194,6 @@ class Suite:
             out["contact"] = state.contact[rows].copy()
         if s.zones:
             out["zones"] = state.zones[rows].copy()
+        if getattr(state, "metabolism", None) is not None:  # internal sensors: E and Ep
+            out["metabolism"] = state.metabolism.levels(rows)
         return out

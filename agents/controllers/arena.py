@@ -2,7 +2,8 @@
 
 An arena controller is an object (it carries maps, fields or neurons):
 `reset(seed, agent, params)` once, then `step(perception) -> (left, right)`
-wheel speeds in m/s each tick.  It sees only its robot's sensors (the
+wheel speeds in m/s each tick, or (left, right, act) for a robot with a
+metabolism (world_server.metabolism.ACTS).  It sees only its robot's sensors (the
 perception dict) and what its paper gives the robot beforehand (`params`:
 the map it is given, its goal or route, its body's limits).
 `snapshot()` / `restore()` make a resumed run bit-equal; `record()` returns
@@ -23,6 +24,7 @@ REGISTRY = {
     "wander": "agents.controllers.wander:WanderController",
     "fingerprint": "agents.controllers.fingerprint:FingerprintController",
     "dft": "agents.controllers.dft:DftController",
+    "bg": "agents.controllers.bg:BgController",
 }
 ARENA_CONTROLLERS = tuple(REGISTRY)
 # Each controller's own scenario table, checked when a scenario is loaded (a callable raising ValueError).
@@ -31,6 +33,7 @@ TABLES = {
     "wander": "agents.controllers.wander.controller:WanderParams.from_table",
     "fingerprint": "agents.controllers.fingerprint.controller:check_table",
     "dft": "agents.controllers.dft.controller:check_table",
+    "bg": "agents.controllers.bg.controller:check_table",
 }
 # Controllers that write a shared key space (swarm/<run>/<share>/<agent>), and which: what one robot
 # publishes at tick t every other robot of the same share receives before it steps tick t + 1.
@@ -38,7 +41,7 @@ SHARES = {"fingerprint": "map", "dft": "context"}
 MAX_SHARE_BYTES = 4 * 1024 * 1024
 # What a controller needs its robot to sense (checked when a scenario is loaded).
 REQUIRES = {"carrot": ("position", "compass"), "wander": (), "fingerprint": ("camera", "laser", "odometry", "compass"),
-            "dft": ("position", "compass", "ir")}
+            "dft": ("position", "compass", "ir"), "bg": ("camera", "sonar", "odometry", "compass")}
 
 
 class ArenaController(Protocol):
@@ -51,6 +54,16 @@ class ArenaController(Protocol):
     def restore(self, state: dict[str, Any]) -> None: ...
 
     def record(self) -> dict[str, np.ndarray]: ...
+
+
+def as_action(step_result) -> np.ndarray:
+    """A controller's answer as the world's action row: (left, right, act), the
+    act 0 (none) when it gave only wheel speeds.  Anything else goes on as it is,
+    for the world to judge and count."""
+    a = np.asarray(step_result, np.float64).ravel()
+    if len(a) == 2:
+        return np.array([a[0], a[1], 0.0])
+    return a if len(a) == 3 else np.full(3, np.nan)
 
 
 def check_table(name: str, table: dict[str, Any]) -> None:

@@ -12,15 +12,12 @@ random step t_i for t_p steps and classifies each run by the route it took
 
 from __future__ import annotations
 
-import csv
 import math
-import multiprocessing as mp
-import os
 from pathlib import Path
 
 import numpy as np
 
-from swarm.arena.experiments import LARGE_HEADING, _fmt, random_pairs, run_pair, zmaze_pairs
+from swarm.arena.experiments import LARGE_HEADING, _fmt, pool_map, random_pairs, run_pair, write_runs, zmaze_pairs
 from swarm.experiments import _pyplot, _save
 from swarm.scenario import ScenarioError
 
@@ -387,30 +384,6 @@ def plot_together(rows: list[dict], path: Path) -> None:
     _save(fig, path)
 
 
-def _pool(work: list[tuple], fn, jobs: int | None, desc: str, progress: bool) -> list[dict]:
-    from tqdm import tqdm
-
-    rows = []
-    bar = tqdm(total=len(work), desc=desc, unit="run", disable=not progress)
-    with mp.get_context("spawn").Pool(jobs or os.cpu_count() or 1) as pool:
-        for row in pool.imap_unordered(fn, work):
-            rows.append(row)
-            bar.update()
-    bar.close()
-    return rows
-
-
-def _write(out: Path, name: str, fields: list[str], rows: list[dict], summary: list[dict]) -> None:
-    with open(out / name, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
-        w.writeheader()
-        w.writerows(rows)
-    with open(out / "summary.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(dict.fromkeys(k for row in summary for k in row)))
-        w.writeheader()
-        w.writerows(summary)
-
-
 def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
                        out: Path | None, noise: str | None = None, max_ticks: int | None = None,
                        progress: bool = True) -> dict:  # fmt: skip
@@ -421,20 +394,20 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
     out.mkdir(parents=True, exist_ok=True)
     if case == "dft-together":
         reps = 60 if reps is None else reps
-        rows = _pool(together_jobs(reps, seed, noise or "low", max_ticks), run_together, jobs, case, progress)
+        rows = pool_map(together_jobs(reps, seed, noise or "low", max_ticks), run_together, jobs, case, progress)
         rows.sort(key=lambda r: (TOGETHER.index(r["condition"]), r["run"]))
         summary, md = summarise_together(rows)
-        _write(out, "runs.csv", TOGETHER_FIELDS, rows, summary)
+        write_runs(out, "runs.csv", TOGETHER_FIELDS, rows, summary)
         plot_together(rows, out / "plot.png")
         title = (f"# The swarm: a scout shares the obstacle it meets (case 3, full box)\n\n{reps} draws of t_i, t_p; "
                  f"noise {noise or 'low'}; seed {seed}.\n\n")  # fmt: skip
     elif case == "dft-case3":
         reps = 240 if reps is None else reps
         noises = (noise,) if noise else ("low", "high")
-        rows = _pool(case3_jobs(reps, seed, noises, max_ticks), run_case3, jobs, case, progress)
+        rows = pool_map(case3_jobs(reps, seed, noises, max_ticks), run_case3, jobs, case, progress)
         rows.sort(key=lambda r: (r["obstacle"], r["noise"], r["run"]))
         summary, md = summarise_case3(rows)
-        _write(out, "runs.csv", CASE3_FIELDS, rows, summary)
+        write_runs(out, "runs.csv", CASE3_FIELDS, rows, summary)
         plot_case3(rows, out / "plot.png")
         plot_case3_paths(rows, out / "paths.png")
         np.savez_compressed(out / "paths.npz", **{f"{r['obstacle']}_{r['noise']}_{r['run']}": r["path"] for r in rows})
@@ -448,11 +421,11 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
         work = pair_jobs(case, reps, seed, max_ticks)
         if noise:
             work = [j for j in work if j[1] == noise]
-        rows = _pool(work, run_pair, jobs, case, progress)
+        rows = pool_map(work, run_pair, jobs, case, progress)
         order = [label(c, n) for c, n in CONDITIONS]
         rows.sort(key=lambda r: (order.index(label(r["controller"], r["noise"])), r["pair"]))
         summary, md = summarise_pairs(rows)
-        _write(out, "runs.csv", PAIR_FIELDS, rows, summary)
+        write_runs(out, "runs.csv", PAIR_FIELDS, rows, summary)
         plot_pairs(rows, out / "plot.png")
         number = case[-1]
         title = (f"# Case {number} (Billing et al. 2015): SPA beside follow the carrot in {expected}\n\n{reps} "

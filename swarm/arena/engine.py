@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from agents.controllers.arena import ShareLog, deliver, make_controller, publications
+from agents.controllers.arena import ShareLog, as_action, deliver, make_controller, publications
 from agents.controllers.navigation.astar import Planner
 from swarm.arena.scenario import ArenaScenario, controller_params
 from swarm.stepper import step_world
@@ -60,7 +60,7 @@ class ArenaEngine:
             c.reset(scenario.seed, a, controller_params(scenario, a))
             self.controllers.append(c)
         self.wall_seconds = 0.0
-        self.actions = np.zeros((self.world.n, 2))
+        self.actions = np.zeros((self.world.n, 3))  # wheel speeds and an act (world_server.arena.ACTION_WIDTH)
         self.agent_ids = list(range(len(self.controllers)))
         self.shares = ShareLog()
         self.refused_shared = 0
@@ -78,7 +78,7 @@ class ArenaEngine:
 
         def decide(perceptions, tick: int) -> np.ndarray:
             for a, (c, p) in enumerate(zip(self.controllers, perceptions, strict=True)):
-                self.actions[a] = c.step(p)
+                self.actions[a] = as_action(c.step(p))
             shared = publications(self.controllers, self.agent_ids)
             if shared:  # what each wrote this tick, every other robot of its share reads before the next
                 self.shares.add(tick, shared)

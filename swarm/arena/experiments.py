@@ -193,3 +193,29 @@ def run_carrot_experiment(scenario: str | None, reps: int | None, jobs: int | No
     (out / "table.md").write_text(text)
     plot(rows, out / "plot.png")
     return {"name": "carrot", "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
+
+
+def pool_map(work: list[tuple], fn, jobs: int | None, desc: str, progress: bool) -> list[dict]:
+    """fn over every job in `jobs` spawned processes (default: every core), with a progress bar; rows as they end."""
+    from tqdm import tqdm
+
+    rows = []
+    bar = tqdm(total=len(work), desc=desc, unit="run", disable=not progress)
+    with mp.get_context("spawn").Pool(jobs or os.cpu_count() or 1) as pool:
+        for row in pool.imap_unordered(fn, work):
+            rows.append(row)
+            bar.update()
+    bar.close()
+    return rows
+
+
+def write_runs(out: Path, name: str, fields: list[str], rows: list[dict], summary: list[dict]) -> None:
+    """The runs (these fields) to out/name and the summary rows to out/summary.csv."""
+    with open(out / name, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    with open(out / "summary.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(dict.fromkeys(k for row in summary for k in row)))
+        w.writeheader()
+        w.writerows(summary)

@@ -131,7 +131,9 @@ ANIMAT = RobotModel(
     max_speed=0.40,
     max_turn_rate=10 * DEG,
     colour=(90, 90, 90),
-    sensors=Sensors(camera=Camera(), sonar=Sonar(), odometry=Odometry(), compass=Compass()),
+    # one ray per 10-degree sector: the colour in each direction, the pixels the BG model counts
+    # (a resource's angular size, so that 7 of them mean "within 70 cm": docs/bg.md)
+    sensors=Sensors(camera=Camera(rays_per_sector=1), sonar=Sonar(), odometry=Odometry(), compass=Compass()),
 )
 
 # The e-puck of Billing et al. (2015) (Mondada et al. 2009): 74 mm, 53 mm axle,

@@ -41,6 +41,7 @@ from swarm.arena.models import (
     Sonar,
 )
 from swarm.scenario import ScenarioError, no_unknown, typed
+from world_server.metabolism import MetabolismParams
 from world_server.sensors import NOISE_LEVELS, ZONE_KINDS, Noise
 
 START_STREAM = 0x53544152  # keeps start-pose draws apart from every other use of the seed
@@ -134,6 +135,7 @@ class ArenaScenario:
     controller_params: dict[str, dict[str, Any]] = field(default_factory=dict)
     description: str = ""
     kind: str = "arena"
+    metabolism: MetabolismParams | None = None  # E and Ep for every robot (the BG paper's survival task)
 
     @property
     def agents(self) -> int:
@@ -333,6 +335,7 @@ _TOP = {
     "resource",
     "group",
     "routes",
+    "metabolism",
     *ARENA_CONTROLLERS,
 }
 _SENSORS = {"camera": Camera, "sonar": Sonar, "ir": IR, "laser": Laser, "odometry": Odometry, "compass": Compass,
@@ -372,6 +375,12 @@ def parse_arena(data: dict, source: str, default_name: str) -> ArenaScenario:
         raise ScenarioError(source, "group", "missing: add at least one [[group]] with count and controller")
     kw["groups"] = tuple(_group(g, robot, source, f"group {i + 1}") for i, g in enumerate(groups))
     kw["controller_params"] = {c: _table(data, c, source) for c in ARENA_CONTROLLERS if c in data}
+    if "metabolism" in data:
+        try:
+            kw["metabolism"] = MetabolismParams.from_table(_table(data, "metabolism", source))
+        except ValueError as exc:
+            field_name, _, message = str(exc).partition(": ")
+            raise ScenarioError(source, field_name, message) from None
     scenario = ArenaScenario(**kw)
     check_arena(scenario, source)
     return scenario

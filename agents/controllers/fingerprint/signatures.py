@@ -18,7 +18,7 @@ import numpy as np
 
 from agents.controllers.fingerprint.align import MAX_LENGTH, SYMBOLS, Matcher, paper_length
 from agents.controllers.fingerprint.features import Fingerprint
-from agents.controllers.navigation.topomap import Link, MapParams, Node, TopoMap
+from agents.controllers.navigation.topomap import MapParams, TopoMap, topomap_from_data, topomap_to_data
 
 
 def pack(strings: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -79,36 +79,14 @@ def fingerprint_from_data(data: list) -> Fingerprint:
 
 def map_to_data(m: TopoMap) -> dict[str, Any]:
     """A fingerprint map as plain data (msgpack- and JSON-safe)."""
-    return {
-        "nodes": [{"mean": fingerprint_data(n.mean), "members": [fingerprint_data(f) for f in n.members],
-                   "position": n.position.tolist(), "observations": n.observations, "visits": n.visits,
-                   "seen_at": [list(p) for p in n.seen_at]}
-                  for n in m.nodes],
-        "links": [[a, b, link.displacement.tolist(), link.count] for (a, b), link in m.links.items()],
-        "current": m.current, "belief": np.asarray(m.belief).tolist(), "closures": m.closures,
-        "odometer": m.odometer, "folded": [[a, b] for a, b in m.folded.items()],
-    }  # fmt: skip
+    return topomap_to_data(m, fingerprint_data)
 
 
 def map_from_data(data: dict[str, Any], signatures: FingerprintSignatures, params: MapParams) -> TopoMap:
-    try:
-        nodes = []
-        for n in data["nodes"]:
-            members = [fingerprint_from_data(f) for f in n["members"]]
-            mean = fingerprint_from_data(n["mean"])
-            # the mean is one of the members: keep it the same object, as the live map does
-            same = [f for f in members if np.array_equal(f.codes, mean.codes)]
-            nodes.append(Node(same[0] if same else mean, members, np.array(n["position"], np.float64),
-                              int(n["observations"]), int(n["visits"]),
-                              [(float(x), float(y), float(o)) for x, y, o in n.get("seen_at", [])]))  # fmt: skip
-        links = {(int(a), int(b)): Link(np.array(d, np.float64), int(c)) for a, b, d, c in data["links"]}
-        m = TopoMap(signatures, params, nodes, links, int(data.get("current", -1)),
-                    np.array(data.get("belief", []), np.float64), int(data.get("closures", 0)),
-                    odometer=float(data.get("odometer", 0.0)),
-                    folded={int(a): int(b) for a, b in data.get("folded", [])})  # fmt: skip
-    except (KeyError, TypeError, ValueError, IndexError) as e:
-        raise ValueError(
-            f"a fingerprint map: malformed ({type(e).__name__}: {e}); "
-            "expected what FingerprintController.map_data() writes"
-        ) from None
+    m = topomap_from_data(data, signatures, params, fingerprint_from_data, "a fingerprint map",
+                          "FingerprintController.map_data()")  # fmt: skip
+    for node in m.nodes:  # the mean is one of the members: keep it the same object, as the live map does
+        same = [f for f in node.members if np.array_equal(f.codes, node.mean.codes)]
+        if same:
+            node.mean = same[0]
     return m

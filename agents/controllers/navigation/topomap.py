@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import heapq
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -339,3 +340,34 @@ class TopoMap:
         self.current = i
         self.belief = np.eye(len(self.nodes))[i]
         return i
+
+
+def topomap_to_data(m: TopoMap, encode: Callable[[Any], Any]) -> dict[str, Any]:
+    """A map as plain data (msgpack- and JSON-safe); `encode` writes one signature."""
+    return {
+        "nodes": [{"mean": encode(n.mean), "members": [encode(f) for f in n.members],
+                   "position": n.position.tolist(), "observations": n.observations, "visits": n.visits,
+                   "seen_at": [list(p) for p in n.seen_at]}
+                  for n in m.nodes],
+        "links": [[a, b, link.displacement.tolist(), link.count] for (a, b), link in m.links.items()],
+        "current": m.current, "belief": np.asarray(m.belief).tolist(), "closures": m.closures,
+        "odometer": m.odometer, "folded": [[a, b] for a, b in m.folded.items()],
+    }  # fmt: skip
+
+
+def topomap_from_data(data: dict[str, Any], signatures: Signatures, params: MapParams,
+                      decode: Callable[[Any], Any], what: str, writer: str) -> TopoMap:  # fmt: skip
+    """The map `topomap_to_data` wrote; ValueError naming `what` and its `writer` if malformed
+    (`decode` reads one signature and raises ValueError on a bad one)."""
+    try:
+        nodes = [Node(decode(n["mean"]), [decode(f) for f in n["members"]], np.array(n["position"], np.float64),
+                      int(n["observations"]), int(n["visits"]),
+                      [(float(x), float(y), float(o)) for x, y, o in n.get("seen_at", [])])
+                 for n in data["nodes"]]  # fmt: skip
+        links = {(int(a), int(b)): Link(np.array(d, np.float64), int(c)) for a, b, d, c in data["links"]}
+        return TopoMap(signatures, params, nodes, links, int(data.get("current", -1)),
+                       np.array(data.get("belief", []), np.float64), int(data.get("closures", 0)),
+                       odometer=float(data.get("odometer", 0.0)),
+                       folded={int(a): int(b) for a, b in data.get("folded", [])})  # fmt: skip
+    except (KeyError, TypeError, ValueError, IndexError) as e:
+        raise ValueError(f"{what}: malformed ({type(e).__name__}: {e}); expected what {writer} writes") from None

@@ -1,0 +1,188 @@
+"""The BG animat (Girard et al. 2005): two basal-ganglia loops select what to
+do from saliences that mix taxon, topological planning and exploration.
+
+Each control period the animat reads its camera, sonars, odometry, compass
+and internal sensors (E, Ep), updates its map, computes the saliences, lets
+the GPR loops settle for the period (gpr.py, 1 ms Euler steps), and acts:
+a dorsal selection (ReloadE or ReloadEp) stops it and asks the world for the
+act; else it heads for the ventral loop's direction; the sonar reflex
+overrides both when something is too close in front.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from agents.controllers.bg.gpr import BasalGanglia, select_dorsal, select_ventral
+from agents.controllers.bg.places import DIRECTIONS, Navigator, NavParams
+from agents.controllers.bg.saliences import SALIENCES, Drives, plan_vector, saliences
+from agents.controllers.bg.senses import RESOURCES, Reflex, proximity, resource_pixels
+from agents.controllers.tables import params_from_table
+from world_server.sensors import ZONE_KINDS
+
+USABLE_ZONE = {"DA": "dangerous", "Ep": "ingesting", "E": "digesting"}
+DORSAL_ACTS = ("ReloadE", "ReloadEp")  # channel order; world_server.metabolism.ACTS codes 1, 2
+
+
+@dataclass(frozen=True)
+class BgParams:
+    saliences: str = "survival"  # survival (eqs. 15-17) | fear (eq. 18) | tmaze (eqs. 19-20)
+    planning: bool = True  # condition A (taxon + topological); False: condition B (taxon only)
+    w_plan: float = 0.65
+    w_taxon: float = 0.55
+    fear: float = 0.2  # F, m(DA)
+    dorsal_threshold: float = 0.5  # disinhibition a consummatory act needs: EP/SNr at half its rest (docs/bg.md)
+    ventral_threshold: float = -0.3  # ... a direction channel needs to join the vector sum (EP/SNr below 1.3 x rest)
+    too_close: float = 0.45  # m from the centre: the sonar reflex takes over
+    reflex_hold: float = 2.0  # s the reflex drives straight on once the front is clear
+    align: float = math.radians(30)  # heading error beyond which the animat turns on the spot
+    learn_map: bool = True  # keep mapping (False: a loaded map stays as it is)
+    map: str = ""  # a saved map (BgController.map_data() as JSON) to start from; "" none
+
+    @classmethod
+    def from_table(cls, table: dict[str, Any] | None) -> BgParams:
+        table = dict(table or {})
+        nav = table.pop("navigation", None)
+        if isinstance(table.get("map"), dict):
+            table.pop("map")  # a map given as data (experiments): read by the controller
+        p = params_from_table(cls, table, "bg", texts=("saliences", "map", "planning", "learn_map"))
+        for name in ("planning", "learn_map"):
+            if not isinstance(getattr(p, name), bool):
+                raise ValueError(f"[bg]: {name} expected true or false, got {getattr(p, name)!r}")
+        if p.saliences not in SALIENCES:
+            raise ValueError(f"bg.saliences: expected one of {', '.join(SALIENCES)}, got {p.saliences!r}")
+        if nav is not None:
+            nav_params(nav)
+        return p
+
+
+def nav_params(table: dict[str, Any] | None) -> NavParams:
+    return params_from_table(NavParams, table, "bg.navigation", ints=("known_age",))
+
+
+def check_table(table: dict[str, Any]) -> None:
+    BgParams.from_table(table)
+
+
+class BgController:
+    def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
+        table = params.get("bg") or {}
+        self.p = BgParams.from_table(table)
+        self.nav_params = nav_params(table.get("navigation"))
+        robot = params["robot"]
+        self.axle, self.max_speed = float(robot["axle"]), float(robot["max_speed"])
+        self.max_wheel = float(robot["max_wheel_speed"])
+        self.max_turn = float(robot["max_turn_rate"])
+        self.dt = float(params["control_period"])
+        self.agent, self.tick = agent, 0
+        self.bg = BasalGanglia()
+        self.nav = Navigator(self.nav_params, seed, agent, RESOURCES)
+        given = table.get("map") if isinstance(table.get("map"), dict) else None
+        if self.p.map:
+            try:
+                given = json.loads(Path(self.p.map).read_text())
+            except (OSError, ValueError) as e:
+                raise ValueError(f"bg.map: cannot read {self.p.map} ({e}); give a file BgController.map_data() "
+                                 "wrote") from None  # fmt: skip
+        if given is not None:
+            self.nav.from_data(given)
+            self.nav.lost()  # put down at its start: where that is on the map, its first view says
+        self.reflex = Reflex(self.p.too_close, self.p.reflex_hold)
+        self.last: dict[str, Any] = {}
+
+    # ---------------------------------------------------------------- step
+
+    def step(self, perception: dict[str, np.ndarray]) -> np.ndarray:
+        levels = perception.get("metabolism")
+        energy, potential = (float(levels[0]), float(levels[1])) if levels is not None else (1.0, 1.0)
+        heading = float(perception["compass"])
+        grey, sonar = perception["camera_grey"], np.asarray(perception["sonar"], np.float64)
+        zones = int(perception.get("zones", 0))
+        usable = {r: bool(zones & (1 << ZONE_KINDS.index(z))) for r, z in USABLE_ZONE.items()}
+        self.nav.move(float(perception["odometry"][0]), heading)
+        prox = proximity(resource_pixels(grey, heading))
+        if self.p.planning:
+            if self.p.learn_map and self.nav.due():
+                self.nav.observe(grey, sonar, heading)
+            self.nav.learn(usable, {r: bool(prox[k].any()) for k, r in enumerate(RESOURCES)}, self.dt)
+            plan = np.stack([self.nav.plan(r) for r in RESOURCES])
+            bka, disorientation = self.nav.back_to_known(), self.nav.D
+        else:
+            plan, bka, disorientation = np.zeros((3, DIRECTIONS)), np.zeros(DIRECTIONS), 0.0
+        drives = Drives(energy, potential, self.p.fear, disorientation, prox,
+                        np.array([usable[r] for r in RESOURCES]), plan, bka,
+                        self.nav.explore(sonar, heading, self.tick * self.dt, self.p.planning))  # fmt: skip
+        s_dorsal, s_ventral = saliences(drives, self.p.saliences, self.p.w_plan if self.p.planning else 0.0,
+                                        self.p.w_taxon)  # fmt: skip
+        self.bg.run(s_dorsal, s_ventral, self.dt)
+        d, v = self.bg.disinhibition()
+        chosen = select_dorsal(d, self.p.dorsal_threshold)
+        direction, strength = select_ventral(v, self.p.ventral_threshold)
+        reflex = self.reflex(sonar, self.dt) if chosen < 0 else None
+        if chosen >= 0:
+            forward, turn, act = 0.0, 0.0, chosen + 1
+        elif reflex is not None:
+            forward, turn, act = reflex[0] * self.max_speed, reflex[1] * self.max_turn, 0
+        elif strength > 0:
+            forward, turn, act = *self._steer(direction, heading, float(sonar[0])), 0
+        else:
+            forward, turn, act = 0.0, 0.0, 0
+        # both wheels within their limit: the turn is kept, the forward speed gives way
+        room = max(self.max_wheel - abs(turn) * self.axle / 2, 0.0)
+        forward = float(np.clip(forward, -room, room))
+        self.tick += 1
+        self.last = {"drives": drives, "s_dorsal": s_dorsal, "s_ventral": s_ventral, "dorsal": d, "ventral": v,
+                     "act": act, "direction": direction if strength > 0 else math.nan, "reflex": reflex is not None,
+                     "plan": plan_vector(drives, self.p.saliences == "fear")}  # fmt: skip
+        return np.array([forward - turn * self.axle / 2, forward + turn * self.axle / 2, float(act)])
+
+    def _steer(self, direction: float, heading: float, ahead: float) -> tuple[float, float]:
+        """Turn towards `direction` as fast as the body allows (10 degrees a second); go forward only when
+        within `align` of it, slower the farther off and the nearer a wall ahead: a turn made while
+        driving at full speed would carry the animat a metre sideways into the walls."""
+        err = (direction - heading + math.pi) % (2 * math.pi) - math.pi
+        turn = float(np.clip(err / self.dt, -self.max_turn, self.max_turn))
+        room = float(np.clip((ahead - self.p.too_close) / self.p.too_close, 0.0, 1.0))
+        forward = self.max_speed * max(0.0, 1.0 - abs(err) / self.p.align) * (0.25 + 0.75 * room)
+        return forward, turn
+
+    # ------------------------------------------------------------ state
+
+    def map_data(self) -> dict[str, Any]:
+        """The map and what its nodes hold, as plain data (JSON-safe): save it, load it with [bg] map."""
+        return self.nav.to_data()
+
+    def snapshot(self) -> dict[str, Any]:
+        return {"tick": self.tick, "bg": {k: v.tolist() for k, v in self.bg.state().items()},
+                "nav": self.nav.to_data(), "reflex": self.reflex.state(), "params": asdict(self.p)}  # fmt: skip
+
+    def restore(self, state: dict[str, Any]) -> None:
+        self.tick = int(state["tick"])
+        self.bg.restore({k: np.array(v, np.float64) for k, v in state["bg"].items()})
+        self.nav.from_data(state["nav"])
+        self.reflex.restore(state["reflex"])
+
+    def record(self) -> dict[str, np.ndarray]:
+        if not self.last:
+            return {}
+        dr: Drives = self.last["drives"]
+        return {
+            "energy": np.array(dr.energy), "potential": np.array(dr.potential),
+            "disorientation": np.array(dr.disorientation),
+            "motivations": np.array([dr.m_e, dr.m_ep, dr.disorientation, dr.fear]),
+            "dorsal": self.last["dorsal"], "ventral": self.last["ventral"],
+            "act": np.array(self.last["act"]), "direction": np.array(self.last["direction"]),
+            "reflex": np.array(self.last["reflex"]),
+        }  # fmt: skip
+
+    def summary(self) -> dict[str, Any]:
+        m = self.nav.map
+        held = {r: int((w > 0.5).sum()) for r, w in self.nav.assoc.items()}
+        return {"map": {"nodes": m.size, "links": len(m.links), "loops_closed": m.closures,
+                        "disorientation": round(self.nav.D, 4), "nodes_holding": held}}  # fmt: skip

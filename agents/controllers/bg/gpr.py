@@ -1,0 +1,207 @@
+"""The GPR basal ganglia (Gurney, Prescott & Redgrave 2001) as Girard et al.
+(2005) use it: two cortico-basal ganglia-thalamo-cortical loops, a dorsal one
+over consummatory acts and a ventral one over 36 directions of movement,
+joined by the trans-subthalamic projection (dorsal STN onto ventral EP/SNr).
+
+Every channel of every nucleus is one leaky integrator, tau da/dt = I - a
+(eq. 3), with the piecewise-linear output of eq. 4 and Table 5.  Inputs are
+eqs. 5-14 with two printing slips of the paper read as the text means them:
+the lateral sums of eqs. 5-7 are over the other channels' outputs (y^j, not
+y^i), and the ventral lateral weight of eq. 7 is the circular channel distance
+over N/2 (|i - j| mod N/2 would let opposite directions not compete at all,
+against the text: "close directions compete less than opposite ones").
+
+The salience a loop receives includes the thalamo-cortical feedback P (the
+`0.4 P_E` and `0.2 P_i` terms of eqs. 15-17): it is part of the dynamics, so
+the engine adds `feedback * y_P` to the external salience at every step.
+
+Integration: explicit Euler at dt = 1 ms.  With the diffuse STN projection
+explicit Euler is stable only for dt / tau < 2 / (1 + 0.9 N); at N = 36 and
+tau = 25 ms that is dt < 1.5 ms (docs/bg.md).  An exponential step at larger
+dt is not the cure: the instability is in the coupling, not in each neuron.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+# Nuclei, in the order of the state's rows.
+D1, D2, STN, GP, EP, VL, TRN, CTX = range(8)
+NUCLEI = ("D1", "D2", "STN", "GP", "EP/SNr", "VL", "TRN", "Ctx")
+# Table 5: threshold epsilon and slope m of each nucleus's output.
+EPSILON = np.array([0.2, 0.2, -0.25, -0.2, -0.2, -0.8, 0.0, 0.0])
+SLOPE = np.array([1.0, 1.0, 1.0, 1.0, 1.0, 0.62, 0.5, 1.0])
+TAU = 0.025  # s (the paper; Gurney's own code uses a gain of 25, tau = 40 ms)
+DOPAMINE = 0.2  # lambda
+DT = 0.001  # s, the Euler step (stable below 1.5 ms at 36 channels)
+
+
+def lateral_uniform(n: int) -> np.ndarray:
+    """The dorsal striatum's lateral inhibition: every other channel, weight 1 (eqs. 5-6)."""
+    return np.ones((n, n)) - np.eye(n)
+
+
+def lateral_circular(n: int) -> np.ndarray:
+    """The ventral striatum's: the circular distance between channels over N/2 (eq. 7, read as the text says)."""
+    i = np.arange(n)
+    d = np.abs(i[:, None] - i[None, :])
+    return np.minimum(d, n - d) / (n / 2)
+
+
+@njit(cache=True, inline="always")
+def _out(a: float, eps: float, m: float) -> float:
+    y = m * (a - eps)
+    return 0.0 if y < 0.0 else (1.0 if y > 1.0 else y)
+
+
+@njit(cache=True)
+def _outputs(a: np.ndarray, y: np.ndarray, eps: np.ndarray, slope: np.ndarray) -> None:
+    for k in range(a.shape[0]):
+        for i in range(a.shape[1]):
+            y[k, i] = _out(a[k, i], eps[k], slope[k])
+
+
+@njit(cache=True)
+def _inputs(y: np.ndarray, salience: np.ndarray, feedback: float, ctx_rest: np.ndarray, lateral: np.ndarray,
+            stn_other: float, dopamine: float, out: np.ndarray, active: np.ndarray) -> None:  # fmt: skip
+    """Eqs. 5-14 for one loop into `out` (8, N); `stn_other` is the sum of the
+    other loop's STN outputs this loop's EP/SNr receives (eq. 10, times 0.4)."""
+    n = y.shape[1]
+    stn_sum, trn_sum = 0.0, 0.0
+    k = 0  # striatal channels with output go in `active`: few, so the lateral sums skip the rest
+    for j in range(n):
+        stn_sum += y[STN, j]
+        trn_sum += y[TRN, j]
+        if y[D1, j] > 0.0 or y[D2, j] > 0.0:
+            active[k] = j
+            k += 1
+    for i in range(n):
+        s = salience[i] + feedback * max(y[CTX, i] - ctx_rest[i], 0.0)
+        li1, li2 = 0.0, 0.0
+        for q in range(k):
+            j = active[q]
+            li1 += lateral[i, j] * y[D1, j]
+            li2 += lateral[i, j] * y[D2, j]
+        out[D1, i] = (1.0 + dopamine) * s - li1
+        out[D2, i] = (1.0 - dopamine) * s - li2
+        out[STN, i] = s - y[GP, i]
+        out[GP, i] = -y[D2, i] + 0.8 * stn_sum
+        out[EP, i] = -y[D1, i] - 0.4 * y[GP, i] + 0.8 * stn_sum + stn_other
+        out[VL, i] = y[CTX, i] - y[EP, i] - 0.13 * (trn_sum - y[TRN, i])
+        out[TRN, i] = y[VL, i] + y[CTX, i]
+        out[CTX, i] = y[VL, i]
+
+
+@njit(cache=True)
+def run_loops(a_d: np.ndarray, a_v: np.ndarray, s_d: np.ndarray, s_v: np.ndarray, fb_d: float, fb_v: float,
+              rest_d: np.ndarray, rest_v: np.ndarray, lat_d: np.ndarray, lat_v: np.ndarray, cross: float, steps: int,
+              h: float, dopamine: float, eps: np.ndarray, slope: np.ndarray) -> None:  # fmt: skip
+    """`steps` Euler steps of h = dt / tau of both loops in place; `cross` weighs
+    the dorsal STN's sum onto the ventral EP/SNr (0.4 in eq. 10; 0 for a lone loop)."""
+    y_d, y_v = np.empty_like(a_d), np.empty_like(a_v)
+    i_d, i_v = np.empty_like(a_d), np.empty_like(a_v)
+    act_d, act_v = np.empty(a_d.shape[1], np.int64), np.empty(a_v.shape[1], np.int64)
+    for _ in range(steps):
+        _outputs(a_d, y_d, eps, slope)
+        _outputs(a_v, y_v, eps, slope)
+        dorsal_stn = 0.0
+        for j in range(a_d.shape[1]):
+            dorsal_stn += y_d[STN, j]
+        _inputs(y_d, s_d, fb_d, rest_d, lat_d, 0.0, dopamine, i_d, act_d)
+        _inputs(y_v, s_v, fb_v, rest_v, lat_v, cross * dorsal_stn, dopamine, i_v, act_v)
+        for k in range(8):
+            for i in range(a_d.shape[1]):
+                a_d[k, i] += h * (i_d[k, i] - a_d[k, i])
+            for i in range(a_v.shape[1]):
+                a_v[k, i] += h * (i_v[k, i] - a_v[k, i])
+
+
+def outputs(a: np.ndarray) -> np.ndarray:
+    y = np.empty_like(a)
+    _outputs(a, y, EPSILON, SLOPE)
+    return y
+
+
+@dataclass(frozen=True)
+class LoopSpec:
+    channels: int
+    feedback: float  # weight of the cortical feedback P in the salience (eqs. 15-17: 0.4 dorsal, 0.2 ventral)
+    circular: bool  # lateral inhibition by channel distance (ventral) or uniform (dorsal)
+
+    def lateral(self) -> np.ndarray:
+        return lateral_circular(self.channels) if self.circular else lateral_uniform(self.channels)
+
+
+DORSAL = LoopSpec(channels=2, feedback=0.4, circular=False)
+VENTRAL = LoopSpec(channels=36, feedback=0.2, circular=True)
+
+
+class BasalGanglia:
+    """Two GPR loops stepped together; `cross` is the trans-subthalamic weight
+    (0.4, eq. 10).  A lone loop for tests: a ventral spec of 0 channels."""
+
+    def __init__(self, dorsal: LoopSpec = DORSAL, ventral: LoopSpec = VENTRAL, cross: float = 0.4,
+                 dt: float = DT, tau: float = TAU, dopamine: float = DOPAMINE):  # fmt: skip
+        self.dorsal, self.ventral, self.cross = dorsal, ventral, cross
+        self.h, self.dopamine, self.dt = dt / tau, dopamine, dt
+        self.lat_d, self.lat_v = dorsal.lateral(), ventral.lateral()
+        self.a_d = np.zeros((8, dorsal.channels))
+        self.a_v = np.zeros((8, ventral.channels))
+        # The resting state (zero salience), settled: the feedback counts from its cortex level and
+        # disinhibition from its EP/SNr level.  At rest the feedback is then 0, so the probe needs none.
+        self.ctx_rest_d, self.ctx_rest_v = np.full(dorsal.channels, np.inf), np.full(ventral.channels, np.inf)
+        self.run(np.zeros(dorsal.channels), np.zeros(ventral.channels), 2.0)
+        y_d, y_v = outputs(self.a_d), outputs(self.a_v)
+        self.ctx_rest_d, self.ctx_rest_v = y_d[CTX].copy(), y_v[CTX].copy()
+        self.rest_d, self.rest_v = y_d[EP].copy(), y_v[EP].copy()
+        self.a_d[...], self.a_v[...] = 0.0, 0.0
+
+    def run(self, s_dorsal: np.ndarray, s_ventral: np.ndarray, seconds: float) -> None:
+        """Integrate both loops for `seconds` with these external saliences held."""
+        steps = round(seconds / self.dt)
+        run_loops(self.a_d, self.a_v, np.ascontiguousarray(s_dorsal, np.float64),
+                  np.ascontiguousarray(s_ventral, np.float64), self.dorsal.feedback, self.ventral.feedback,
+                  self.ctx_rest_d, self.ctx_rest_v, self.lat_d, self.lat_v, self.cross, steps, self.h, self.dopamine,
+                  EPSILON, SLOPE)  # fmt: skip
+
+    def y_dorsal(self) -> np.ndarray:
+        return outputs(self.a_d)
+
+    def y_ventral(self) -> np.ndarray:
+        return outputs(self.a_v)
+
+    def disinhibition(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per channel, how far below its resting level the EP/SNr output is, as a
+        share of that level (1: fully released, 0 or less: not)."""
+        d = 1.0 - self.y_dorsal()[EP] / np.maximum(self.rest_d, 1e-9)
+        v = 1.0 - self.y_ventral()[EP] / np.maximum(self.rest_v, 1e-9) if self.ventral.channels else np.zeros(0)
+        return d, v
+
+    def state(self) -> dict[str, np.ndarray]:
+        return {"a_d": self.a_d.copy(), "a_v": self.a_v.copy()}
+
+    def restore(self, state: dict[str, np.ndarray]) -> None:
+        self.a_d[...] = state["a_d"]
+        self.a_v[...] = state["a_v"]
+
+
+def select_dorsal(disinhibition: np.ndarray, threshold: float) -> int:
+    """Winner-takes-all: the most disinhibited channel if it is released beyond `threshold`, else -1."""
+    k = int(np.argmax(disinhibition))
+    return k if disinhibition[k] > threshold else -1
+
+
+def select_ventral(disinhibition: np.ndarray, threshold: float) -> tuple[float, float]:
+    """(direction, strength): the vector sum of the channels released beyond
+    `threshold`, each weighted by how far beyond it (channel i points at
+    i * 360/N degrees); strength 0 (direction nan) when none is."""
+    n = len(disinhibition)
+    w = np.where(disinhibition > threshold, disinhibition - threshold, 0.0)
+    if not w.any():
+        return float("nan"), 0.0
+    angle = np.arange(n) * (2 * np.pi / n)
+    x, y = float(w @ np.cos(angle)), float(w @ np.sin(angle))
+    return float(np.arctan2(y, x) % (2 * np.pi)), float(np.hypot(x, y))

@@ -1,0 +1,296 @@
+"""Filliat-style navigation for the BG animat (Girard et al. 2005, section
+2.1) on the shared topological map (agents/controllers/navigation/topomap.py).
+
+A place is what the animat perceives there, turned allocentric by the
+compass: 36 grey levels of the panoramic camera and 8 sonar ranges.  On top
+of the map this module keeps what the BG model asks of the navigation
+system:
+
+- Disorientation D in [0, 1]: up by `d_rise` of the way to 1 each time a new
+  node is made, down by the factor `d_fall` at each observation in a node
+  known before the current visit (the paper: "D increases when the robot is
+  creating new nodes and only decreases when it spends time in well known
+  areas"); a node is known once `known_age` observations have passed since
+  it was made: coming back to it is coming back to a known area;
+- resources learned per node by a Hebbian rule with forgetting: while a
+  resource is usable, dw = `gain` * dt * b(node) * (1 - w); while it is not
+  even in sight, dw = -`gain` * dt * b(node) * w (a place that held it, where
+  it cannot be seen, has lost it: an exhausted resource is forgotten, not a
+  resource merely out of reach);
+- P(res): shortest routes over the links from every node that holds res,
+  weighted by what it holds and by exp(-distance / `reach`), give the
+  proximity of res from the current node; its direction is that of the
+  route's first `lookahead` metres (summed link displacements), spread over
+  the 36 directions by a von Mises bump;
+- BKA: P towards the known nodes (made `known_age` observations ago or more);
+- Expl: the directions in which the sonars see room and the map has no node
+  near yet, plus a slowly turning random preference (random exploration
+  finds what no map knows about).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from agents.controllers.bg.senses import to_allocentric
+from agents.controllers.navigation.topomap import MapParams, TopoMap, topomap_from_data, topomap_to_data
+from swarm.rng import fill_uniform
+
+DIRECTIONS = 36
+ANGLES = np.arange(DIRECTIONS) * (2 * math.pi / DIRECTIONS)
+S_EXPLORE = 101  # noise stream of the exploration preference
+
+
+@dataclass(frozen=True)
+class NavParams:
+    spacing: float = 0.3  # odometric metres between two observations (the map's delta d)
+    theta: float = 0.5  # largest dissimilarity that joins the current node
+    grey_scale: float = 35.0  # grey levels of one unit of dissimilarity
+    sonar_scale: float = 0.7  # metres of one unit of dissimilarity
+    d_rise: float = 0.1
+    d_fall: float = 0.9
+    gain: float = 0.05  # Hebbian gain, 1/s (learning and forgetting)
+    reach: float = 5.0  # m: P falls by e over this route length
+    lookahead: float = 1.0  # m of route whose direction P points along
+    width: float = 4.0  # von Mises concentration of a direction's bump over the 36 channels
+    known_age: int = 20  # observations after its creation from which coming back to a node means a known area
+    near: float = 0.6  # m: a new node is linked to the nodes observed this close in the last `recent` m
+    recent: float = 10.0
+    open_range: float = 1.0  # m of sonar room from which a direction counts as open
+    novelty_radius: float = 2.0  # m: nodes nearer than this, in a direction, make it known
+    wander_period: float = 20.0  # s between two draws of the exploration preference
+    wander_weight: float = 0.5
+
+
+class PlaceSignatures:
+    """Grey panorama (36) + sonar (8), allocentric; P(match) = exp(-mean squared scaled difference)."""
+
+    def __init__(self, grey_scale: float, sonar_scale: float):
+        self.gs, self.ss = grey_scale, sonar_scale
+
+    def likelihoods(self, observation: Any, means: list[Any]) -> np.ndarray:
+        if not means:
+            return np.zeros(0)
+        m = np.stack(means)
+        g = ((m[:, :DIRECTIONS] - observation[:DIRECTIONS]) / self.gs) ** 2
+        s = ((m[:, DIRECTIONS:] - observation[DIRECTIONS:]) / self.ss) ** 2
+        return np.exp(-0.5 * (g.mean(axis=1) + s.mean(axis=1)))
+
+    def mean(self, members: list[Any]) -> Any:
+        return np.mean(members, axis=0)
+
+
+def bump(direction: float, strength: float, width: float) -> np.ndarray:
+    """A von Mises bump over the 36 directions, peak `strength` at `direction`."""
+    return strength * np.exp(width * (np.cos(ANGLES - direction) - 1.0))
+
+
+class Navigator:
+    def __init__(self, params: NavParams, seed: int, agent: int, resources: tuple[str, ...]):
+        self.p, self.seed, self.agent = params, seed, agent
+        self.map = TopoMap(PlaceSignatures(params.grey_scale, params.sonar_scale),
+                           MapParams(theta=params.theta, near=params.near, recent=params.recent))  # fmt: skip
+        self.born: list[int] = []  # observation count at each node's creation
+        self.observations = 0
+        self.resources = resources
+        self.assoc: dict[str, np.ndarray] = {r: np.zeros(0) for r in resources}
+        self.xy = np.zeros(2)  # odometric position (compass-turned odometry)
+        self.since = np.zeros(2)  # displacement since the last observation
+        self.D = 0.0
+        self.created = 0
+        self.relocalize = False
+        self._edge_key: tuple = ()
+        self._edge_cache: tuple[np.ndarray, np.ndarray, np.ndarray] = ()  # type: ignore[assignment]
+        self._towards: dict[tuple, np.ndarray] = {}  # P vectors, until the map or what nodes hold changes
+        self._novel_key: tuple = ()
+        self._novel = np.ones(DIRECTIONS)
+        self._wander_key = -1
+        self._wander = np.zeros(DIRECTIONS)
+
+    # ----------------------------------------------------------- sensing
+
+    def move(self, forward: float, heading: float) -> None:
+        d = forward * np.array([math.cos(heading), math.sin(heading)])
+        self.xy = self.xy + d
+        self.since = self.since + d
+
+    def due(self) -> bool:
+        return float(np.hypot(*self.since)) >= self.p.spacing or not self.map.nodes
+
+    def lost(self) -> None:
+        """The animat was put down somewhere on a map it has (a loaded one): the next observation
+        localizes it by matching alone, and its odometric frame is re-anchored on that node."""
+        self.relocalize = True
+
+    def observe(self, grey: np.ndarray, sonar: np.ndarray, heading: float) -> int:
+        """Map one place (every `spacing` metres): join, close a loop or create a node; D follows."""
+        observation = np.concatenate([to_allocentric(grey.astype(np.float64), heading), to_allocentric(sonar, heading)])
+        if self.relocalize and self.map.nodes:
+            self.map.belief = np.full(len(self.map.nodes), 1.0 / len(self.map.nodes))
+            _, belief = self.map.localize(observation, np.zeros(2))
+            node = int(np.argmax(belief))
+            self.map.current, self.map.belief = node, np.eye(len(self.map.nodes))[node]
+            self.xy, self.since, self.relocalize = self.map.nodes[node].position.copy(), np.zeros(2), False
+            return node
+        before, folded = len(self.map.nodes), len(self.map.folded)
+        node = self.map.observe(observation, self.xy, self.since)
+        if len(self.map.folded) > folded:  # a young node turned out to be a known place: what it held goes there
+            for young, known in list(self.map.folded.items())[folded:]:
+                for w in self.assoc.values():
+                    w[known], w[young] = max(w[known], w[young]), 0.0
+        self.since = np.zeros(2)
+        self.observations += 1
+        self.born += [self.observations] * (len(self.map.nodes) - before)
+        if len(self.map.nodes) > before:
+            self.created += 1
+            self.D += self.p.d_rise * (1.0 - self.D)
+            for r in self.resources:
+                self.assoc[r] = np.concatenate([self.assoc[r], np.zeros(len(self.map.nodes) - len(self.assoc[r]))])
+        elif self.observations - self.born[node] >= self.p.known_age:
+            self.D *= self.p.d_fall
+        return node
+
+    def learn(self, usable: dict[str, bool], seen: dict[str, bool], dt: float) -> None:
+        """Hebbian association of the believed nodes with the resources usable there, and forgetting:
+        a node believed to hold a resource that is not even in sight from there loses it."""
+        b = self.map.belief
+        if len(b) == 0:
+            return
+        for r in self.resources:
+            w = self.assoc[r]
+            if usable.get(r):
+                w += self.p.gain * dt * b * (1.0 - w)
+            elif not seen.get(r):
+                w -= self.p.gain * dt * b * w
+
+    # ----------------------------------------------------------- vectors
+
+    def _edges(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(from, to, length) of every link both ways, rebuilt only when the links change."""
+        key = (len(self.map.nodes), len(self.map.links), self.observations)
+        if self._edge_key != key:
+            ab = np.array(list(self.map.links), np.int64).reshape(-1, 2)
+            d = np.array([max(link.distance, 1e-3) for link in self.map.links.values()])
+            self._edge_cache = (np.concatenate([ab[:, 0], ab[:, 1]]), np.concatenate([ab[:, 1], ab[:, 0]]),
+                                np.concatenate([d, d]))  # fmt: skip
+            self._edge_key = key
+        return self._edge_cache
+
+    def towards(self, strength: np.ndarray) -> np.ndarray:
+        """36-vector pointing along the route to the nodes of largest strength * exp(-route / reach)."""
+        k = len(self.map.nodes)
+        here = self.map.current
+        if k == 0 or here < 0 or not (strength > 1e-3).any():
+            return np.zeros(DIRECTIONS)
+        key = (self.observations, here, np.round(strength, 2).tobytes())
+        if key in self._towards:
+            return self._towards[key]
+        rows, cols, lengths = self._edges()
+        sources = np.flatnonzero(strength > 1e-3)  # a virtual source k reaches each by what it holds
+        g = csr_matrix((np.concatenate([lengths, -self.p.reach * np.log(strength[sources])]),
+                        (np.concatenate([rows, np.full(len(sources), k)]), np.concatenate([cols, sources]))),
+                       shape=(k + 1, k + 1))  # fmt: skip
+        dist, pred = dijkstra(g, directed=True, indices=k, return_predecessors=True)
+        out = np.zeros(DIRECTIONS)
+        if np.isfinite(dist[here]):
+            value = math.exp(-dist[here] / self.p.reach)
+            offset, node, travelled = np.zeros(2), here, 0.0
+            while pred[node] != k and pred[node] >= 0 and travelled < self.p.lookahead:
+                nxt = int(pred[node])
+                d = self._displacement(node, nxt)
+                offset, travelled, node = offset + d, travelled + float(np.hypot(*d)), nxt
+            if travelled > 0.0:  # else here is where it is: the last stretch is the taxon's
+                out = bump(math.atan2(offset[1], offset[0]), value, self.p.width)
+        if len(self._towards) > 64:
+            self._towards.clear()
+        self._towards[key] = out
+        return out
+
+    def _displacement(self, a: int, b: int) -> np.ndarray:
+        key = (min(a, b), max(a, b))
+        d = self.map.links[key].displacement
+        return d if a < b else -d
+
+    def plan(self, resource: str) -> np.ndarray:
+        return self.towards(self.assoc[resource])
+
+    def back_to_known(self) -> np.ndarray:
+        known = (self.observations - np.array(self.born) >= self.p.known_age).astype(np.float64)
+        if len(known) and self.map.current >= 0 and known[self.map.current]:
+            return np.zeros(DIRECTIONS)
+        return self.towards(known)
+
+    def explore(self, sonar: np.ndarray, heading: float, time: float, use_map: bool) -> np.ndarray:
+        """A bump at the direction to explore: where the sonars see room, the map has no node near
+        yet, and a random preference (turning every `wander_period` seconds, drawn from seed, agent and
+        that period's index) points.  One bump, not a broad profile: a broad salience over the 36
+        channels excites the diffuse STN so much that no channel is released (docs/bg.md)."""
+        alloc = to_allocentric(sonar, heading)
+        room = np.interp(ANGLES, np.arange(9) * (2 * math.pi / 8), np.append(alloc, alloc[0]))
+        open_ = np.clip(room / self.p.open_range - 0.5, 0.0, 1.0)
+        if self._novel_key != (self.observations, use_map):  # the map's coverage changes only at observations
+            self._novel = self._novelty(use_map)
+            self._novel_key = (self.observations, use_map)
+        period = int(time // self.p.wander_period)
+        if self._wander_key != period:
+            u = np.empty((1, 1))
+            fill_uniform(np.int64(self.seed), np.array([self.agent]), np.int64(period), np.int64(S_EXPLORE), u)
+            self._wander = bump(float(u[0, 0]) * math.pi, self.p.wander_weight, 2.0)
+            self._wander_key = period
+        score = open_ * (0.5 * self._novel + self._wander)
+        if score.max() <= 0:
+            return np.zeros(DIRECTIONS)
+        return bump(ANGLES[int(np.argmax(score))], 1.0, self.p.width)
+
+    def _novelty(self, use_map: bool) -> np.ndarray:
+        """Per direction, 1 where no node of the map lies within `novelty_radius`, falling with each one that does."""
+        if not (use_map and self.map.nodes):
+            return np.ones(DIRECTIONS)
+        pos = np.array([n.position for n in self.map.nodes]) - self.xy
+        dist = np.hypot(pos[:, 0], pos[:, 1])
+        near = (dist < self.p.novelty_radius) & (dist > 0.2)
+        if not near.any():
+            return np.ones(DIRECTIONS)
+        ang = np.arctan2(pos[near, 1], pos[near, 0])
+        seen = np.exp(4.0 * (np.cos(ANGLES[:, None] - ang[None, :]) - 1.0)).sum(axis=1)
+        return np.exp(-seen / 2.0)
+
+    # ------------------------------------------------------------ state
+
+    def to_data(self) -> dict[str, Any]:
+        """The map, what its nodes hold and the odometric frame, as plain data (to save and load)."""
+        return {"map": topomap_to_data(self.map, lambda sig: np.asarray(sig).tolist()),
+                "assoc": {r: w.tolist() for r, w in self.assoc.items()}, "xy": self.xy.tolist(),
+                "since": self.since.tolist(), "D": self.D, "created": self.created, "born": self.born,
+                "observations": self.observations, "relocalize": self.relocalize}  # fmt: skip
+
+    def from_data(self, data: dict[str, Any]) -> None:
+        try:
+            self.map = topomap_from_data(data["map"], self.map.signatures, self.map.params, _place,
+                                         "a bg map", "BgController.map_data()")  # fmt: skip
+            assoc = {r: np.array(data["assoc"].get(r, [0.0] * len(self.map.nodes)), np.float64)
+                     for r in self.resources}  # fmt: skip
+            if any(w.shape != (len(self.map.nodes),) for w in assoc.values()):
+                raise ValueError("one resource weight per node expected")
+            self.assoc = assoc
+            self.xy, self.since = np.array(data["xy"], np.float64), np.array(data["since"], np.float64)
+            self.D, self.created = float(data["D"]), int(data["created"])
+            self.born, self.observations = [int(b) for b in data["born"]], int(data["observations"])
+            self.relocalize = bool(data.get("relocalize", False))
+            if len(self.born) != len(self.map.nodes):
+                raise ValueError("one birth per node expected")
+        except (KeyError, TypeError, ValueError, AttributeError) as e:
+            raise ValueError(f"a bg map: malformed ({e}); expected what BgController.map_data() writes") from None
+
+
+def _place(data: Any) -> np.ndarray:
+    a = np.array(data, np.float64)
+    if a.shape != (DIRECTIONS + 8,) or not np.isfinite(a).all():
+        raise ValueError(f"a place: expected {DIRECTIONS + 8} finite numbers")
+    return a

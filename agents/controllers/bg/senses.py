@@ -1,0 +1,89 @@
+"""The animat's face on its sensors (Girard et al. 2005, section 3.2).
+
+The camera gives the colour of the nearest thing in each 10-degree sector;
+the BG model reads three kinds of resource from it by their grey level
+(ingesting 127, digesting 255, dangerous 31: the simulator's visual sensors
+see colours directly).  Channels of the ventral loop are allocentric
+directions, so every egocentric reading is turned by the compass first.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+RESOURCES = ("DA", "Ep", "E")  # dangerous, potential energy (ingesting), energy (digesting)
+RESOURCE_GREY = np.array([31, 127, 255])
+WINDOW = 7  # pixels (sectors) of the window centred on each direction (the paper)
+_HALF = WINDOW // 2
+_WINDOWS = (np.arange(36)[:, None] + np.arange(-_HALF, _HALF + 1)[None, :]) % 36  # per direction, its window
+
+
+def to_allocentric(readings: np.ndarray, heading: float) -> np.ndarray:
+    """Readings of equally spaced egocentric bearings (k * 360/n degrees from the
+    heading) resampled at the allocentric directions k * 360/n, linearly
+    between neighbours (the last axis is the bearing)."""
+    n = readings.shape[-1]
+    pos = (np.arange(n) - heading * n / (2 * math.pi)) % n  # where direction k falls among the bearings
+    lo = np.floor(pos).astype(np.int64)
+    f = pos - lo
+    return readings[..., lo] * (1 - f) + readings[..., (lo + 1) % n] * f
+
+
+def resource_pixels(grey: np.ndarray, heading: float) -> np.ndarray:
+    """(3, n) booleans: which allocentric sectors show each resource (RESOURCES order).
+    Sector k of the camera points at heading + k * 360/n; it goes to the nearest direction."""
+    n = len(grey)
+    shift = round(heading * n / (2 * math.pi)) % n
+    pixels = grey[None, :] == RESOURCE_GREY[:, None]
+    return np.roll(pixels, shift, axis=1)
+
+
+def proximity(pixels: np.ndarray) -> np.ndarray:
+    """Prox vectors (3, n): per direction, the contiguous pixels of the resource
+    in the 7-pixel window centred on it -- the run through the centre pixel,
+    cut to the window -- over 7.  0 where the centre pixel does not show the
+    resource (so a direction points at what it sees), 1 when the resource
+    fills the window (it then spans more than 60 degrees: the paper's A(.))."""
+    win = pixels[:, _WINDOWS]  # (3, n, 7): each direction's window, centre at _HALF
+    right = np.cumprod(win[..., _HALF:], axis=2).sum(axis=2)  # the centre and the run after it
+    left = np.cumprod(win[..., _HALF::-1], axis=2).sum(axis=2)  # the centre and the run before it
+    return np.where(win[..., _HALF], left + right - 1, 0) / WINDOW
+
+
+SIDE = 1 / 3
+
+
+class Reflex:
+    """The sonar obstacle-avoidance reflex that overrides the BG's choice when
+    something is nearer than `too_close` straight ahead, or nearer than a
+    third of it to the sonars at +-45 degrees.  It turns away, to the side with more room (chosen when it
+    starts and kept, so it does not flip between two walls), backing off when
+    nearly touching; once the front is clear it drives straight on for `hold`
+    seconds, past the obstacle, before giving the BG back the body."""
+
+    def __init__(self, too_close: float, hold: float):
+        self.too_close, self.hold = too_close, hold
+        self.side = 0  # +1 turning left, -1 right, 0 off
+        self.clear_for = math.inf  # seconds since the front became clear
+
+    def __call__(self, sonar: np.ndarray, dt: float) -> tuple[float, float] | None:
+        """(forward factor of the top speed, turn sign) while the reflex has the body, else None."""
+        n = len(sonar)
+        # straight ahead at `too_close`; the +-45 degree sonars at a third of it: in the bg corridors
+        # (0.8 m for a 0.3 m body) anything more sets the reflex off at every sway
+        if sonar[0] < self.too_close or min(sonar[1], sonar[n - 1]) < self.too_close * SIDE:
+            if self.side == 0:
+                self.side = 1 if sonar[1 : n // 2].mean() >= sonar[n // 2 + 1 :].mean() else -1
+            self.clear_for = 0.0
+            return (-0.25 if sonar[0] < 0.6 * self.too_close else 0.0), float(self.side)
+        self.side = 0
+        self.clear_for += dt
+        return (1.0, 0.0) if self.clear_for < self.hold else None
+
+    def state(self) -> list[float]:
+        return [float(self.side), self.clear_for]
+
+    def restore(self, state: list[float]) -> None:
+        self.side, self.clear_for = int(state[0]), float(state[1])

@@ -1,0 +1,315 @@
+"""`swarm experiment bg-survival | bg-choice | bg-forget | bg-fear | bg-tmaze`:
+the experiments of Girard et al. (2005) with the bg animat.
+
+- bg-survival (exp. 1, Table 1): condition A (taxon + topological) against B
+  (taxon only) in bg-exp1, each run until death or 4 h; medians, ranges and a
+  Mann-Whitney U test (the paper's Table 1 caption swaps A and B; its text
+  is right: A uses the map).
+- bg-choice (exp. 2.1, Table 2): a map built without Ep2, then Ep2 appears;
+  which Ep the animat reloads at first, for W_plan 0.65 / 0.55 / 0.45.
+- bg-forget (exp. 2.2): a map built with Ep2, then Ep2 is gone; the time to
+  forget it (the time to reload at Ep1 less the most direct path's).
+- bg-fear (exp. 3.1, Table 3): F = 0.2 and Ep 0.1 or 0.5; Ep1 behind the
+  dangerous area or the far Ep2; Fisher's exact test.
+- bg-tmaze (exp. 3.2, Table 4): the T-maze with branch ratios 1, 1.5, 2;
+  which branch the animat enters first.
+
+Experiments 2 and 3 give the animat "a previously built map": one mapping
+run per experiment (the animat lives `MAPPING_SECONDS` there, hungry, so it
+meets the resources), saved, and loaded by every test.  Every test differs
+from the others only by its seed (sensor noise, exploration draws).
+docs/bg.md says every choice.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from swarm.arena.experiments import pool_map, write_runs
+from swarm.scenario import ScenarioError, load_scenario
+
+EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze")
+SCENARIO = {"bg-survival": "bg-exp1", "bg-choice": "bg-exp2", "bg-forget": "bg-exp2", "bg-fear": "bg-exp3",
+            "bg-tmaze": "tmaze"}  # fmt: skip
+REPS = {"bg-survival": 10, "bg-choice": 15, "bg-forget": 15, "bg-fear": 20, "bg-tmaze": 15}
+MAPPING_SECONDS = 1800.0  # the mapping phase of experiments 2 and 3: half an hour of the animat's life
+MAPPING_LEVELS = (0.6, 0.6)  # E, Ep during mapping: needs enough to seek resources and reload there
+TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep by then counts as "none"
+W_PLANS = (0.65, 0.55, 0.45)
+FEAR_EP = (0.1, 0.5)
+RATIOS = (1.0, 1.5, 2.0)
+# The paper's numbers, to print beside ours.
+PAPER_SURVIVAL = {"A": (14431.5, 2531, 17274), "B": (4908.0, 2518, 8831), "U": 15}
+PAPER_CHOICE = {0.65: (13, 2), 0.55: (7, 8), 0.45: (2, 13)}
+PAPER_FORGET = (178.0, 78.0, 300.0)  # mean, sd, max seconds
+PAPER_FEAR = {0.1: (13, 7), 0.5: (2, 18)}
+PAPER_TMAZE = {1.0: (3, 12), 1.5: (4, 11), 2.0: (8, 7)}
+JUNCTION = (3.1, 4.3)  # T-maze: the stem's walls (x): left of the first is the left branch, right of the second the right
+
+
+def _with(s, bg: dict[str, Any] | None = None, metabolism: dict[str, Any] | None = None,
+          seed: int | None = None, absent: tuple[str, ...] = (), max_ticks: int | None = None):  # fmt: skip
+    """A scenario changed for one run: [bg] fields, metabolism fields, resources taken away."""
+    params = dict(s.controller_params)
+    params["bg"] = {**params.get("bg", {}), **(bg or {})}
+    obstacles = tuple(dataclasses.replace(o, appear=10**9) if o.name in absent else o for o in s.obstacles)
+    m = dataclasses.replace(s.metabolism, **(metabolism or {}))
+    out = dataclasses.replace(s, controller_params=params, obstacles=obstacles, metabolism=m,
+                              seed=s.seed if seed is None else seed,
+                              max_ticks=s.max_ticks if max_ticks is None else max_ticks)  # fmt: skip
+    return out
+
+
+# ------------------------------------------------------------------ runs
+
+
+def run_survival(job: tuple) -> dict:
+    """One animat in bg-exp1 until it dies or 4 h pass: (condition, run, seed)."""
+    from swarm.arena.engine import ArenaEngine
+
+    condition, run, seed = job
+    s = _with(load_scenario("bg-exp1"), bg={"planning": condition == "A"}, seed=seed)
+    summary = ArenaEngine(s).run()
+    r = summary["robots"][0]
+    return {"condition": condition, "run": run, "seed": seed, "survival_seconds": r["survival_seconds"],
+            "died": not r["alive"], "reload_e_seconds": r["reloads"]["ReloadE"] * s.control_period,
+            "reload_ep_seconds": r["reloads"]["ReloadEp"] * s.control_period, "idle_acts": r["idle_acts"],
+            "distance": r["distance"], "nodes": (r.get("map") or {}).get("nodes"),
+            "wall_seconds": summary["wall_seconds"]}  # fmt: skip
+
+
+def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] | None = None) -> dict:
+    """The mapping phase: the animat lives MAPPING_SECONDS in `name`, hungry; its map as plain data."""
+    from swarm.arena.engine import ArenaEngine
+
+    s = load_scenario(name)
+    ticks = int(MAPPING_SECONDS / s.control_period)
+    s = _with(s, bg=bg, metabolism={"energy": MAPPING_LEVELS[0], "potential": MAPPING_LEVELS[1], "stop_at": "death"},
+              seed=seed, absent=absent, max_ticks=ticks)  # fmt: skip
+    engine = ArenaEngine(s)
+    engine.run()
+    return engine.controllers[0].map_data()
+
+
+def run_test(job: tuple) -> dict:
+    """One test of experiments 2 and 3 on a loaded map: (experiment, label, run, seed, scenario, bg, metabolism,
+    absent, map)."""
+    from swarm.arena.engine import ArenaEngine
+
+    experiment, label, run, seed, name, bg, metabolism, absent, map_data = job
+    s = load_scenario(name)
+    s = _with(s, bg={**bg, "map": map_data}, metabolism=metabolism, seed=seed, absent=absent,
+              max_ticks=int(TEST_SECONDS / s.control_period))  # fmt: skip
+    engine = ArenaEngine(s)
+    first_branch = None
+    while not engine.world.done():
+        engine.step(1)
+        x = float(engine.world.pose[0, 0])
+        if first_branch is None and experiment == "bg-tmaze" and float(engine.world.pose[0, 1]) > 3.1:
+            first_branch = "left" if x < JUNCTION[0] else "right" if x > JUNCTION[1] else None
+    r = engine.summary()["robots"][0]
+    seconds = r["ingest_tick"] * s.control_period if r["ingest_tick"] is not None else None
+    return {"experiment": experiment, "condition": label, "run": run, "seed": seed, "chose": r["ingested"] or "none",
+            "branch": first_branch or "", "seconds": seconds, "distance": r["distance"],
+            "wall_seconds": engine.wall_seconds}  # fmt: skip
+
+
+# --------------------------------------------------------------- summaries
+
+
+def _survival_summary(rows: list[dict]) -> tuple[list[dict], str]:
+    from scipy.stats import mannwhitneyu
+
+    a = np.array([r["survival_seconds"] for r in rows if r["condition"] == "A"])
+    b = np.array([r["survival_seconds"] for r in rows if r["condition"] == "B"])
+    summary, lines = [], []
+    for cond, x in (("A", a), ("B", b)):
+        paper = PAPER_SURVIVAL[cond]
+        summary.append({"condition": cond, "runs": len(x), "median_s": float(np.median(x)), "min_s": float(x.min()),
+                        "max_s": float(x.max()), "alive_at_cap": int(sum(not r["died"] for r in rows
+                                                                          if r["condition"] == cond)),
+                        "paper_median_s": paper[0], "paper_min_s": paper[1], "paper_max_s": paper[2]})  # fmt: skip
+        lines.append(f"| {cond} | {len(x)} | {np.median(x):.1f} | {x.min():.0f} : {x.max():.0f} | {paper[0]} | "
+                     f"{paper[1]} : {paper[2]} | {np.median(x) / paper[0]:.2f} |")  # fmt: skip
+    test = mannwhitneyu(a, b, alternative="two-sided")
+    u = min(test.statistic, len(a) * len(b) - test.statistic)
+    md = ("| condition | runs | median (s) | range (s) | paper median | paper range | ours / paper |\n"
+          "|---|---|---|---|---|---|---|\n" + "\n".join(lines) +
+          f"\n\nMann-Whitney U = {u:.1f}, p = {test.pvalue:.3g} (two-sided); the paper: U = {PAPER_SURVIVAL['U']}, "
+          f"p < 0.01.  A is taxon + topological navigation, B taxon only (the paper's text; its Table 1 caption "
+          f"swaps them).\n")  # fmt: skip
+    summary.append({"condition": "U test", "u": u, "p": test.pvalue, "paper_u": PAPER_SURVIVAL["U"]})
+    return summary, md
+
+
+def _choice_summary(rows: list[dict], paper: dict, header: str, options: tuple[str, str], field: str = "chose",
+                    fisher: bool = False) -> tuple[list[dict], str]:  # fmt: skip
+    summary, lines, table = [], [], []
+    for cond, (p1, p2) in paper.items():
+        sel = [r for r in rows if r["condition"] == cond]
+        n1 = sum(r[field] == options[0] for r in sel)
+        n2 = sum(r[field] == options[1] for r in sel)
+        other = len(sel) - n1 - n2
+        table.append([n1, n2])
+        summary.append({"condition": cond, "runs": len(sel), options[0]: n1, options[1]: n2, "neither": other,
+                        f"paper_{options[0]}": p1, f"paper_{options[1]}": p2})  # fmt: skip
+        lines.append(f"| {cond} | {n1} | {n2} | {other} | {p1} | {p2} |")
+    md = (f"| {header} | {options[0]} | {options[1]} | neither | paper {options[0]} | paper {options[1]} |\n"
+          "|---|---|---|---|---|---|\n" + "\n".join(lines) + "\n")  # fmt: skip
+    if fisher:
+        from scipy.stats import fisher_exact
+
+        p = fisher_exact(table).pvalue
+        md += f"\nFisher's exact test: p = {p:.3g} (the paper: p < 0.01).\n"
+        summary.append({"condition": "Fisher", "p": p})
+    return summary, md
+
+
+def _forget_summary(rows: list[dict], direct: float) -> tuple[list[dict], str]:
+    times = np.array([r["seconds"] - direct for r in rows if r["chose"] == "Ep1" and r["seconds"] is not None])
+    n = len(rows)
+    mean, sd, top = (float(times.mean()), float(times.std(ddof=1)) if len(times) > 1 else 0.0, float(times.max())) \
+        if len(times) else (math.nan, math.nan, math.nan)  # fmt: skip
+    pm, ps, px = PAPER_FORGET
+    md = (f"| tests | reached Ep1 | mean (s) | sd (s) | max (s) | paper mean | paper sd | paper max |\n"
+          f"|---|---|---|---|---|---|---|---|\n| {n} | {len(times)} | {mean:.0f} | {sd:.0f} | {top:.0f} | {pm:.0f} | "
+          f"{ps:.0f} | {px:.0f} |\n\nTime to forget = time to reload at Ep1 less the most direct path's "
+          f"({direct:.0f} s here: start, Ep2's reach, Ep1's reach at 0.4 m/s; the paper's was 46 s).\n")  # fmt: skip
+    return [{"tests": n, "reached_ep1": len(times), "mean_s": mean, "sd_s": sd, "max_s": top, "direct_s": direct,
+             "paper_mean_s": pm, "paper_sd_s": ps, "paper_max_s": px}], md  # fmt: skip
+
+
+def direct_seconds(name: str) -> float:
+    """bg-forget's most direct path: start to Ep2's reach, then on to Ep1's reach (A*), at the animat's top speed."""
+    from swarm.arena.engine import _planner
+
+    s = load_scenario(name)
+    planner = _planner(s.size, s.walls)
+    res = {o.name: o for o in s.obstacles}
+    start = tuple(s.groups[0].starts[0][:2])
+    leg1 = planner.plan(start, res["Ep2"].centre)[0] - res["Ep2"].reach
+    leg2 = planner.plan(res["Ep2"].centre, res["Ep1"].centre)[0] - res["Ep1"].reach
+    return (leg1 + res["Ep2"].reach + leg2) / s.groups[0].robot.max_speed
+
+
+# ------------------------------------------------------------------ plots
+
+
+def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) -> None:
+    from swarm.experiments import _pyplot, _save
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    if experiment == "bg-survival":
+        for k, cond in enumerate(("A", "B")):
+            x = [r["survival_seconds"] / 3600 for r in rows if r["condition"] == cond]
+            ax.scatter(np.full(len(x), k) + np.linspace(-0.15, 0.15, len(x)), x, alpha=0.7)
+            ax.plot([k - 0.3, k + 0.3], [np.median(x)] * 2, "k-")
+            ax.plot([k - 0.3, k + 0.3], [PAPER_SURVIVAL[cond][0] / 3600] * 2, "r--")
+        ax.set_xticks([0, 1], ["A: taxon + map", "B: taxon only"])
+        ax.set_ylabel("survival (h); black: our median, red: the paper's")
+    elif experiment == "bg-forget":
+        x = [r["seconds"] for r in rows if r["seconds"] is not None]
+        ax.hist(x, bins=10)
+        ax.set_xlabel("seconds to reload at Ep1")
+    else:
+        rows_ = [r for r in summary if isinstance(r.get("runs"), int)]
+        keys = [k for k in rows_[0] if k not in ("condition", "runs", "neither") and not k.startswith("paper")]
+        x = np.arange(len(rows_))
+        for k, key in enumerate(keys):
+            ax.bar(x + (k - 0.5) * 0.35, [r[key] for r in rows_], 0.35, label=f"ours: {key}")
+            ax.plot(x + (k - 0.5) * 0.35, [r[f"paper_{key}"] for r in rows_], "k_", markersize=20)
+        ax.set_xticks(x, [str(r["condition"]) for r in rows_])
+        ax.set_ylabel("tests (bars ours, black ticks the paper)")
+        ax.legend()
+    ax.set_title(experiment)
+    _save(fig, path)
+
+
+# ------------------------------------------------------------------ entry
+
+
+def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
+                      out: Path | None, ratios: tuple[float, ...] | None = None,
+                      progress: bool = True) -> dict:  # fmt: skip
+    expected = SCENARIO[experiment]
+    if scenario not in (None, expected) and not (experiment == "bg-tmaze" and scenario.startswith("tmaze")):
+        raise ScenarioError("command line", "--scenario", f"{experiment} runs on {expected} (the paper's)")
+    reps = REPS[experiment] if reps is None else reps
+    if reps < 2:
+        raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
+    out = Path(out) if out is not None else Path("results") / experiment
+    out.mkdir(parents=True, exist_ok=True)
+    if experiment == "bg-survival":
+        work = [(c, k, seed + k) for c in ("A", "B") for k in range(reps)]
+        rows = pool_map(work, run_survival, jobs, experiment, progress)
+        rows.sort(key=lambda r: (r["condition"], r["run"]))
+        summary, md = _survival_summary(rows)
+        title = f"# Experiment 1 (Girard et al. 2005): survival with and without the map\n\n{reps} runs per " \
+                f"condition, at most 4 h; seed {seed}.\n\n"
+    else:
+        work, maps = _tests(experiment, reps, seed, ratios)
+        (out / "maps.json").write_text(json.dumps(maps))
+        rows = pool_map(work, run_test, jobs, experiment, progress)
+        rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
+        summary, md, title = _test_summary(experiment, rows, reps, seed, maps)
+    write_runs(out, "runs.csv", list(rows[0]), rows, summary)
+    _plot(experiment, rows, summary, out / "plot.png")
+    text = title + md
+    (out / "table.md").write_text(text)
+    return {"name": experiment, "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
+
+
+def _tests(experiment: str, reps: int, seed: int, ratios) -> tuple[list[tuple], dict[str, dict]]:
+    """The tests' jobs, and the maps they load (built here, once per scenario)."""
+    work, maps = [], {}
+    if experiment in ("bg-choice", "bg-forget"):
+        mapped_without = ("Ep2",) if experiment == "bg-choice" else ()
+        maps["bg-exp2"] = build_map("bg-exp2", seed, mapped_without)
+        if experiment == "bg-choice":
+            for w in W_PLANS:
+                work += [(experiment, w, k, seed + k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, (),
+                          maps["bg-exp2"]) for k in range(reps)]  # fmt: skip
+        else:
+            work += [(experiment, "Ep2 gone", k, seed + k, "bg-exp2", {}, {}, ("Ep2",), maps["bg-exp2"])
+                     for k in range(reps)]  # fmt: skip
+    elif experiment == "bg-fear":
+        maps["bg-exp3"] = build_map("bg-exp3", seed, ())
+        for ep in FEAR_EP:
+            work += [(experiment, ep, k, seed + k, "bg-exp3", {}, {"potential": ep}, (), maps["bg-exp3"])
+                     for k in range(reps)]  # fmt: skip
+    else:
+        for ratio in ratios or RATIOS:
+            name = f"tmaze-{ratio:g}"
+            maps[name] = build_map(name, seed, ())
+            work += [(experiment, ratio, k, seed + k, name, {}, {}, (), maps[name]) for k in range(reps)]
+    return work, maps
+
+
+def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int,
+                  maps: dict) -> tuple[list[dict], str, str]:  # fmt: skip
+    held = "; ".join(f"{name}: {len(m['map']['nodes'])} nodes, holding "
+                     + ", ".join(f"{r} {sum(w > 0.5 for w in ws)}" for r, ws in m["assoc"].items())
+                     for name, m in maps.items())  # fmt: skip
+    head = f"{reps} tests per condition; seed {seed}; each on the map of a {MAPPING_SECONDS / 60:.0f}-minute " \
+           f"mapping run ({held}).\n\n"
+    if experiment == "bg-choice":
+        summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
+        title = "# Experiment 2.1 (Girard et al. 2005): a new resource, planning against taxon\n\n" + head
+    elif experiment == "bg-forget":
+        summary, md = _forget_summary(rows, direct_seconds("bg-exp2"))
+        title = "# Experiment 2.2 (Girard et al. 2005): forgetting an exhausted resource\n\n" + head
+    elif experiment == "bg-fear":
+        summary, md = _choice_summary(rows, PAPER_FEAR, "Ep at start", ("Ep1", "Ep2"), fisher=True)
+        title = "# Experiment 3.1 (Girard et al. 2005): fear against the need for Ep (F = 0.2)\n\n" + head
+    else:
+        paper = {r: PAPER_TMAZE[r] for r in sorted({row["condition"] for row in rows})}
+        summary, md = _choice_summary(rows, paper, "ratio", ("left", "right"), field="branch")
+        title = "# Experiment 3.2 (Girard et al. 2005): the T-maze, first branch entered\n\n" + head
+    return summary, md, title

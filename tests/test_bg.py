@@ -1,0 +1,285 @@
+"""The bg animat (Girard et al. 2005): the world's metabolism, the animat's
+senses, motivations and saliences, its map, and the controller in both
+runtimes.  The GPR loops are in test_bg_gpr.py."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from agents.controllers.bg import BgController
+from agents.controllers.bg.places import ANGLES, Navigator, NavParams
+from agents.controllers.bg.saliences import Drives, plan_vector, saliences
+from agents.controllers.bg.senses import Reflex, proximity, resource_pixels
+from swarm import protocol_arena as proto
+from swarm.arena.engine import ArenaEngine
+from swarm.arena.scenario import controller_params
+from swarm.protocol import Rejected
+from swarm.scenario import ScenarioError, load_scenario
+from tests.arena_helpers import arena, box
+from world_server.arena import ArenaWorld
+
+FOOD = (
+    '[metabolism]\n{extra}\n'
+    '[[resource]]\nname = "food"\nkind = "ingesting"\ncentre = [0.6, 0.5]\n'
+    '[[resource]]\nname = "rest"\nkind = "digesting"\ncentre = [2.4, 0.5]\n'
+    '[[resource]]\nname = "danger"\nkind = "dangerous"\ncentre = [1.5, 1.5]\n'
+    '[[group]]\ncount = 1\ncontroller = "bg"\nrobot = "animat"\nstart = [{x}, {y}, 0.0]\n'
+)
+
+
+def _world(x: float = 1.2, y: float = 0.5, extra: str = "", **kw) -> ArenaWorld:
+    text = FOOD.format(extra=extra, x=x, y=y)
+    return ArenaWorld(arena(text, w=3.0, h=2.0, robot="animat", **kw))
+
+
+# ------------------------------------------------------------- metabolism
+
+
+def test_a_full_energy_lasts_33_minutes_then_the_animat_dies_and_stops():
+    w = _world(extra="energy = 0.01\n")
+    dt = w.scenario.control_period
+    ticks = math.ceil(0.01 * 1980 / dt)
+    for _ in range(ticks - 1):
+        w.apply(np.zeros((1, 3)))
+    assert w.metabolism.alive[0] and w.metabolism.energy[0] == pytest.approx(0.01 - (ticks - 1) * dt / 1980)
+    w.apply(np.zeros((1, 3)))
+    assert not w.metabolism.alive[0] and w.finished[0] and w.done()
+    pose = w.pose.copy()
+    w.apply(np.array([[0.3, 0.3, 0.0]]))
+    assert np.array_equal(w.pose, pose)  # a dead animat does not move
+
+
+def test_reloading_works_only_in_a_zone_of_its_kind():
+    w = _world(x=1.2, extra="potential = 0.5\nenergy = 0.5\n")  # 0.6 m from the food's centre: within reach
+    before = w.metabolism.levels(np.array([0]))[0].copy()
+    w.apply(np.array([[0.0, 0.0, 2.0]]))  # ReloadEp at the food
+    ep = w.metabolism.potential[0]
+    assert ep == pytest.approx(before[1] + 0.1 * w.scenario.control_period)
+    assert w.metabolism.ingest_tick[0] == 0 and w.robot_summaries(w.optimum)[0]["ingested"] == "food"
+    w.apply(np.array([[0.0, 0.0, 1.0]]))  # ReloadE away from the digesting zone: nothing, counted
+    assert w.metabolism.idle_acts[0] == 1 and w.metabolism.potential[0] == pytest.approx(ep)
+
+
+def test_digesting_turns_potential_energy_into_energy():
+    w = _world(x=2.4 - 0.6, extra="potential = 0.5\nenergy = 0.5\n")
+    dt = w.scenario.control_period
+    w.apply(np.array([[0.0, 0.0, 1.0]]))
+    e, ep = w.metabolism.levels(np.array([0]))[0]
+    assert ep == pytest.approx(0.5 - 0.1 * dt) and e == pytest.approx(0.5 + 0.1 * dt - dt / 1980)
+
+
+def test_a_dangerous_area_drains_energy():
+    calm, danger = _world(x=1.2, y=0.5), _world(x=1.5, y=1.1)
+    for w in (calm, danger):
+        w.apply(np.zeros((1, 3)))
+    dt = calm.scenario.control_period
+    assert calm.metabolism.energy[0] - danger.metabolism.energy[0] == pytest.approx(0.01 * dt)
+
+
+def test_the_animat_senses_its_energy_and_the_state_resumes():
+    w = _world(extra="energy = 0.7\npotential = 0.3\n")
+    assert np.allclose(w.perceive()[0]["metabolism"], [0.7, 0.3])
+    w.apply(np.array([[0.0, 0.0, 2.0]]))
+    saved = w.snapshot()
+    other = _world(extra="energy = 0.7\npotential = 0.3\n")
+    other.restore(saved)
+    assert np.array_equal(other.metabolism.energy, w.metabolism.energy)
+    assert other.metabolism.ingest_tick[0] == w.metabolism.ingest_tick[0]
+
+
+@pytest.mark.parametrize("table, field", [
+    ("energy = 2.0", "metabolism.energy"), ("lifetime = 0", "metabolism.lifetime"),
+    ('stop_at = "never"', "metabolism.stop_at"), ("rate = 1", "metabolism.rate"),
+])  # fmt: skip
+def test_a_bad_metabolism_table_is_one_clear_line(table, field):
+    with pytest.raises(ScenarioError) as e:
+        arena(FOOD.format(extra=table, x=1.2, y=0.5), w=3.0, h=2.0, robot="animat")
+    assert field in str(e.value) and "\n" not in str(e.value)
+
+
+def test_acts_cross_the_wire_only_when_there_are_some():
+    plain = proto.parse_acts(proto.actions(3, [0, 1], np.array([[0.1, 0.1, 0.0], [0.2, 0.2, 0.0]])))
+    assert plain.wheels.shape == (2, 2)
+    acting = proto.parse_acts(proto.actions(3, [0, 1], np.array([[0.1, 0.1, 2.0], [0.2, 0.2, 0.0]])))
+    assert acting.wheels.shape == (2, 3) and acting.wheels[0, 2] == 2.0
+    from swarm.protocol import pack, unpack
+
+    m = unpack(proto.actions(3, [0, 1], np.array([[0.1, 0.1, 2.0], [0.2, 0.2, 0.0]])), 1 << 20)
+    m["acts"] = b"\x00" * 3
+    assert isinstance(proto.parse_acts(pack(m)), Rejected)
+
+
+# ------------------------------------------------------------------ senses
+
+
+def test_prox_counts_the_run_through_each_direction_within_seven_pixels():
+    pixels = np.zeros((1, 36), bool)
+    pixels[0, [5, 6, 7]] = True
+    pixels[0, 20:36] = True
+    counts = np.rint(proximity(pixels) * 7).astype(int)[0]
+    assert list(counts[4:9]) == [0, 3, 3, 3, 0]  # a small resource: 3/7 where it is, nothing beside it
+    assert counts[27] == 7 and counts[20] == 4 and counts[35] == 4  # a large one fills windows inside it
+
+
+def test_resource_pixels_are_turned_allocentric_by_the_compass():
+    grey = np.full(36, 180, np.uint8)
+    grey[0] = 127  # straight ahead: an ingesting zone
+    pixels = resource_pixels(grey, math.radians(90))
+    assert pixels[1, 9] and pixels[1].sum() == 1  # heading north: the Ep pixel is the 90-degree direction
+
+
+def test_the_reflex_turns_to_the_roomier_side_and_holds_its_choice():
+    r = Reflex(too_close=0.45, hold=1.0)
+    sonar = np.array([0.3, 2.0, 2.0, 2.0, 2.0, 0.5, 0.5, 0.5])  # wall ahead; room on the left (sonars 1-3)
+    assert r(sonar, 0.25) == (0.0, 1.0)
+    assert r(np.array([0.3, 0.5, 0.5, 0.5, 2.0, 2.0, 2.0, 2.0]), 0.25)[1] == 1.0  # keeps turning left
+    assert r(np.full(8, 3.0), 0.25) == (1.0, 0.0)  # clear: straight on for `hold`
+    for _ in range(4):
+        r(np.full(8, 3.0), 0.25)
+    assert r(np.full(8, 3.0), 0.25) is None  # then the BG has the body again
+
+
+# ------------------------------------------------------ motivations, saliences
+
+
+def _drives(e=1.0, ep=1.0, **kw) -> Drives:
+    base = {"fear": 0.2, "disorientation": 0.0, "prox": np.zeros((3, 36)), "usable": np.zeros(3, bool),
+            "plan": np.zeros((3, 36)), "bka": np.zeros(36), "expl": np.zeros(36)}  # fmt: skip
+    base.update(kw)
+    return Drives(e, ep, **base)
+
+
+def test_motivations_follow_equation_2():
+    d = _drives(e=0.4, ep=0.3)
+    assert d.m_e == pytest.approx(0.6 * math.sqrt(1 - 0.7**2)) and d.m_ep == pytest.approx(0.7)
+    assert _drives(e=0.4, ep=0.0).m_e == 0.0  # no Ep to digest: no drive to the digesting zone
+
+
+def test_plan_combines_needs_and_fear_subtracts_danger():
+    p = np.zeros((3, 36))
+    p[1, 5], p[2, 5], p[0, 7] = 0.8, 0.5, 1.0
+    d = _drives(e=0.0, ep=0.5, plan=p)
+    expected = 1 - (1 - d.m_e * 0.5) * (1 - d.m_ep * 0.8)
+    assert plan_vector(d, False)[5] == pytest.approx(expected)
+    assert plan_vector(d, True)[7] == 0.0 and plan_vector(d, False)[7] == 0.0  # clipped at 0 for the root
+    p[1, 7] = 0.8
+    assert plan_vector(_drives(e=0.0, ep=0.5, plan=p), True)[7] < plan_vector(_drives(e=0.0, ep=0.5, plan=p), False)[7]
+
+
+def test_usable_food_drives_the_dorsal_loop_and_lower_weights_in_the_tmaze():
+    prox = np.zeros((3, 36))
+    prox[1, 3:10] = 1.0
+    d = _drives(e=1.0, ep=0.2, prox=prox, usable=np.array([False, True, False]))
+    dorsal, _ = saliences(d, "survival", 0.65, 0.55)
+    assert dorsal[1] == pytest.approx(0.8 + 0.2 * 0.8) and dorsal[0] == 0.0  # eq. 16
+    assert saliences(d, "tmaze", 0.65, 0.55)[0][1] == pytest.approx(0.9 * 0.8 + 0.1 * 0.8)  # eq. 20
+
+
+# -------------------------------------------------------------- navigation
+
+
+def _nav() -> Navigator:
+    return Navigator(NavParams(), seed=0, agent=0, resources=("DA", "Ep", "E"))
+
+
+def _place(k: int) -> tuple[np.ndarray, np.ndarray]:
+    grey = np.full(36, 40 + 60 * k, np.uint8)
+    return grey, np.full(8, 1.0 + 1.0 * k)
+
+
+def test_the_map_learns_where_food_is_forgets_it_when_gone_and_plans_to_it():
+    nav = _nav()
+    for k in range(4):  # a straight corridor eastwards, a different place every 0.3 m
+        nav.move(0.3 if k else 0.0, 0.0)
+        nav.observe(*_place(k), 0.0)
+    assert nav.map.size == 4 and nav.map.current == 3
+    for _ in range(6):  # it stays there a while (a node no longer young)
+        nav.observe(*_place(3), 0.0)
+    for _ in range(200):
+        nav.learn({"Ep": True}, {"Ep": True}, 0.25)  # food usable at the east end
+    assert nav.assoc["Ep"][3] > 0.9
+    nav.move(-0.3, 0.0)  # back west, to the first node (heading 0, moving backwards)
+    for k in (2, 1, 0):
+        nav.move(-0.3 if k < 2 else 0.0, 0.0)
+        nav.observe(*_place(k), 0.0)
+    towards = nav.plan("Ep")
+    assert abs(ANGLES[int(np.argmax(towards))]) < 0.3 and towards.max() > 0.3  # east, along the corridor
+    nav.map.belief = np.eye(4)[3]
+    for _ in range(400):
+        nav.learn({"Ep": False}, {"Ep": False}, 0.25)  # at the east end and no food in sight: forgotten
+    assert nav.assoc["Ep"][3] < 0.1
+
+
+def test_a_saved_map_loads_back_exactly_and_a_bad_one_is_one_line():
+    nav = _nav()
+    for k in range(3):
+        nav.move(0.3, 0.0)
+        nav.observe(*_place(k), 0.0)
+    data = json.loads(json.dumps(nav.to_data()))
+    other = _nav()
+    other.from_data(data)
+    assert other.to_data() == nav.to_data()
+    data["map"]["nodes"][0]["mean"] = [1.0, 2.0]
+    with pytest.raises(ValueError, match="a bg map: malformed") as e:
+        _nav().from_data(data)
+    assert "\n" not in str(e.value)
+
+
+# -------------------------------------------------------------- controller
+
+
+def test_the_animat_reloads_at_food_it_sees_and_then_goes_on():
+    """Hungry for Ep beside an ingesting zone: it selects ReloadEp, the world raises Ep, and once sated it moves."""
+    s = arena(FOOD.format(extra="energy = 1.0\npotential = 0.3\n", x=1.2, y=0.5), w=3.0, h=2.0, robot="animat",
+              noise="low", max_ticks=600)  # fmt: skip
+    s = s.with_overrides(start=(1.2, 0.5, math.pi))  # facing the food, 0.6 m away
+    engine = ArenaEngine(s)
+    engine.step(400)
+    r = engine.summary()["robots"][0]
+    assert r["reloads"]["ReloadEp"] > 10 and r["potential"] > 0.6 and r["ingested"] == "food"
+    assert r["distance"] > 0.1 and engine.summary()["rejected_actions"] == 0
+
+
+def test_snapshot_and_restore_continue_bit_for_bit():
+    s = load_scenario("bg-exp1").with_overrides(max_ticks=400)
+    a = ArenaEngine(s)
+    a.step(200)
+    saved_world = a.world.snapshot()
+    saved = [json.loads(json.dumps(c.snapshot())) for c in a.controllers]
+    b = ArenaEngine(s)
+    b.world.restore(saved_world)
+    for c, state in zip(b.controllers, saved, strict=True):
+        c.restore(state)
+    a.step(200)
+    b.step(200)
+    np.testing.assert_array_equal(a.world.pose, b.world.pose)
+    assert a.controllers[0].snapshot() == b.controllers[0].snapshot()
+
+
+def test_a_bad_bg_table_is_one_clear_line():
+    text = box(FOOD.format(extra="", x=1.2, y=0.5) + '[bg]\nsaliences = "hunger"\n', w=3.0, h=2.0, robot="animat")
+    from swarm.arena.scenario import parse_arena_text
+
+    with pytest.raises(ScenarioError) as e:
+        parse_arena_text(text, "bad.toml")
+    assert "saliences" in str(e.value) and "\n" not in str(e.value)
+    c = BgController()
+    params = controller_params(load_scenario("bg-exp1"), 0)
+    params["bg"] = {"map": "/nonexistent/map.json"}
+    with pytest.raises(ValueError, match=r"bg\.map: cannot read"):
+        c.reset(0, 0, params)
+
+
+def test_lockstep_bg_equals_in_process_bit_for_bit():
+    from tests.distributed import run_world
+
+    scenario = load_scenario("bg-exp1").with_overrides(seed=3, max_ticks=240)
+    engine = ArenaEngine(scenario)
+    expected = engine.run()
+    summary, world = run_world(scenario, "bg-lockstep", [("bg", 1, 1)], deadline=60.0)
+    np.testing.assert_array_equal(world.pose, engine.world.pose)
+    body = [{k: v for k, v in r.items() if k != "map"} for r in expected["robots"]]  # the world's part: no map
+    assert summary["robots"] == body and summary["rejected_messages"] == 0
+    assert summary["robots"][0]["energy"] < 1.0 and summary["robots"][0]["distance"] > 1.0

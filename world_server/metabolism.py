@@ -1,0 +1,141 @@
+"""The virtual metabolism of Girard et al. (2005), the world's side of it.
+
+Each robot of a scenario with a [metabolism] table carries Energy E and
+Potential Energy Ep in [0, 1].  E runs down so that a full load lasts 33
+minutes (section 3.1); ReloadEp inside an ingesting zone raises Ep; ReloadE
+inside a digesting zone turns Ep into E; a robot whose E reaches 0 is dead
+(it stops where it is and stays an obstacle).  The paper gives neither the
+reload rates nor what a dangerous area does: ours are in MetabolismParams and
+docs/bg.md.  A robot reads its E and Ep as internal sensors ("metabolism").
+
+A robot asks for a consummatory act with the third number of its action
+(ACTS: 0 none, 1 ReloadE, 2 ReloadEp); an act outside a zone of its kind does
+nothing but is counted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+ACTS = ("none", "ReloadE", "ReloadEp")
+ACT_ZONE = {1: "digesting", 2: "ingesting"}  # the zone kind each act needs
+STOPS = ("death", "ingest")
+
+
+@dataclass(frozen=True)
+class MetabolismParams:
+    energy: float = 1.0  # E at the start
+    potential: float = 1.0  # Ep at the start
+    lifetime: float = 1980.0  # seconds a full E lasts (the paper: 33 min)
+    ingest_rate: float = 0.1  # Ep gained per second of ReloadEp in an ingesting zone (ours)
+    digest_rate: float = 0.1  # E gained (and Ep spent) per second of ReloadE in a digesting zone (ours)
+    danger_rate: float = 0.01  # extra E lost per second within a dangerous area's reach (ours)
+    stop_at: str = "death"  # the run ends when every robot is dead; "ingest": when each has reloaded Ep once
+
+    @classmethod
+    def from_table(cls, table: dict[str, Any]) -> MetabolismParams:
+        """Raise ValueError (one line, naming the field) on a bad [metabolism] table."""
+        known = {f.name for f in fields(cls)}
+        for k, v in table.items():
+            if k not in known:
+                raise ValueError(f"metabolism.{k}: unknown; expected one of {', '.join(sorted(known))}")
+            if k == "stop_at":
+                if v not in STOPS:
+                    raise ValueError(f"metabolism.stop_at: expected one of {', '.join(STOPS)}, got {v!r}")
+                continue
+            if not isinstance(v, int | float) or isinstance(v, bool) or not np.isfinite(v) or v < 0:
+                raise ValueError(f"metabolism.{k}: expected a number >= 0, got {v!r}")
+            if k in ("energy", "potential") and v > 1:
+                raise ValueError(f"metabolism.{k}: expected a level in [0, 1], got {v!r}")
+        if table.get("lifetime", 1.0) == 0:
+            raise ValueError("metabolism.lifetime: expected a positive number of seconds")
+        return cls(**{k: (v if k == "stop_at" else float(v)) for k, v in table.items()})
+
+
+class Metabolism:
+    """E and Ep of n robots, stepped once per control period of `dt` seconds."""
+
+    STATE = ("energy", "potential", "alive", "died_tick", "ingest_tick", "ingest_resource", "acts", "idle_acts")
+
+    def __init__(self, n: int, params: MetabolismParams, dt: float, resources: list[tuple[str, str, tuple]]):
+        """`resources`: (name, zone kind, centre) of every resource, in the scenario's order."""
+        self.p, self.dt, self.resources = params, dt, resources
+        self.energy = np.full(n, params.energy)
+        self.potential = np.full(n, params.potential)
+        self.alive = self.energy > 0
+        self.died_tick = np.where(self.alive, -1, 0).astype(np.int64)
+        self.ingest_tick = np.full(n, -1, np.int64)  # first ReloadEp that worked
+        self.ingest_resource = np.full(n, -1, np.int64)  # ... at which resource
+        self.acts = np.zeros((n, len(ACTS)), np.int64)  # acts that worked, per kind
+        self.idle_acts = np.zeros(n, np.int64)  # acts asked for outside a zone of their kind
+
+    def levels(self, rows: np.ndarray) -> np.ndarray:
+        """(E, Ep) of these robots: their internal sensors."""
+        return np.column_stack([self.energy[rows], self.potential[rows]])
+
+    def step(self, acts: np.ndarray, zone_bits: np.ndarray, moving: np.ndarray, xy: np.ndarray, tick: int,
+             zone_bit) -> None:  # fmt: skip
+        """One control period: robots in `moving` (alive, present, acting) do their
+        acts where their zones allow; every living robot's E runs down."""
+        p, dt = self.p, self.dt
+        live = self.alive & moving
+        in_zone = {kind: (zone_bits & zone_bit(kind)) != 0 for kind in ("ingesting", "digesting", "dangerous")}
+        for code, kind in ACT_ZONE.items():
+            asked = live & (acts == code)
+            works = asked & in_zone[kind]
+            self.idle_acts += asked & ~works
+            self.acts[:, code] += works
+            if code == 2:  # ReloadEp
+                self.potential = np.where(works, np.minimum(1.0, self.potential + p.ingest_rate * dt), self.potential)
+                first = works & (self.ingest_tick < 0)
+                for a in np.flatnonzero(first):
+                    self.ingest_tick[a] = tick
+                    self.ingest_resource[a] = self._nearest(xy[a], kind)
+            else:  # ReloadE: Ep becomes E, as much as there is of one and room for the other
+                gain = np.minimum.reduce([np.full(len(acts), p.digest_rate * dt), self.potential, 1.0 - self.energy])
+                gain = np.where(works, np.maximum(gain, 0.0), 0.0)
+                self.energy = self.energy + gain
+                self.potential = self.potential - gain
+        loss = dt / p.lifetime + np.where(in_zone["dangerous"], p.danger_rate * dt, 0.0)
+        self.energy = np.where(self.alive, np.maximum(self.energy - loss, 0.0), self.energy)
+        died = self.alive & (self.energy <= 0.0)
+        self.died_tick[died] = tick
+        self.alive &= ~died
+
+    def _nearest(self, xy: np.ndarray, kind: str) -> int:
+        best, which = np.inf, -1
+        for k, (_, z, centre) in enumerate(self.resources):
+            d = float(np.hypot(xy[0] - centre[0], xy[1] - centre[1]))
+            if z == kind and d < best:
+                best, which = d, k
+        return which
+
+    def done(self) -> bool:
+        if self.p.stop_at == "ingest":
+            return bool(((self.ingest_tick >= 0) | ~self.alive).all())
+        return not self.alive.any()
+
+    def summary(self, agent: int, dt: float, ticks: int) -> dict[str, Any]:
+        died = int(self.died_tick[agent])
+        r = int(self.ingest_resource[agent])
+        return {
+            "alive": bool(self.alive[agent]),
+            "energy": round(float(self.energy[agent]), 5),
+            "potential": round(float(self.potential[agent]), 5),
+            "survival_seconds": round((died if died >= 0 else ticks) * dt, 2),
+            "died_tick": died if died >= 0 else None,
+            "ingested": self.resources[r][0] if r >= 0 else None,
+            "ingest_tick": int(self.ingest_tick[agent]) if self.ingest_tick[agent] >= 0 else None,
+            "reloads": {ACTS[k]: int(self.acts[agent, k]) for k in (1, 2)},
+            "idle_acts": int(self.idle_acts[agent]),
+        }
+
+    def snapshot(self) -> dict[str, np.ndarray]:
+        return {f"metabolism_{k}": np.array(getattr(self, k)) for k in self.STATE}
+
+    def restore(self, state: dict[str, np.ndarray]) -> None:
+        for k in self.STATE:
+            setattr(self, k, np.array(state[f"metabolism_{k}"]))
