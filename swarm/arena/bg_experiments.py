@@ -50,7 +50,7 @@ PAPER_CHOICE = {0.65: (13, 2), 0.55: (7, 8), 0.45: (2, 13)}
 PAPER_FORGET = (178.0, 78.0, 300.0)  # mean, sd, max seconds
 PAPER_FEAR = {0.1: (13, 7), 0.5: (2, 18)}
 PAPER_TMAZE = {1.0: (3, 12), 1.5: (4, 11), 2.0: (8, 7)}
-JUNCTION = (3.1, 4.3)  # T-maze: the stem's walls (x): left of the first is the left branch, right of the second the right
+JUNCTION = (3.1, 4.3)  # T-maze: the stem's walls (x): beyond the first, the left branch; beyond the second, the right
 
 
 def _with(s, bg: dict[str, Any] | None = None, metabolism: dict[str, Any] | None = None,
