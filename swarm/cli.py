@@ -45,7 +45,7 @@ examples:
   swarm experiment fingerprint-localize         # map on one tour, localize on another (Tapus et al. 2006)
   swarm run zmaze --controller dft              # plan and act with dynamic neural fields (Billing et al. 2015)
   swarm experiment dft-case1                    # SPA beside follow the carrot on the paper's 100 pairs
-  swarm bench engine | distributed | recording | arena | fingerprint | dft
+  swarm bench engine | distributed | recording | arena | fingerprint | dft | bg
   docker compose up swarm                       # the same in containers (compose.yaml, docs/docker.md)
 """
 
@@ -153,11 +153,13 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
 
     bench = sub.add_parser("bench", help="measure throughput", description="Measure throughput.")
-    bench.add_argument("target", choices=["engine", "distributed", "recording", "arena", "fingerprint", "dft"],
+    bench.add_argument("target", choices=["engine", "distributed", "recording", "arena", "fingerprint", "dft",
+                                          "bg"],
                        help="engine: the in-process engine; distributed: world + agent processes; "
                        "recording: what recording costs; arena: sensing and physics of the arena; "
                        "fingerprint: features, one alignment, localization against 20-1000 nodes; "
-                       "dft: one step of the neural-field architecture at 100x100 and 210x210 cells")  # fmt: skip
+                       "dft: one step of the neural-field architecture at 100x100 and 210x210 cells; "
+                       "bg: the animat's GPR loops, sensing, navigation and step, as real-time factors")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument("--quick", action="store_true", help="shorter measurement")
 
@@ -570,6 +572,12 @@ def cmd_experiment(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    if args.target == "bg":
+        from swarm.bench_bg import bench_bg, format_bg_bench
+
+        result = bench_bg(quick=args.quick)
+        print(json.dumps(result) if args.json else format_bg_bench(result))
+        return 0
     if args.target == "dft":
         from swarm.bench_dft import bench_dft, format_dft_bench
 

@@ -15,6 +15,7 @@ Layout (timeline `tick`; the record at tick t shows the world after tick t):
                           by its agent process on swarm/<run>/plans/<group>)
     world/optimum/<agent> static: the A* optimum from the robot's start to its goal (L_o; not for routes)
     fields/<agent>/…      a dft controller's fields and intentions (in process; swarm/recording_fields.py)
+    bg/<agent>/…          a bg animat's E, Ep, D, motivations, acts and channels (in process; swarm/recording_bg.py)
     world/map/<agent>/…,  a controller's topological map over the floor plan, its belief and current
     map/<agent>/…         fingerprint (in process; swarm/recording_topomap.py)
     metrics/<name>        reached, collisions, distance, agents_alive, tick_ms, rejected_messages
@@ -36,6 +37,8 @@ from swarm.recording import FORMAT_VERSION, software_versions
 
 ARENA_METRICS = ("reached", "collisions", "distance", "agents_alive", "tick_ms", "rejected_messages")
 ROBOT_SERIES = ("path_length", "collisions", "in_goal", "finished")
+# What explains a controller, by the flag it sets: the log that records it (in process).
+CONTROLLER_LOGS = {"keeps_fields": "swarm.recording_fields:FieldLog", "keeps_channels": "swarm.recording_bg:ChannelLog"}
 GROUP_COLOURS = ((40, 160, 40), (220, 120, 20), (60, 90, 220), (200, 40, 140), (30, 170, 190), (150, 150, 30))
 
 
@@ -103,7 +106,7 @@ class ArenaRecorder:
         self._obstacles_on: tuple | None = None
         self._plans_logged: set[int] = set()
         self._maps = None
-        self._fields = None
+        self._logs: dict = {}  # per CONTROLLER_LOGS flag, its log
         self._published = None
         self._static_done = False
 
@@ -249,15 +252,18 @@ class ArenaRecorder:
             self._maps.capture(tick, a, c.record(), self.world.pose[a, :2])
 
     def _log_fields(self, tick: int) -> None:
-        """The neural fields of each controller that keeps them (swarm.recording_fields)."""
-        for a, c in enumerate(self.controllers):
-            if not getattr(c, "keeps_fields", False):
-                continue
-            if self._fields is None:
-                from swarm.recording_fields import FieldLog
+        """What explains each controller that says it keeps some: neural fields (swarm.recording_fields),
+        basal-ganglia channels (swarm.recording_bg); each log made at its first use."""
+        import importlib
 
-                self._fields = FieldLog(self.rr, self.rec)
-            self._fields.capture(tick, a, c.record())
+        for a, c in enumerate(self.controllers):
+            for flag, target in CONTROLLER_LOGS.items():
+                if not getattr(c, flag, False):
+                    continue
+                if flag not in self._logs:
+                    module, cls = target.split(":")
+                    self._logs[flag] = getattr(importlib.import_module(module), cls)(self.rr, self.rec)
+                self._logs[flag].capture(tick, a, c.record())
 
     def log_published_map(self, tick: int, agent: int, data) -> None:
         """Distributed: a robot's map from its publication on the map key space."""
@@ -315,8 +321,8 @@ class ArenaRecorder:
                              columns=rr.Scalars.columns(scalars=values).partition([n] * len(ticks)))  # fmt: skip
             self._robots[name] = []
         self._paths = paths = np.concatenate([self._paths, pose[..., :2].transpose(1, 0, 2)], axis=1)
-        if self._fields is not None:
-            self._fields.flush()
+        for log in self._logs.values():
+            log.flush()
         rec.set_time("tick", sequence=int(ticks[-1]))
         rec.log("world/trajectories", rr.LineStrips2D([flip(p) for p in paths], colors=self.colours, radii=0.002,
                                                       draw_order=4.0))  # fmt: skip

@@ -19,8 +19,9 @@ import io
 
 import numpy as np
 
+from swarm.recording_series import SeriesLog
+
 EBS = ("N", "S", "W", "E")
-SERIES = ("intention", "action", "turn")
 FIELD_RANGE = 10.0
 STEP = 0.5  # activation per grey level
 
@@ -36,20 +37,17 @@ def png(u: np.ndarray) -> bytes:
     return buf.getvalue()
 
 
-class FieldLog:
+class FieldLog(SeriesLog):
     def __init__(self, rr, rec, every: int = 20):
-        self.rr, self.rec, self.every = rr, rec, every
-        self._ticks: dict[int, list[int]] = {}
-        self._series: dict[int, dict[str, list[np.ndarray]]] = {}
+        super().__init__(rr, rec, every)
 
     def capture(self, tick: int, agent: int, record: dict[str, np.ndarray]) -> None:
-        self._ticks.setdefault(agent, []).append(tick)
-        series = self._series.setdefault(agent, {k: [] for k in SERIES})
-        series["intention"].append(np.asarray(record["intention_max"], np.float64))
+        series = self.tick(agent, tick)
+        series.setdefault("intention", []).append(np.asarray(record["intention_max"], np.float64))
         action = np.asarray(record["action"])
-        series["action"].append(action.max(axis=1).astype(np.float64))
+        series.setdefault("action", []).append(action.max(axis=1).astype(np.float64))
         angles = -np.pi + np.argmax(action, axis=1) * 2 * np.pi / action.shape[1]
-        series["turn"].append(-angles)  # cells above the middle lie on the robot's right: a negative turn
+        series.setdefault("turn", []).append(-angles)  # cells above the middle lie on the robot's right: turn < 0
         if tick % self.every == 0:
             self.rec.set_time("tick", sequence=tick)
             for kind, key in (("M", "motivation"), ("I", "intention")):
@@ -57,16 +55,6 @@ class FieldLog:
                     self.rec.log(f"fields/{agent}/{kind}/{d}",
                                  self.rr.EncodedImage(contents=png(u), media_type="image/png"))  # fmt: skip
 
-    def flush(self) -> None:
-        rr = self.rr
-        for agent, ticks in self._ticks.items():
-            if not ticks:
-                continue
-            index = [rr.TimeColumn("tick", sequence=np.array(ticks, np.int64))]
-            for name, rows in self._series[agent].items():
-                values = np.stack(rows)
-                for k, d in enumerate(EBS):
-                    self.rec.send_columns(f"fields/{agent}/{name}/{d}", indexes=index,
-                                          columns=rr.Scalars.columns(scalars=values[:, k]))  # fmt: skip
-            self._ticks[agent] = []
-            self._series[agent] = {k: [] for k in SERIES}
+    def columns(self, agent: int, name: str, rows: list) -> list[tuple[str, np.ndarray]]:
+        values = np.stack(rows)
+        return [(f"fields/{agent}/{name}/{d}", values[:, k]) for k, d in enumerate(EBS)]

@@ -1,6 +1,7 @@
 """Topological maps in an arena recording: the nodes and links of every
 controller that keeps a map (its `record()` gives `node`, `nodes`, `links`,
-and may give `belief` and `fingerprint`), over the floor plan.
+and may give `belief`, `fingerprint` and `holds`, the resources each node
+holds), over the floor plan.
 
 A node is drawn where the robot truly was, on average, while that node was
 its current one: ground truth for display only (the controller knows only
@@ -87,7 +88,9 @@ class MapLog:
         where = {k: sums[k][:2] / sums[k][2] for k in ids}
         colour = self.colours[agent] if agent < len(self.colours) else (200, 200, 200)
         pts = flip(np.array([where[k] for k in ids]))
-        rec.log(f"world/map/{agent}/nodes", rr.Points2D(pts, radii=0.12, colors=[colour], labels=[f"n{k}" for k in ids],
+        holds = list(record.get("holds", []))  # what each node holds (the bg animat's resources), if anything
+        labels = [f"n{k} {holds[k]}".strip() if k < len(holds) else f"n{k}" for k in ids]
+        rec.log(f"world/map/{agent}/nodes", rr.Points2D(pts, radii=0.12, colors=[colour], labels=labels,
                                                         draw_order=6.0))  # fmt: skip
         shown = [(a, b) for a, b in links.tolist() if a in ids and b in ids]
         strips = [flip(np.array([where[a], where[b]])) for a, b in shown]

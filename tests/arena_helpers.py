@@ -28,3 +28,13 @@ def box(body: str = "", w: float = 1.0, h: float = 1.0, robot: str = "epuck", no
 
 def arena(body: str, **kw):
     return parse_arena_text(box(body, **kw), "test.toml")
+
+
+def rrd_rows(path) -> dict[str, int]:
+    """Rows per entity path of a recording, read back through rerun's reader."""
+    from rerun.chunk import RrdReader
+
+    rows: dict[str, int] = {}
+    for chunk in RrdReader(path).stream():
+        rows[chunk.entity_path.lstrip("/")] = rows.get(chunk.entity_path.lstrip("/"), 0) + chunk.num_rows
+    return rows

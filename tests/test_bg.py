@@ -17,7 +17,7 @@ from swarm.arena.engine import ArenaEngine
 from swarm.arena.scenario import controller_params
 from swarm.protocol import Rejected
 from swarm.scenario import ScenarioError, load_scenario
-from tests.arena_helpers import arena, box
+from tests.arena_helpers import arena, box, rrd_rows
 from world_server.arena import ArenaWorld
 
 FOOD = (
@@ -207,8 +207,8 @@ def test_the_map_learns_where_food_is_forgets_it_when_gone_and_plans_to_it():
     towards = nav.plan("Ep")
     assert abs(ANGLES[int(np.argmax(towards))]) < 0.3 and towards.max() > 0.3  # east, along the corridor
     nav.map.belief = np.eye(4)[3]
-    for _ in range(400):
-        nav.learn({"Ep": False}, {"Ep": False}, 0.25)  # at the east end and no food in sight: forgotten
+    for _ in range(600):  # 150 s at the east end and no food in sight: forgotten
+        nav.learn({"Ep": False}, {"Ep": False}, 0.25)
     assert nav.assoc["Ep"][3] < 0.1
 
 
@@ -283,3 +283,31 @@ def test_lockstep_bg_equals_in_process_bit_for_bit():
     body = [{k: v for k, v in r.items() if k != "map"} for r in expected["robots"]]  # the world's part: no map
     assert summary["robots"] == body and summary["rejected_messages"] == 0
     assert summary["robots"][0]["energy"] < 1.0 and summary["robots"][0]["distance"] > 1.0
+
+
+def test_a_recording_holds_the_metabolism_the_channels_and_the_map(tmp_path):
+    from swarm.recording_arena import ArenaRecorder
+
+    s = load_scenario("bg-exp1").with_overrides(max_ticks=80)
+    engine = ArenaEngine(s)
+    path = tmp_path / "bg.rrd"
+    recorder = ArenaRecorder(path, engine.world, {"run_id": "bg"}, controllers=engine.controllers)
+    recorder.close(engine.run(recorder=recorder))
+    rows = rrd_rows(path)
+    for name in ("energy", "potential", "disorientation", "act", "direction", "motivation/E", "motivation/BKA"):
+        assert rows[f"bg/0/{name}"] == 80, name
+    assert rows["bg/0/dorsal"] == rows["bg/0/ventral"] == 20  # a bar chart every 4 ticks
+    assert rows["world/map/0/nodes"] >= 1 and rows["map/0/belief"] >= 1
+
+
+def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):
+    from swarm.arena.bg_experiments import run_bg_experiment
+
+    result = run_bg_experiment("bg-tmaze", None, 2, 2, 0, tmp_path, ratios=(1.0,), progress=False)
+    assert result["runs"] == 2
+    for name in ("runs.csv", "summary.csv", "table.md", "plot.png", "maps.json"):
+        assert (tmp_path / name).exists(), name
+    text = (tmp_path / "table.md").read_text()
+    assert "| 1.0 |" in text and "paper left" in text
+    maps = json.loads((tmp_path / "maps.json").read_text())
+    assert len(maps["tmaze-1"]["map"]["nodes"]) >= 3  # the mapping run made a map every test loaded

@@ -71,14 +71,20 @@ def test_ventral_lateral_inhibition_grows_with_circular_distance():
     assert w[0, 35] == w[0, 1]  # circular: 350 degrees is next to 0
 
 
-def test_a_dorsal_selection_stops_the_ventral_loop():
-    """The trans-subthalamic projection (eq. 10): a consummatory act holds every direction back."""
-    bg = BasalGanglia()
-    bg.run(np.zeros(2), bump(5, 0.6), 1.0)
-    assert select_ventral(bg.disinhibition()[1], VENTRAL)[1] > 0
-    bg.run(np.array([0.6, 0.0]), bump(5, 0.6), 1.0)
-    d, v = bg.disinhibition()
+def test_a_dorsal_selection_holds_the_ventral_loop_back():
+    """The trans-subthalamic projection (eq. 10): a consummatory act raises every direction's EP/SNr
+    output, so a direction the animat would take alone is no longer released."""
+    from agents.controllers.bg.places import ANGLES
+    from agents.controllers.bg.places import bump as von_mises
+
+    directions = von_mises(ANGLES[5], 0.35, 4.0)  # an exploration-sized salience, as the animat's bumps are
+    free, acting = BasalGanglia(), BasalGanglia()
+    free.run(np.zeros(2), directions, 1.0)
+    acting.run(np.array([0.6, 0.0]), directions, 1.0)
+    assert select_ventral(free.disinhibition()[1], VENTRAL)[1] > 0
+    d, v = acting.disinhibition()
     assert select_dorsal(d, THRESHOLD) == 0 and select_ventral(v, VENTRAL)[1] == 0.0
+    assert acting.y_ventral()[EP].min() > 1.5 * free.y_ventral()[EP].min()
 
 
 def test_euler_step_settles_at_one_millisecond_and_oscillates_at_two():

@@ -28,7 +28,7 @@ from agents.controllers.dft.fields import (
 from agents.controllers.dft.robot import Interface, gaussian_2d
 from swarm.arena.engine import ArenaEngine
 from swarm.scenario import ScenarioError, load_scenario, parse_scenario_text
-from tests.arena_helpers import arena, box
+from tests.arena_helpers import arena, box, rrd_rows
 
 # ------------------------------------------------------------------ engine
 
@@ -347,8 +347,6 @@ def test_lockstep_dft_equals_in_process_bit_for_bit():
 
 
 def test_a_recording_holds_the_fields_the_intentions_and_the_optimum(tmp_path):
-    from rerun.chunk import RrdReader
-
     from swarm.recording_arena import ArenaRecorder
 
     s = load_scenario("zmaze").with_overrides(controller="dft", max_ticks=60)
@@ -356,9 +354,7 @@ def test_a_recording_holds_the_fields_the_intentions_and_the_optimum(tmp_path):
     path = tmp_path / "dft.rrd"
     recorder = ArenaRecorder(path, engine.world, {"run_id": "dft"}, controllers=engine.controllers)
     recorder.close(engine.run(recorder=recorder))
-    rows: dict[str, int] = {}
-    for chunk in RrdReader(path).stream():
-        rows[chunk.entity_path.lstrip("/")] = rows.get(chunk.entity_path.lstrip("/"), 0) + chunk.num_rows
+    rows = rrd_rows(path)
     for d in EBS:
         assert rows[f"fields/0/M/{d}"] == rows[f"fields/0/I/{d}"] == 3  # ticks 0, 20, 40
         assert rows[f"fields/0/intention/{d}"] == rows[f"fields/0/action/{d}"] == 60

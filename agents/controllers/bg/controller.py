@@ -37,8 +37,8 @@ class BgParams:
     w_plan: float = 0.65
     w_taxon: float = 0.55
     fear: float = 0.2  # F, m(DA)
-    dorsal_threshold: float = 0.5  # disinhibition a consummatory act needs: EP/SNr at half its rest (docs/bg.md)
-    ventral_threshold: float = -0.3  # ... a direction channel needs to join the vector sum (EP/SNr below 1.3 x rest)
+    dorsal_threshold: float = 0.9  # disinhibition an act needs to start (it goes on while above 0: docs/bg.md)
+    ventral_threshold: float = -0.6  # ... a direction channel needs to join the vector sum (EP/SNr below 1.6 x rest)
     too_close: float = 0.45  # m from the centre: the sonar reflex takes over
     reflex_hold: float = 2.0  # s the reflex drives straight on once the front is clear
     align: float = math.radians(30)  # heading error beyond which the animat turns on the spot
@@ -71,6 +71,9 @@ def check_table(table: dict[str, Any]) -> None:
 
 
 class BgController:
+    keeps_map = True  # the recording draws its map (swarm/recording_topomap.py) ...
+    keeps_channels = True  # ... and its E, Ep, D, motivations and channels (swarm/recording_bg.py)
+
     def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
         table = params.get("bg") or {}
         self.p = BgParams.from_table(table)
@@ -94,6 +97,7 @@ class BgController:
             self.nav.from_data(given)
             self.nav.lost()  # put down at its start: where that is on the map, its first view says
         self.reflex = Reflex(self.p.too_close, self.p.reflex_hold)
+        self.acting = -1  # the dorsal channel selected last tick
         self.last: dict[str, Any] = {}
 
     # ---------------------------------------------------------------- step
@@ -122,7 +126,8 @@ class BgController:
                                         self.p.w_taxon)  # fmt: skip
         self.bg.run(s_dorsal, s_ventral, self.dt)
         d, v = self.bg.disinhibition()
-        chosen = select_dorsal(d, self.p.dorsal_threshold)
+        chosen = select_dorsal(d, self.p.dorsal_threshold, self.acting)
+        self.acting = chosen
         direction, strength = select_ventral(v, self.p.ventral_threshold)
         reflex = self.reflex(sonar, self.dt) if chosen < 0 else None
         if chosen >= 0:
@@ -160,18 +165,23 @@ class BgController:
 
     def snapshot(self) -> dict[str, Any]:
         return {"tick": self.tick, "bg": {k: v.tolist() for k, v in self.bg.state().items()},
-                "nav": self.nav.to_data(), "reflex": self.reflex.state(), "params": asdict(self.p)}  # fmt: skip
+                "nav": self.nav.to_data(), "reflex": self.reflex.state(), "acting": self.acting,
+                "params": asdict(self.p)}  # fmt: skip
 
     def restore(self, state: dict[str, Any]) -> None:
         self.tick = int(state["tick"])
         self.bg.restore({k: np.array(v, np.float64) for k, v in state["bg"].items()})
         self.nav.from_data(state["nav"])
         self.reflex.restore(state["reflex"])
+        self.acting = int(state["acting"])
 
     def record(self) -> dict[str, np.ndarray]:
         if not self.last:
             return {}
         dr: Drives = self.last["drives"]
+        m = self.nav.map
+        holds = [" ".join(r for r, w in self.nav.assoc.items() if len(w) > k and w[k] > 0.5)
+                 for k in range(len(m.nodes))]  # fmt: skip
         return {
             "energy": np.array(dr.energy), "potential": np.array(dr.potential),
             "disorientation": np.array(dr.disorientation),
@@ -179,6 +189,10 @@ class BgController:
             "dorsal": self.last["dorsal"], "ventral": self.last["ventral"],
             "act": np.array(self.last["act"]), "direction": np.array(self.last["direction"]),
             "reflex": np.array(self.last["reflex"]),
+            # the map, for swarm/recording_topomap.py: node, nodes, links, belief, and what nodes hold
+            "node": np.array(m.current), "nodes": np.array(m.size), "folded": np.array(sorted(m.folded), np.int64),
+            "links": np.array(list(m.links), np.int64).reshape(-1, 2), "belief": np.asarray(m.belief, np.float64),
+            "holds": np.array(holds, dtype=object),
         }  # fmt: skip
 
     def summary(self) -> dict[str, Any]:

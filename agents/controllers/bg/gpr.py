@@ -188,20 +188,26 @@ class BasalGanglia:
         self.a_v[...] = state["a_v"]
 
 
-def select_dorsal(disinhibition: np.ndarray, threshold: float) -> int:
-    """Winner-takes-all: the most disinhibited channel if it is released beyond `threshold`, else -1."""
+def select_dorsal(disinhibition: np.ndarray, threshold: float, incumbent: int = -1) -> int:
+    """Winner-takes-all: the most disinhibited channel if it is released beyond `threshold` -- or, for the
+    channel selected last (`incumbent`), released at all (below its resting output): an act goes on until
+    its channel is inhibited again, as the thalamo-cortical loop's persistence means it to.  Else -1."""
     k = int(np.argmax(disinhibition))
-    return k if disinhibition[k] > threshold else -1
+    floor = 0.0 if k == incumbent else threshold
+    return k if disinhibition[k] > floor else -1
 
 
 def select_ventral(disinhibition: np.ndarray, threshold: float) -> tuple[float, float]:
     """(direction, strength): the vector sum of the channels released beyond
     `threshold`, each weighted by how far beyond it (channel i points at
-    i * 360/N degrees); strength 0 (direction nan) when none is."""
+    i * 360/N degrees); strength 0 (direction nan) when none is, or when the
+    released channels point every way (their sum is under a tenth of their weight)."""
     n = len(disinhibition)
     w = np.where(disinhibition > threshold, disinhibition - threshold, 0.0)
     if not w.any():
         return float("nan"), 0.0
     angle = np.arange(n) * (2 * np.pi / n)
     x, y = float(w @ np.cos(angle)), float(w @ np.sin(angle))
+    if np.hypot(x, y) < 0.1 * w.sum():
+        return float("nan"), 0.0
     return float(np.arctan2(y, x) % (2 * np.pi)), float(np.hypot(x, y))

@@ -14,7 +14,7 @@ system:
   it was made: coming back to it is coming back to a known area;
 - resources learned per node by a Hebbian rule with forgetting: while a
   resource is usable, dw = `gain` * dt * b(node) * (1 - w); while it is not
-  even in sight, dw = -`gain` * dt * b(node) * w (a place that held it, where
+  even in sight, dw = -`forget` * dt * b(node) * w (a place that held it, where
   it cannot be seen, has lost it: an exhausted resource is forgotten, not a
   resource merely out of reach);
 - P(res): shortest routes over the links from every node that holds res,
@@ -50,18 +50,22 @@ S_EXPLORE = 101  # noise stream of the exploration preference
 @dataclass(frozen=True)
 class NavParams:
     spacing: float = 0.3  # odometric metres between two observations (the map's delta d)
-    theta: float = 0.5  # largest dissimilarity that joins the current node
+    theta: float = 0.6  # largest dissimilarity (1 - P(match)) that joins the current node (docs/bg.md: calibration)
+    closure_match: float = 0.45  # P(match) with which a known node the belief points at closes a loop
+    extent: float = 1.0  # m: a node stretches no farther from where it was first seen (Filliat's maps are dense)
+    closure_radius: float = 2.0  # m: a loop closes only onto a node this near by odometry (alike places elsewhere)
     grey_scale: float = 35.0  # grey levels of one unit of dissimilarity
-    sonar_scale: float = 0.7  # metres of one unit of dissimilarity
+    sonar_scale: float = 1.0  # metres of one unit of dissimilarity
     d_rise: float = 0.1
     d_fall: float = 0.9
-    gain: float = 0.05  # Hebbian gain, 1/s (learning and forgetting)
-    reach: float = 5.0  # m: P falls by e over this route length
+    gain: float = 1.0  # Hebbian gain while a resource is usable, 1/s: a few seconds there and the node holds it
+    forget: float = 0.02  # ... and while it is not even in sight, 1/s: half forgotten in about 35 s there
+    reach: float = 15.0  # m: P falls by e over this route length (docs/bg.md)
     lookahead: float = 1.0  # m of route whose direction P points along
     width: float = 4.0  # von Mises concentration of a direction's bump over the 36 channels
     known_age: int = 20  # observations after its creation from which coming back to a node means a known area
-    near: float = 0.6  # m: a new node is linked to the nodes observed this close in the last `recent` m
-    recent: float = 10.0
+    near: float = 0.0  # m: link a new node to nodes observed this close (0: only to nodes driven between:
+    recent: float = 10.0  # two places 0.5 m apart on either side of a wall are no route)
     open_range: float = 1.0  # m of sonar room from which a direction counts as open
     novelty_radius: float = 2.0  # m: nodes nearer than this, in a direction, make it known
     wander_period: float = 20.0  # s between two draws of the exploration preference
@@ -95,7 +99,8 @@ class Navigator:
     def __init__(self, params: NavParams, seed: int, agent: int, resources: tuple[str, ...]):
         self.p, self.seed, self.agent = params, seed, agent
         self.map = TopoMap(PlaceSignatures(params.grey_scale, params.sonar_scale),
-                           MapParams(theta=params.theta, near=params.near, recent=params.recent))  # fmt: skip
+                           MapParams(theta=params.theta, closure_match=params.closure_match, near=params.near,
+                                     recent=params.recent, closure_radius=params.closure_radius))  # fmt: skip
         self.born: list[int] = []  # observation count at each node's creation
         self.observations = 0
         self.resources = resources
@@ -139,7 +144,7 @@ class Navigator:
             self.xy, self.since, self.relocalize = self.map.nodes[node].position.copy(), np.zeros(2), False
             return node
         before, folded = len(self.map.nodes), len(self.map.folded)
-        node = self.map.observe(observation, self.xy, self.since)
+        node = self.map.observe(observation, self.xy, self.since, self.p.extent)
         if len(self.map.folded) > folded:  # a young node turned out to be a known place: what it held goes there
             for young, known in list(self.map.folded.items())[folded:]:
                 for w in self.assoc.values():
@@ -165,9 +170,9 @@ class Navigator:
         for r in self.resources:
             w = self.assoc[r]
             if usable.get(r):
-                w += self.p.gain * dt * b * (1.0 - w)
+                w += np.minimum(self.p.gain * dt * b, 1.0) * (1.0 - w)
             elif not seen.get(r):
-                w -= self.p.gain * dt * b * w
+                w -= self.p.forget * dt * b * w
 
     # ----------------------------------------------------------- vectors
 

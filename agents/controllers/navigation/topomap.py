@@ -103,6 +103,7 @@ class MapParams:
     kappa: float = 2.0  # concentration of the link direction model (von Mises)
     spread: float = 1e-2  # belief spread to every node at each prediction (kidnapping, errors)
     floor: float = 1e-3  # likelihood floor: one bad match never rules a node out
+    closure_radius: float | None = None  # a loop closes only onto a node this near by odometry (None: anywhere)
 
 
 @dataclass
@@ -218,10 +219,14 @@ class TopoMap:
 
     # ------------------------------------------------------------ mapping
 
-    def observe(self, observation: Any, position: np.ndarray, displacement: np.ndarray) -> int:
+    def observe(self, observation: Any, position: np.ndarray, displacement: np.ndarray,
+                extent: float | None = None) -> int:  # fmt: skip
         """Map one observation made at odometric `position` after moving
         `displacement`: join the current node, close a loop to a known one, or
-        start a new node (steps 1-5 of the paper).  Returns the node it joined."""
+        start a new node (steps 1-5 of the paper).  With `extent`, the current
+        node is joined only within that distance of where it was first seen (a dense map:
+        where places look alike, a corridor still becomes a chain of nodes).
+        Returns the node it joined."""
         position = np.asarray(position, np.float64)
         self.odometer += float(np.hypot(*displacement))
         if not self.nodes:
@@ -237,16 +242,20 @@ class TopoMap:
         if young.visits == 1 and young.observations <= self.params.young and len(self.nodes) > 1:
             others = likelihood.copy()
             others[self.current] = -1.0
+            others[~self._within_reach(position)] = -1.0
             known = int(np.argmax(others))
             if others[known] >= self.params.closure_match and others[known] >= likelihood[self.current] - 0.05:
                 self.closures += 1  # the node just started is a place known before: a loop closed late
                 self._fold(self.current, known, observation, position)
                 return known
-        if 1.0 - likelihood[self.current] < self.params.theta:
+        first = self.nodes[self.current].seen_at[0] if self.nodes[self.current].seen_at else None
+        near = extent is None or first is None or math.hypot(position[0] - first[0], position[1] - first[1]) <= extent
+        if 1.0 - likelihood[self.current] < self.params.theta and near:
             self._join(self.current, observation, position)
             return self.current
         others = self.belief.copy()  # the belief given that the robot has left the current node
         others[self.current] = 0.0
+        others[~self._within_reach(position)] = 0.0
         best = int(np.argmax(others))
         share = others[best] / others.sum() if others.sum() > 0 else 0.0
         if share >= self.params.closure and likelihood[best] >= self.params.closure_match:
@@ -254,6 +263,13 @@ class TopoMap:
             self._move(best, observation, position)
             return best
         return self._new_node(observation, position)
+
+    def _within_reach(self, position: np.ndarray) -> np.ndarray:
+        """Which nodes a loop may close onto from `position`: all, or those within `closure_radius` by odometry."""
+        if self.params.closure_radius is None:
+            return np.ones(len(self.nodes), np.bool_)
+        centres = np.array([n.position for n in self.nodes])
+        return np.hypot(*(centres - position).T) <= self.params.closure_radius
 
     # ------------------------------------------------- maps of other robots
 
