@@ -96,10 +96,16 @@ def print_arena_summary(summary: dict, as_json: bool) -> int:
                 f"  robot {r['agent']} ({r['controller']}): {'reached' if r['reached'] else 'not reached'}{first}, "
                 f"L_p {r['path_length']:.3f} m, L_o {lo} m, L_p/L_o {ratio}, collisions {r['collisions']}"
             )
+            if "alive" in r:  # a metabolism (the BG paper's survival task)
+                life = "alive" if r["alive"] else f"died after {r['survival_seconds']} s"
+                print(f"    {life}: E {r['energy']:.3f}, Ep {r['potential']:.3f}, reloading {r['reloads']} ticks, "
+                      f"first Ep at {r['ingested'] or 'none'}, acts out of reach {r['idle_acts']}")  # fmt: skip
             if r.get("map"):
                 m = r["map"]
-                print(f"    map: {m['fingerprints']} fingerprints, {m['nodes']} nodes, {m['links']} links, "
-                      f"{m['loops_closed']} loops closed")  # fmt: skip
+                seen = f"{m['fingerprints']} fingerprints, " if "fingerprints" in m else ""
+                held = f", nodes holding {m['nodes_holding']}" if "nodes_holding" in m else ""
+                print(f"    map: {seen}{m['nodes']} nodes, {m['links']} links, {m['loops_closed']} loops closed"
+                      f"{held}")  # fmt: skip
         if len(summary["robots"]) > 20:
             print(f"  ... {len(summary['robots']) - 20} more robots (--json lists them all)")
         if "agents_lost" in summary:

@@ -311,3 +311,13 @@ def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):
     assert "| 1.0 |" in text and "paper left" in text
     maps = json.loads((tmp_path / "maps.json").read_text())
     assert len(maps["tmaze-1"]["map"]["nodes"]) >= 3  # the mapping run made a map every test loaded
+
+
+def test_swarm_run_prints_the_animats_metabolism_and_map():
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-m", "swarm", "run", "bg-exp1", "--max-ticks", "40"], capture_output=True,
+                         text=True, timeout=300)  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    assert "alive: E 0.99" in out.stdout and "map:" in out.stdout and "Traceback" not in out.stderr
