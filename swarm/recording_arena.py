@@ -216,9 +216,10 @@ class ArenaRecorder:
             self._obstacles_on = on
             self._log_obstacles(tick, on)
         if self.controllers is not None:
-            self._log_plans(tick)
-            self._log_maps(tick)
-            self._log_fields(tick)
+            records = [c.record() for c in self.controllers]  # once a tick: the logs below share them
+            self._log_plans(tick, records)
+            self._log_maps(tick, records)
+            self._log_fields(tick, records)
         if len(self._ticks) >= self.flush_every:
             self.flush()
 
@@ -233,14 +234,14 @@ class ArenaRecorder:
             colors=[o.colour for o in here], labels=[o.name or "obstacle" for o in here], draw_order=1.5,
         ))  # fmt: skip
 
-    def _log_plans(self, tick: int) -> None:
-        for a, c in enumerate(self.controllers):
+    def _log_plans(self, tick: int, records: list[dict]) -> None:
+        for a in range(len(self.controllers)):
             if a not in self._plans_logged:
-                path = np.asarray(c.record().get("path", np.zeros((0, 2))))
+                path = np.asarray(records[a].get("path", np.zeros((0, 2))))
                 if len(path) > 1:
                     self.log_plan(tick, a, path)
 
-    def _log_maps(self, tick: int) -> None:
+    def _log_maps(self, tick: int, records: list[dict]) -> None:
         """The topological map of each controller that keeps one (swarm.recording_topomap)."""
         for a, c in enumerate(self.controllers):
             if not getattr(c, "keeps_map", False):
@@ -249,9 +250,9 @@ class ArenaRecorder:
                 from swarm.recording_topomap import MapLog
 
                 self._maps = MapLog(self.rr, self.rec, self.colours)
-            self._maps.capture(tick, a, c.record(), self.world.pose[a, :2])
+            self._maps.capture(tick, a, records[a], self.world.pose[a, :2])
 
-    def _log_fields(self, tick: int) -> None:
+    def _log_fields(self, tick: int, records: list[dict]) -> None:
         """What explains each controller that says it keeps some: neural fields (swarm.recording_fields),
         basal-ganglia channels (swarm.recording_bg); each log made at its first use."""
         import importlib
@@ -263,7 +264,7 @@ class ArenaRecorder:
                 if flag not in self._logs:
                     module, cls = target.split(":")
                     self._logs[flag] = getattr(importlib.import_module(module), cls)(self.rr, self.rec)
-                self._logs[flag].capture(tick, a, c.record())
+                self._logs[flag].capture(tick, a, records[a])
 
     def log_published_map(self, tick: int, agent: int, data) -> None:
         """Distributed: a robot's map from its publication on the map key space."""
