@@ -249,8 +249,7 @@ class ArenaWorld:
         before = self.pose[:, :2].copy()
         moving = ok & ~self.finished & self.present & self.in_world
         if self.metabolism is not None:  # the start-of-tick zones: where the robot was when it acted
-            self.metabolism.step(acts, self.zones, moving, self.pose[:, :2], self.tick,
-                                 lambda kind: 1 << ZONE_KINDS.index(kind))  # fmt: skip
+            self.metabolism.step(acts, self.zones, moving, self.pose[:, :2], self.tick)
             self.finished |= ~self.metabolism.alive  # a dead robot stops, an obstacle to the others
         self.bodies.drive(wheels, self.axle, moving, pinned=~self.present & self.in_world)
         self.path_length += np.hypot(*(self.pose[:, :2] - before).T)

@@ -20,6 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from world_server.sensors import ZONE_KINDS
+
 ACTS = ("none", "ReloadE", "ReloadEp")
 ACT_ZONE = {1: "digesting", 2: "ingesting"}  # the zone kind each act needs
 STOPS = ("death", "ingest")
@@ -76,13 +78,12 @@ class Metabolism:
         """(E, Ep) of these robots: their internal sensors."""
         return np.column_stack([self.energy[rows], self.potential[rows]])
 
-    def step(self, acts: np.ndarray, zone_bits: np.ndarray, moving: np.ndarray, xy: np.ndarray, tick: int,
-             zone_bit) -> None:  # fmt: skip
+    def step(self, acts: np.ndarray, zone_bits: np.ndarray, moving: np.ndarray, xy: np.ndarray, tick: int) -> None:
         """One control period: robots in `moving` (alive, present, acting) do their
         acts where their zones allow; every living robot's E runs down."""
         p, dt = self.p, self.dt
         live = self.alive & moving
-        in_zone = {kind: (zone_bits & zone_bit(kind)) != 0 for kind in ("ingesting", "digesting", "dangerous")}
+        in_zone = {k: (zone_bits & (1 << ZONE_KINDS.index(k))) != 0 for k in ("ingesting", "digesting", "dangerous")}
         for code, kind in ACT_ZONE.items():
             asked = live & (acts == code)
             works = asked & in_zone[kind]
