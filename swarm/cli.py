@@ -24,7 +24,7 @@ from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled
 CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
 FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize", "fingerprint-together")
 DFT_EXPERIMENTS = ("dft-case1", "dft-case2", "dft-case3", "dft-together")
-BG_EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze")
+BG_EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze", "bg-colony")
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -45,6 +45,8 @@ examples:
   swarm experiment fingerprint-localize         # map on one tour, localize on another (Tapus et al. 2006)
   swarm run zmaze --controller dft              # plan and act with dynamic neural fields (Billing et al. 2015)
   swarm experiment dft-case1                    # SPA beside follow the carrot on the paper's 100 pairs
+  swarm run bg-exp1                             # the basal-ganglia animat survives (Girard et al. 2005)
+  swarm up bg-colony                            # four animats, each its own process, sharing one map
   swarm bench engine | distributed | recording | arena | fingerprint | dft | bg
   docker compose up swarm                       # the same in containers (compose.yaml, docs/docker.md)
 """
@@ -67,6 +69,16 @@ def _ratios(text: str) -> tuple[float, ...]:
     if not values or any(v not in RATIOS for v in values):
         raise argparse.ArgumentTypeError(f"expected some of {','.join(f'{r:g}' for r in RATIOS)} (the tmaze-R "
                                          f"scenarios), got {text}")  # fmt: skip
+    return values
+
+
+def _sizes(text: str) -> tuple[int, ...]:
+    try:
+        values = tuple(int(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if not values or any(not 1 <= v <= 8 for v in values):
+        raise argparse.ArgumentTypeError(f"expected colony sizes from 1 to 8 (the nest's places), got {text}")
     return values
 
 
@@ -131,7 +143,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     names_help += (
         "; bg-survival | bg-choice | bg-forget | bg-fear | bg-tmaze: the basal-ganglia animat (Girard et al. "
-        "2005): survival with and without its map, a new resource, a removed one, fear against need, the T-maze"
+        "2005): survival with and without its map, a new resource, a removed one, fear against need, the T-maze; "
+        "bg-colony: survival against colony size, with and without a shared map"
     )
     exp.add_argument("name", choices=[*EXPERIMENTS, "carrot", *FINGERPRINT_EXPERIMENTS, *DFT_EXPERIMENTS,
                                       *BG_EXPERIMENTS],
@@ -148,6 +161,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="dft-*: run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)")
     exp.add_argument("--ratios", type=_ratios, metavar="R,R,...",
                      help="bg-tmaze: right / left branch length ratios to run (default 1,1.5,2: tmaze-R scenarios)")
+    exp.add_argument("--sizes", type=_sizes, metavar="N,N,...",
+                     help="bg-colony: colony sizes to run (default 1,2,4,8)")
     exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
     exp.add_argument("--seed", type=_seed, default=0, help="first seed (runs use seed..seed+reps-1)")
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
@@ -542,6 +557,17 @@ def cmd_experiment(args) -> int:
         return 0
     if args.noise or args.max_steps:
         raise ScenarioError("command line", "--noise/--max-steps", "these are for the dft-* experiments")
+    if args.name == "bg-colony":
+        if args.scenario or args.ratios:
+            raise ScenarioError("command line", "--scenario/--ratios", "bg-colony runs bg-colony; give --sizes")
+        from swarm.arena.bg_colony import run_colony_experiment
+
+        result = run_colony_experiment(args.sizes, args.reps, args.jobs, args.seed, args.out)
+        print(result["markdown"])
+        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
+        return 0
+    if args.sizes:
+        raise ScenarioError("command line", "--sizes", "this is for bg-colony")
     if args.name in BG_EXPERIMENTS:
         from swarm.arena.bg_experiments import run_bg_experiment
 

@@ -104,8 +104,10 @@ def print_arena_summary(summary: dict, as_json: bool) -> int:
                 m = r["map"]
                 seen = f"{m['fingerprints']} fingerprints, " if "fingerprints" in m else ""
                 held = f", nodes holding {m['nodes_holding']}" if "nodes_holding" in m else ""
+                others = (f"; from the others {m['from_others']} nodes, {m['merged_with_ours']} merged with ours"
+                          if "from_others" in m else "")  # fmt: skip
                 print(f"    map: {seen}{m['nodes']} nodes, {m['links']} links, {m['loops_closed']} loops closed"
-                      f"{held}")  # fmt: skip
+                      f"{held}{others}")  # fmt: skip
         if len(summary["robots"]) > 20:
             print(f"  ... {len(summary['robots']) - 20} more robots (--json lists them all)")
         if "agents_lost" in summary:

@@ -38,3 +38,23 @@ def rrd_rows(path) -> dict[str, int]:
     for chunk in RrdReader(path).stream():
         rows[chunk.entity_path.lstrip("/")] = rows.get(chunk.entity_path.lstrip("/"), 0) + chunk.num_rows
     return rows
+
+
+def resumed_pair(scenario, ticks: int):
+    """(a, b): engine a runs 2 x `ticks`; b is a fresh engine given a's world and controller
+    snapshots (through JSON) after the first `ticks`, then runs the rest.  Equal if resume is exact."""
+    import json
+
+    from swarm.arena.engine import ArenaEngine
+
+    a = ArenaEngine(scenario)
+    a.step(ticks)
+    saved_world = a.world.snapshot()
+    saved = [json.loads(json.dumps(c.snapshot())) for c in a.controllers]
+    b = ArenaEngine(scenario)
+    b.world.restore(saved_world)
+    for c, state in zip(b.controllers, saved, strict=True):
+        c.restore(state)
+    a.step(ticks)
+    b.step(ticks)
+    return a, b

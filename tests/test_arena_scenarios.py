@@ -12,7 +12,8 @@ from tests.arena_helpers import arena
 from world_server.arena import ArenaWorld
 from world_server.sensors import ZONE_KINDS
 
-ARENAS = ["zmaze", "large-maze", "bg-exp1", "bg-exp2", "bg-exp3", "tmaze-1", "tmaze-1.5", "tmaze-2", "office"]
+ARENAS = ["zmaze", "large-maze", "bg-exp1", "bg-exp2", "bg-exp3", "tmaze-1", "tmaze-1.5", "tmaze-2", "office",
+          "bg-colony"]
 
 
 def test_every_bundled_arena_loads_and_ticks():

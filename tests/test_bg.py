@@ -17,7 +17,7 @@ from swarm.arena.engine import ArenaEngine
 from swarm.arena.scenario import controller_params
 from swarm.protocol import Rejected
 from swarm.scenario import ScenarioError, load_scenario
-from tests.arena_helpers import arena, box, rrd_rows
+from tests.arena_helpers import arena, box, resumed_pair, rrd_rows
 from world_server.arena import ArenaWorld
 
 FOOD = (
@@ -207,7 +207,10 @@ def test_the_map_learns_where_food_is_forgets_it_when_gone_and_plans_to_it():
     towards = nav.plan("Ep")
     assert abs(ANGLES[int(np.argmax(towards))]) < 0.3 and towards.max() > 0.3  # east, along the corridor
     nav.map.belief = np.eye(4)[3]
-    for _ in range(600):  # 150 s at the east end and no food in sight: forgotten
+    for _ in range(600):  # 150 s at the east end with the food in sight but out of reach: kept
+        nav.learn({"Ep": False}, {"Ep": True}, 0.25)
+    assert nav.assoc["Ep"][3] > 0.9
+    for _ in range(600):  # 150 s there and no food in sight: forgotten
         nav.learn({"Ep": False}, {"Ep": False}, 0.25)
     assert nav.assoc["Ep"][3] < 0.1
 
@@ -243,17 +246,7 @@ def test_the_animat_reloads_at_food_it_sees_and_then_goes_on():
 
 
 def test_snapshot_and_restore_continue_bit_for_bit():
-    s = load_scenario("bg-exp1").with_overrides(max_ticks=400)
-    a = ArenaEngine(s)
-    a.step(200)
-    saved_world = a.world.snapshot()
-    saved = [json.loads(json.dumps(c.snapshot())) for c in a.controllers]
-    b = ArenaEngine(s)
-    b.world.restore(saved_world)
-    for c, state in zip(b.controllers, saved, strict=True):
-        c.restore(state)
-    a.step(200)
-    b.step(200)
+    a, b = resumed_pair(load_scenario("bg-exp1").with_overrides(max_ticks=400), 200)
     np.testing.assert_array_equal(a.world.pose, b.world.pose)
     assert a.controllers[0].snapshot() == b.controllers[0].snapshot()
 

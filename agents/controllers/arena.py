@@ -37,7 +37,7 @@ TABLES = {
 }
 # Controllers that write a shared key space (swarm/<run>/<share>/<agent>), and which: what one robot
 # publishes at tick t every other robot of the same share receives before it steps tick t + 1.
-SHARES = {"fingerprint": "map", "dft": "context"}
+SHARES = {"fingerprint": "map", "dft": "context", "bg": "map"}
 MAX_SHARE_BYTES = 4 * 1024 * 1024
 # What a controller needs its robot to sense (checked when a scenario is loaded).
 REQUIRES = {"carrot": ("position", "compass"), "wander": (), "fingerprint": ("camera", "laser", "odometry", "compass"),

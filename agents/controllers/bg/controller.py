@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from agents.controllers.bg.colony import ColonyMap
 from agents.controllers.bg.gpr import BasalGanglia, select_dorsal, select_ventral
 from agents.controllers.bg.places import DIRECTIONS, Navigator, NavParams
 from agents.controllers.bg.saliences import SALIENCES, Drives, plan_vector, saliences
@@ -43,6 +44,7 @@ class BgParams:
     reflex_hold: float = 2.0  # s the reflex drives straight on once the front is clear
     align: float = math.radians(30)  # heading error beyond which the animat turns on the spot
     learn_map: bool = True  # keep mapping (False: a loaded map stays as it is)
+    share: bool = False  # a colony: publish the map and what its places hold on swarm/<run>/map/**, merge the others'
     map: str = ""  # a saved map (BgController.map_data() as JSON) to start from; "" none
 
     @classmethod
@@ -51,8 +53,8 @@ class BgParams:
         nav = table.pop("navigation", None)
         if isinstance(table.get("map"), dict):
             table.pop("map")  # a map given as data (experiments): read by the controller
-        p = params_from_table(cls, table, "bg", texts=("saliences", "map", "planning", "learn_map"))
-        for name in ("planning", "learn_map"):
+        p = params_from_table(cls, table, "bg", texts=("saliences", "map", "planning", "learn_map", "share"))
+        for name in ("planning", "learn_map", "share"):
             if not isinstance(getattr(p, name), bool):
                 raise ValueError(f"[bg]: {name} expected true or false, got {getattr(p, name)!r}")
         if p.saliences not in SALIENCES:
@@ -96,6 +98,9 @@ class BgController:
         if given is not None:
             self.nav.from_data(given)
             self.nav.lost()  # put down at its start: where that is on the map, its first view says
+        # a colony shares its map (colony.py); an animat without one (condition B) has nothing to share
+        self.shares = "map" if self.p.share and self.p.planning else None
+        self.colony = ColonyMap(self.nav, agent)
         self.reflex = Reflex(self.p.too_close, self.p.reflex_hold)
         self.acting = -1  # the dorsal channel selected last tick
         self.last: dict[str, Any] = {}
@@ -113,7 +118,7 @@ class BgController:
         prox = proximity(resource_pixels(grey, heading))
         if self.p.planning:
             if self.p.learn_map and self.nav.due():
-                self.nav.observe(grey, sonar, heading)
+                self.colony.adopt(self.nav.observe(grey, sonar, heading))
             self.nav.learn(usable, {r: bool(prox[k].any()) for k, r in enumerate(RESOURCES)}, self.dt)
             plan = np.stack([self.nav.plan(r) for r in RESOURCES])
             bka, disorientation = self.nav.back_to_known(), self.nav.D
@@ -159,6 +164,14 @@ class BgController:
 
     # ------------------------------------------------------------ state
 
+    def publish(self) -> dict[str, Any] | None:
+        """What changed in the map and in what its places hold, for the colony."""
+        return self.colony.publish() if self.shares else None
+
+    def receive(self, sender: int, data: Any) -> None:
+        """Merge another animat's publication (ValueError if malformed)."""
+        self.colony.receive(sender, data)
+
     def map_data(self) -> dict[str, Any]:
         """The map and what its nodes hold, as plain data (JSON-safe): save it, load it with [bg] map."""
         return self.nav.to_data()
@@ -166,12 +179,14 @@ class BgController:
     def snapshot(self) -> dict[str, Any]:
         return {"tick": self.tick, "bg": {k: v.tolist() for k, v in self.bg.state().items()},
                 "nav": self.nav.to_data(), "reflex": self.reflex.state(), "acting": self.acting,
-                "params": asdict(self.p)}  # fmt: skip
+                "colony": self.colony.to_data(), "params": asdict(self.p)}  # fmt: skip
 
     def restore(self, state: dict[str, Any]) -> None:
         self.tick = int(state["tick"])
         self.bg.restore({k: np.array(v, np.float64) for k, v in state["bg"].items()})
         self.nav.from_data(state["nav"])
+        self.colony = ColonyMap(self.nav, self.agent)  # on the restored map
+        self.colony.restore(state["colony"])
         self.reflex.restore(state["reflex"])
         self.acting = int(state["acting"])
 
@@ -198,5 +213,9 @@ class BgController:
     def summary(self) -> dict[str, Any]:
         m = self.nav.map
         held = {r: int((w > 0.5).sum()) for r, w in self.nav.assoc.items()}
-        return {"map": {"nodes": m.size, "links": len(m.links), "loops_closed": m.closures,
-                        "disorientation": round(self.nav.D, 4), "nodes_holding": held}}  # fmt: skip
+        out = {"nodes": m.size, "links": len(m.links), "loops_closed": m.closures,
+               "disorientation": round(self.nav.D, 4), "nodes_holding": held}
+        if self.shares:
+            out |= {"from_others": self.colony.shared.added, "merged_with_ours": self.colony.shared.merged,
+                    "holds_heard": self.colony.heard}  # fmt: skip
+        return {"map": out}

@@ -54,6 +54,7 @@ class NavParams:
     closure_match: float = 0.45  # P(match) with which a known node the belief points at closes a loop
     extent: float = 1.0  # m: a node stretches no farther from where it was first seen (Filliat's maps are dense)
     closure_radius: float = 2.0  # m: a loop closes only onto a node this near by odometry (alike places elsewhere)
+    merge_match: float = 0.6  # P(match) with which another animat's node is one of ours (within closure_radius)
     grey_scale: float = 35.0  # grey levels of one unit of dissimilarity
     sonar_scale: float = 1.0  # metres of one unit of dissimilarity
     d_rise: float = 0.1
@@ -100,7 +101,8 @@ class Navigator:
         self.p, self.seed, self.agent = params, seed, agent
         self.map = TopoMap(PlaceSignatures(params.grey_scale, params.sonar_scale),
                            MapParams(theta=params.theta, closure_match=params.closure_match, near=params.near,
-                                     recent=params.recent, closure_radius=params.closure_radius))  # fmt: skip
+                                     recent=params.recent, closure_radius=params.closure_radius,
+                                     merge_match=params.merge_match))  # fmt: skip
         self.born: list[int] = []  # observation count at each node's creation
         self.observations = 0
         self.resources = resources
@@ -117,6 +119,7 @@ class Navigator:
         self._novel = np.ones(DIRECTIONS)
         self._wander_key = -1
         self._wander = np.zeros(DIRECTIONS)
+        self.news = 0  # changes from other animats (their nodes, links, what nodes hold): caches key on it too
 
     # ----------------------------------------------------------- sensing
 
@@ -161,6 +164,17 @@ class Navigator:
             self.D *= self.p.d_fall
         return node
 
+    def grow(self) -> None:
+        """Nodes another animat's map brought in (agents/controllers/navigation/mapshare.py): they hold
+        nothing until told, and count as known (their maker has been there: coming into one is coming
+        into a known area)."""
+        added = len(self.map.nodes) - len(self.born)
+        if added > 0:
+            self.born += [self.observations - self.p.known_age] * added
+            for r in self.resources:
+                self.assoc[r] = np.concatenate([self.assoc[r], np.zeros(added)])
+        self.news += 1
+
     def learn(self, usable: dict[str, bool], seen: dict[str, bool], dt: float) -> None:
         """Hebbian association of the believed nodes with the resources usable there, and forgetting:
         a node believed to hold a resource that is not even in sight from there loses it."""
@@ -178,7 +192,7 @@ class Navigator:
 
     def _edges(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(from, to, length) of every link both ways, rebuilt only when the links change."""
-        key = (len(self.map.nodes), len(self.map.links), self.observations)
+        key = (len(self.map.nodes), len(self.map.links), self.observations, self.news)
         if self._edge_key != key:
             ab = np.array(list(self.map.links), np.int64).reshape(-1, 2)
             d = np.array([max(link.distance, 1e-3) for link in self.map.links.values()])
@@ -193,7 +207,7 @@ class Navigator:
         here = self.map.current
         if k == 0 or here < 0 or not (strength > 1e-3).any():
             return np.zeros(DIRECTIONS)
-        key = (self.observations, here, np.round(strength, 2).tobytes())
+        key = (self.observations, self.news, here, np.round(strength, 2).tobytes())
         if key in self._towards:
             return self._towards[key]
         rows, cols, lengths = self._edges()
@@ -239,9 +253,9 @@ class Navigator:
         alloc = to_allocentric(sonar, heading)
         room = np.interp(ANGLES, np.arange(9) * (2 * math.pi / 8), np.append(alloc, alloc[0]))
         open_ = np.clip(room / self.p.open_range - 0.5, 0.0, 1.0)
-        if self._novel_key != (self.observations, use_map):  # the map's coverage changes only at observations
+        if self._novel_key != (self.observations, self.news, use_map):  # coverage changes only with these
             self._novel = self._novelty(use_map)
-            self._novel_key = (self.observations, use_map)
+            self._novel_key = (self.observations, self.news, use_map)
         period = int(time // self.p.wander_period)
         if self._wander_key != period:
             u = np.empty((1, 1))
@@ -273,11 +287,11 @@ class Navigator:
         return {"map": topomap_to_data(self.map, lambda sig: np.asarray(sig).tolist()),
                 "assoc": {r: w.tolist() for r, w in self.assoc.items()}, "xy": self.xy.tolist(),
                 "since": self.since.tolist(), "D": self.D, "created": self.created, "born": self.born,
-                "observations": self.observations, "relocalize": self.relocalize}  # fmt: skip
+                "observations": self.observations, "relocalize": self.relocalize, "news": self.news}  # fmt: skip
 
     def from_data(self, data: dict[str, Any]) -> None:
         try:
-            self.map = topomap_from_data(data["map"], self.map.signatures, self.map.params, _place,
+            self.map = topomap_from_data(data["map"], self.map.signatures, self.map.params, place_from_data,
                                          "a bg map", "BgController.map_data()")  # fmt: skip
             assoc = {r: np.array(data["assoc"].get(r, [0.0] * len(self.map.nodes)), np.float64)
                      for r in self.resources}  # fmt: skip
@@ -288,13 +302,14 @@ class Navigator:
             self.D, self.created = float(data["D"]), int(data["created"])
             self.born, self.observations = [int(b) for b in data["born"]], int(data["observations"])
             self.relocalize = bool(data.get("relocalize", False))
+            self.news = int(data.get("news", 0))
             if len(self.born) != len(self.map.nodes):
                 raise ValueError("one birth per node expected")
         except (KeyError, TypeError, ValueError, AttributeError) as e:
             raise ValueError(f"a bg map: malformed ({e}); expected what BgController.map_data() writes") from None
 
 
-def _place(data: Any) -> np.ndarray:
+def place_from_data(data: Any) -> np.ndarray:
     a = np.array(data, np.float64)
     if a.shape != (DIRECTIONS + 8,) or not np.isfinite(a).all():
         raise ValueError(f"a place: expected {DIRECTIONS + 8} finite numbers")
