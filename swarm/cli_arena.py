@@ -92,10 +92,14 @@ def print_arena_summary(summary: dict, as_json: bool) -> int:
             ratio = "n/a" if r["path_ratio"] is None else f"{r['path_ratio']:.3f}"
             lo = "n/a" if r["optimal_length"] is None else f"{r['optimal_length']:.3f}"
             first = "" if r["ticks_to_goal"] is None else f" (first at the goal at tick {r['ticks_to_goal']})"
-            print(
-                f"  robot {r['agent']} ({r['controller']}): {'reached' if r['reached'] else 'not reached'}{first}, "
-                f"L_p {r['path_length']:.3f} m, L_o {lo} m, L_p/L_o {ratio}, collisions {r['collisions']}"
-            )
+            if r.get("goal") is None and r["optimal_length"] is None:  # no goal to reach (a wanderer, an animat)
+                print(f"  robot {r['agent']} ({r['controller']}): path {r['path_length']:.3f} m, "
+                      f"collisions {r['collisions']}")  # fmt: skip
+            else:
+                print(
+                    f"  robot {r['agent']} ({r['controller']}): {'reached' if r['reached'] else 'not reached'}{first}, "
+                    f"L_p {r['path_length']:.3f} m, L_o {lo} m, L_p/L_o {ratio}, collisions {r['collisions']}"
+                )
             if "alive" in r:  # a metabolism (the BG paper's survival task)
                 life = "alive" if r["alive"] else f"died after {r['survival_seconds']} s"
                 print(f"    {life}: E {r['energy']:.3f}, Ep {r['potential']:.3f}, reloading {r['reloads']} ticks, "
