@@ -73,12 +73,15 @@ def _ratios(text: str) -> tuple[float, ...]:
 
 
 def _sizes(text: str) -> tuple[int, ...]:
+    from swarm.arena.bg_colony import NEST
+
     try:
         values = tuple(int(v) for v in text.split(","))
     except ValueError:
         values = ()
-    if not values or any(not 1 <= v <= 8 for v in values):
-        raise argparse.ArgumentTypeError(f"expected colony sizes from 1 to 8 (the nest's places), got {text}")
+    if not values or any(not 1 <= v <= len(NEST) for v in values):
+        raise argparse.ArgumentTypeError(f"expected colony sizes from 1 to {len(NEST)} (the nest's places), "
+                                         f"got {text}")  # fmt: skip
     return values
 
 

@@ -29,24 +29,29 @@ class ColonyMap:
     def __init__(self, nav: Navigator, agent: int):
         self.nav, self.agent = nav, agent
         self.shared = SharedMap(nav.map, agent, lambda sig: np.asarray(sig).tolist(), place_from_data)
-        self.sent: dict[int, np.ndarray] = {}  # node -> the weights last sent or heard
+        # per node, the weights last sent or heard (NaN: none yet), the resources in the navigator's order
+        self.sent = np.full((0, len(nav.resources)), np.nan)
         self.heard = 0  # weights of a place taken from another animat
 
-    def _weights(self) -> np.ndarray:
-        """(nodes, resources): what each node holds, the resources in the navigator's order."""
-        return np.stack([self.nav.assoc[r] for r in self.nav.resources], axis=1)
+    def _sent_rows(self) -> np.ndarray:
+        """`sent`, one row per node of the map (nodes made since start with none)."""
+        grow = len(self.nav.map.nodes) - len(self.sent)
+        if grow > 0:
+            self.sent = np.vstack([self.sent, np.full((grow, self.sent.shape[1]), np.nan)])
+        return self.sent
 
     def publish(self) -> dict[str, Any] | None:
         """What changed since the last publication: places, links and what places hold; None if nothing."""
         data = self.shared.publish() or {"nodes": [], "links": []}
-        weights, holds = self._weights(), []
-        for i, w in enumerate(weights):
-            if i in self.nav.map.folded:
-                continue
-            last = self.sent.get(i)
-            if (last is None and w.max() >= HOLDS_STEP) or (last is not None and np.abs(w - last).max() >= HOLDS_STEP):
-                self.sent[i] = w.copy()
-                holds.append([*self.shared.global_id(i), *np.round(w, 4).tolist()])
+        weights = np.stack([self.nav.assoc[r] for r in self.nav.resources], axis=1)
+        last = self._sent_rows()
+        # a node never sent counts from 0: it goes once it holds something (weights are >= 0)
+        moved = np.abs(weights - np.nan_to_num(last)).max(axis=1, initial=0.0) >= HOLDS_STEP
+        moved[list(self.nav.map.folded)] = False
+        holds = []
+        for i in np.flatnonzero(moved):
+            last[i] = weights[i]
+            holds.append([*self.shared.global_id(int(i)), *np.round(weights[i], 4).tolist()])
         if holds:
             data["holds"] = holds
         return data if data["nodes"] or data["links"] or holds else None
@@ -62,7 +67,7 @@ class ColonyMap:
                 continue
             for r, value in zip(self.nav.resources, w, strict=True):
                 self.nav.assoc[r][i] = value
-            self.sent[i] = w
+            self._sent_rows()[i] = w
             self.heard += 1
 
     def adopt(self, node: int) -> None:
@@ -81,10 +86,12 @@ class ColonyMap:
         return holds
 
     def to_data(self) -> dict[str, Any]:
-        return {"shared": self.shared.to_data(), "sent": [[i, *w.tolist()] for i, w in self.sent.items()],
-                "heard": self.heard}  # fmt: skip
+        rows = [[int(i), *self.sent[i].tolist()] for i in np.flatnonzero(~np.isnan(self.sent[:, 0]))]
+        return {"shared": self.shared.to_data(), "sent": rows, "heard": self.heard}
 
     def restore(self, data: dict[str, Any]) -> None:
         self.shared.restore(data["shared"])
-        self.sent = {int(row[0]): np.array(row[1:], np.float64) for row in data["sent"]}
+        self.sent = np.full((len(self.nav.map.nodes), self.sent.shape[1]), np.nan)
+        for row in data["sent"]:
+            self.sent[int(row[0])] = row[1:]
         self.heard = int(data["heard"])
