@@ -3,7 +3,10 @@
 Each agent's controller is reset with what the world's welcome gives it (the
 seed, its id, and its params: the map it is given, its goal or route, its
 body), exactly as the in-process engine resets it, so lock-step runs equal
-in-process runs pose for pose.
+in-process runs pose for pose.  At the ticks the world saves after, each
+controller's memory goes with its action; a restarted world gives it back
+(or gives it to the newcomer that takes a missing agent's place), so a
+resumed run goes on exactly as if nothing had happened.
 """
 
 from __future__ import annotations
@@ -12,6 +15,7 @@ import numpy as np
 
 from agents.controllers.arena import as_action, deliver, make_controller, publications
 from agents.runtime import AgentRuntime
+from swarm import memory_codec
 from swarm import protocol as proto
 from swarm import protocol_arena as arena_proto
 
@@ -23,11 +27,19 @@ class ArenaAgentRuntime(AgentRuntime):
         self.brains: list = [None] * count
         self.sent_plans: dict[int, tuple] = {}  # agent -> (length, first, last point) of the last plan sent
         self.refused_shared = 0  # other robots' publications this process's controllers refused
+        self.refused_memory = 0  # memories handed back that could not be decoded
 
     def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
         brain = make_controller(msg.get("controller", self.controller))
         brain.reset(int(msg["seed"]), agent, msg["params"])
         self.brains[slot] = brain
+        if isinstance(msg.get("memory"), bytes):  # a missing agent's place, taken over where it was saved
+            self.refused_memory += not give_back(brain, msg["memory"])
+
+    def _restore(self, msg: arena_proto.ArenaMemory) -> None:
+        for agent, blob in msg.memory:
+            if (slot := self.slot_of.get(agent)) is not None:
+                self.refused_memory += not give_back(self.brains[slot], blob)
 
     def _parse(self, data: bytes):
         return arena_proto.parse_obs(data)
@@ -44,7 +56,8 @@ class ArenaAgentRuntime(AgentRuntime):
             agents.append(agent)
             wheels.append(np.zeros(3) if self.null else as_action(self.brains[slot].step(reading)))
         shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
-        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared)
+        memory = [(a, memory_codec.encode(b.snapshot())) for a, b in mine] if obs.keep and not self.null else []
+        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory)
         self.act_publisher.put(payload)
         if not self.null:
             self._send_plans(obs.tick, agents)
@@ -60,3 +73,18 @@ class ArenaAgentRuntime(AgentRuntime):
             if self.sent_plans.get(agent) != key:
                 self.sent_plans[agent] = key
                 self.session.put(self.keys.plan(self.group), arena_proto.plan_message(tick, agent, path))
+
+
+def give_back(brain, blob: bytes) -> bool:
+    """Restore a controller from a saved memory.  One that cannot be decoded or
+    restored leaves the controller as it was (False: the caller counts it)."""
+    memory = memory_codec.decode(blob)
+    if isinstance(memory, proto.Rejected):
+        return False
+    had = brain.snapshot()
+    try:
+        brain.restore(memory)
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError):
+        brain.restore(had)
+        return False
+    return True

@@ -125,7 +125,7 @@ class AgentRuntime:
                 if isinstance(msg, dict):
                     if msg.get("type") == "stop":
                         return answered
-                elif isinstance(msg, proto.Memory):
+                elif isinstance(msg, proto.HandBack):
                     self._heard = time.monotonic()
                     self._restore(msg)
                 elif not isinstance(msg, proto.Rejected):

@@ -205,10 +205,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--state-dir",
         default="runs",
         metavar="DIR",
-        help="persist the world to DIR/<run-id>.state.npz and resume from it on restart (default runs)",
+        help="persist the world to DIR/<run-id>.state.npz (an arena: .arena.npz) and resume from it on "
+        "restart (default runs)",
     )
     world.add_argument("--persist-every", type=int, default=50, metavar="K",
-                       help="persist every K ticks (default 50; 0: only at the end)")  # fmt: skip
+                       help="persist every K ticks (default 50; 0: only at the end; an arena saves at its "
+                       "physics checkpoints, every lcm(K, checkpoint) ticks)")  # fmt: skip
     world.add_argument("--start-timeout", type=float, default=600.0, metavar="S",
                        help="give up if the agents have not all joined after S seconds (default 600)")  # fmt: skip
     world.add_argument("--linger", type=float, default=0.0, metavar="S",

@@ -205,8 +205,12 @@ class ObsBlocks(NamedTuple):
     pf: bytes  # K x PERC_F_LEN little-endian float64, unchecked
 
 
+class HandBack:
+    """A resumed world's message that gives controllers back their memory (each family its own)."""
+
+
 @dataclass(frozen=True)
-class Memory:
+class Memory(HandBack):
     rows: np.ndarray  # (K, 1 + MEM_LEN): agent, memory
 
 
@@ -298,9 +302,10 @@ def check_family(m: dict, kind: str, family: str, what: str) -> dict | Rejected:
     return m
 
 
-def family_header(data: bytes, kind: str, family: str, what: str) -> tuple[dict, int] | Rejected:
+def family_header(data: bytes, kind: str, family: str, what: str,
+                  limit: int = MAX_MESSAGE_BYTES) -> tuple[dict, int] | Rejected:  # fmt: skip
     """What every family's agent message shares: (message, tick), type, family and tick checked."""
-    m = family_message(data, kind, family, what)
+    m = family_message(data, kind, family, what, limit)
     if isinstance(m, Rejected):
         return m
     tick = int_field(m, "tick")

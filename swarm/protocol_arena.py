@@ -8,6 +8,11 @@
                   on <share>/<agent> and hands them to every agent process with the next
                   tick's observations (`shared` there too), so in lock-step every robot reads
                   tick t's writes at tick t + 1, as in the in-process engine
+                  At the ticks after which the world saves its state (`keep` in the
+                  observation), the action also carries each controller's memory
+                  (`memory`: [agent, bytes of swarm.memory_codec]); the world stores it
+                  and hands it back, as a `memory` message on obs/<group> or in a
+                  newcomer's welcome, when a restarted world resumes the run
     plans/<group> agent process -> world: one agent's planned path (P x 2 float64, m), once
                   per new plan, at most MAX_PLAN_POINTS points (the recording's, not the controller's)
 
@@ -24,6 +29,7 @@ import numpy as np
 
 from swarm.protocol import (
     FAMILY_ARENA,
+    HandBack,
     Rejected,
     check_family,
     family_header,
@@ -35,6 +41,7 @@ from swarm.protocol import (
 )
 
 MAX_OBS_BYTES = 64 * 1024 * 1024  # observations come from the world; 100 animats take ~100 KB
+MAX_ACT_BYTES = 64 * 1024 * 1024  # an action may carry shared maps and, at a save, the controllers' memory
 DTYPES = {"<f8": np.float64, "<i8": np.int64, "|u1": np.uint8, "|b1": np.bool_}
 MAX_SENSORS, MAX_DIMS = 32, 4
 MAX_PLAN_POINTS = 2000  # 32 KB: a plan message stays under the world's message limit
@@ -42,6 +49,7 @@ MAX_PLAN_POINTS = 2000  # 32 KB: a plan message stays under the world's message 
 
 MAX_SHARED = 4 * 1024 * 1024  # bytes of shared payloads in one message
 Shared = list[tuple[int, str, bytes]]  # (agent, share, payload)
+Memories = list[tuple[int, bytes]]  # (agent, its controller's memory, swarm.memory_codec)
 
 
 @dataclass(frozen=True)
@@ -50,6 +58,7 @@ class ArenaObs:
     agents: np.ndarray  # (K,)
     perceptions: list[dict[str, np.ndarray]]
     shared: Shared = ()  # what every robot published last tick
+    keep: bool = False  # the world saves after this tick: send the controllers' memory with the action
 
 
 @dataclass(frozen=True)
@@ -58,6 +67,39 @@ class ArenaActs:
     agents: np.ndarray  # (K,)
     wheels: np.ndarray  # (K, 2), or (K, 3) with acts; not yet judged
     shared: Shared = ()  # what these agents publish this tick, not yet judged
+    memory: Memories = ()  # at a save: each controller's memory after this tick's step
+
+
+@dataclass(frozen=True)
+class ArenaMemory(HandBack):
+    """A resumed run, before its first tick: each agent's controller memory at the saved tick."""
+
+    memory: Memories
+
+
+def _memory_field(memory: Memories) -> list:
+    return [[int(a), bytes(blob)] for a, blob in memory]
+
+
+def parse_memory(raw, agents: np.ndarray | None = None) -> Memories | Rejected:
+    """[[agent, bytes], ...]; with `agents`, only those agents may appear (an action's)."""
+    if raw is None:
+        return []
+    if not isinstance(raw, list):
+        return Rejected("memory: expected a list of [agent, bytes]")
+    named = None if agents is None else set(agents.tolist())
+    out = []
+    for item in raw:
+        if not (isinstance(item, list) and len(item) == 2 and type(item[0]) is int and isinstance(item[1], bytes)):
+            return Rejected("memory: expected [agent, bytes]")
+        if named is not None and item[0] not in named:
+            return Rejected("memory: names an agent the message does not act for")
+        out.append((item[0], item[1]))
+    return out
+
+
+def memory_message(memory: Memories) -> bytes:
+    return pack({"type": "memory", "family": FAMILY_ARENA, "memory": _memory_field(memory)})
 
 
 def _shared_field(shared: Shared) -> list:
@@ -90,15 +132,18 @@ def _encode(value) -> list:
     return [kind, list(a.shape), np.ascontiguousarray(a, dtype=DTYPES[kind]).astype(kind).tobytes()]
 
 
-def observations(tick: int, agents, perceptions: list[dict[str, np.ndarray]], shared: Shared = ()) -> bytes:
+def observations(tick: int, agents, perceptions: list[dict[str, np.ndarray]], shared: Shared = (),
+                 keep: bool = False) -> bytes:  # fmt: skip
     m = {"type": "obs", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
          "perceptions": [{k: _encode(v) for k, v in p.items()} for p in perceptions]}  # fmt: skip
     if shared:
         m["shared"] = _shared_field(shared)
+    if keep:
+        m["keep"] = True
     return pack(m)
 
 
-def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = ()) -> bytes:
+def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = (), memory: Memories = ()) -> bytes:
     """(K, 2) wheel speeds, or (K, 3) with a consummatory act each: the acts go
     in their own field, and only when one is not 0 (the message of robots
     without a metabolism stays as it was)."""
@@ -109,6 +154,8 @@ def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = ()) -> bytes
         m["acts"] = np.ascontiguousarray(wheels[:, 2]).astype("<f8").tobytes()
     if shared:
         m["shared"] = _shared_field(shared)
+    if memory:
+        m["memory"] = _memory_field(memory)
     return pack(m)
 
 
@@ -129,6 +176,9 @@ def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
     m = unpack(data, MAX_OBS_BYTES)
     if isinstance(m, Rejected) or m.get("type") in ("stop", "wake"):
         return m
+    if m.get("type") == "memory":
+        memory = parse_memory(m.get("memory"))
+        return memory if isinstance(memory, Rejected) else ArenaMemory(memory)
     m = check_family(m, "obs", FAMILY_ARENA, "an arena observation")
     if isinstance(m, Rejected):
         return m
@@ -148,11 +198,11 @@ def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
         perceptions.append(decoded)
     if bad := first_rejection(shared := parse_shared(m.get("shared"))):
         return bad
-    return ArenaObs(tick, agents, perceptions, shared)
+    return ArenaObs(tick, agents, perceptions, shared, m.get("keep") is True)
 
 
 def parse_acts(data: bytes) -> ArenaActs | Rejected:
-    header = family_header(data, "act", FAMILY_ARENA, "an action")
+    header = family_header(data, "act", FAMILY_ARENA, "an action", MAX_ACT_BYTES)
     if isinstance(header, Rejected):
         return header
     m, tick = header
@@ -170,7 +220,9 @@ def parse_acts(data: bytes) -> ArenaActs | Rejected:
         if not isinstance(acts, bytes) or len(acts) != 8 * len(agents):
             return Rejected(f"acts: expected {len(agents)} binary float64")
         wheels = np.column_stack([wheels, np.frombuffer(acts, dtype="<f8").astype(np.float64)])
-    return ArenaActs(tick, agents, wheels, shared)
+    if bad := first_rejection(memory := parse_memory(m.get("memory"), agents)):
+        return bad
+    return ArenaActs(tick, agents, wheels, shared, memory)
 
 
 @dataclass(frozen=True)

@@ -73,8 +73,7 @@ class ArenaWorld:
         self.in_world = np.full(self.n, not parked)
         start = np.column_stack([-10.0 - 4 * self.radius.max() * np.arange(self.n), np.full(self.n, -10.0),
                                  np.zeros(self.n)]) if parked else s.start_poses()  # fmt: skip
-        self.bodies = DiffDrive(start, self.radius, s.wall_rects(), s.wall_segments(), s.control_period, s.substeps,
-                                self.in_world)  # fmt: skip
+        self.bodies = self._new_bodies(start)
         self.present = np.ones(self.n, np.bool_)  # False: the agent is gone, its body stays as an obstacle
         self.suites: list[Suite] = []
         first = 0
@@ -104,11 +103,17 @@ class ArenaWorld:
         self.rejected = dict.fromkeys(REJECT_REASONS, 0)
         self.optimum: list[float | None] = [None] * self.n  # L_o per robot, computed once by the summary
         self.start_pose = start.copy()
+        self.checkpointed: dict[str, np.ndarray] | None = None  # the snapshot of the last checkpoint
         self.zones = np.zeros(self.n, np.int64)
         self._update_zones()
         self.metabolism = None if s.metabolism is None else Metabolism(
             self.n, s.metabolism, s.control_period,
             [(o.name, o.zone, o.centre) for o in s.obstacles if o.zone is not None])  # fmt: skip
+
+    def _new_bodies(self, pose: np.ndarray) -> DiffDrive:
+        s = self.scenario
+        return DiffDrive(pose, self.radius, s.wall_rects(), s.wall_segments(), s.control_period, s.substeps,
+                         self.in_world)  # fmt: skip
 
     # ------------------------------------------------------------- contract
 
@@ -257,6 +262,9 @@ class ArenaWorld:
         self._obstacles_at(self.tick)
         self._update_zones()
         self._track_goals()
+        if self.tick % self.scenario.checkpoint == 0:  # the physics restarts from its saved state, in every runtime
+            self.checkpointed = self.snapshot()
+            self.restore(self.checkpointed)
 
     def _limit(self, wheels: np.ndarray) -> np.ndarray:
         """The model's forward-speed and turn-rate limits scale the wheel speeds down."""
@@ -330,13 +338,16 @@ class ArenaWorld:
     BODY_STATE = ("distance", "collisions", "blocked_seconds", "contact", "motion")
 
     def snapshot(self) -> dict[str, np.ndarray]:
-        """What a restarted world resumes from (arrays only).  pymunk's contact
-        caches are not in it, so a resumed run is close to, not bit-equal with,
-        the run it continues (docs/arena.md)."""
+        """What a restarted world resumes from (arrays only), pymunk's cached
+        contacts included.  Chipmunk also carries a position correction from
+        one step to the next that pymunk cannot read, so a snapshot is exact
+        only where every runtime restarts its physics from it: at the
+        scenario's checkpoints (`apply`), where the world server saves."""
         out = {k: np.array(getattr(self, k)) for k in self.STATE}
         out.update({f"body_{k}": np.array(getattr(self.bodies, k)) for k in self.BODY_STATE})
         out["pose"] = self.pose.copy()
         out["velocity"] = self.bodies.velocities()
+        out.update(self.bodies.contacts())
         out["tick"] = np.array(self.tick)
         out["sim_seconds"] = np.array(self.bodies.sim_seconds)
         out["optimum"] = np.array([np.nan if v is None else v for v in self.optimum])
@@ -351,15 +362,20 @@ class ArenaWorld:
         for k in self.BODY_STATE:
             getattr(self.bodies, k)[...] = state[f"body_{k}"]
         self.tick = int(state["tick"])
-        self.bodies.sim_seconds = float(state["sim_seconds"])
         self.optimum = [None if np.isnan(v) else float(v) for v in state["optimum"]]
         self.rejected = dict.fromkeys(REJECT_REASONS, 0)
         self.rejected.update({k: int(v) for k, v in zip(REJECT_REASONS, state["rejected"], strict=False)})
         if self.metabolism is not None:
             self.metabolism.restore(state)
-        for a in range(self.n):
-            self.bodies.restore(a, state["pose"][a], state["velocity"][a], bool(self.in_world[a]))
+        counters = {k: getattr(self.bodies, k) for k in self.BODY_STATE}
+        self.bodies = self._new_bodies(state["pose"])  # a fresh space: the same one in every runtime
+        for k, v in counters.items():
+            setattr(self.bodies, k, v)
+        self.bodies.sim_seconds = float(state["sim_seconds"])
+        self.bodies.set_velocities(state["velocity"])
         self._obstacles_at(self.tick)
+        if "contacts_f" in state:
+            self.bodies.take_contacts(state)
         self._update_zones()
 
     def remove_agent(self, agent: int) -> None:

@@ -12,6 +12,7 @@ mix controllers.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -41,7 +42,10 @@ class ArenaServer(WorldServer):
         self.shared_out: list[tuple[int, str, bytes]] = []  # last tick's, going out with this tick's observations
         self.shared_history: dict[tuple[str, int], list[bytes]] = {}  # every publication, for `get <share>/**`
         self.shares = ShareLog()
+        self.memory: list[bytes | None] = [None] * self.world.n  # each controller's memory at the last save
         self.state_file = Path(self.state_dir) / f"{self.keys.run}.arena.npz" if self.state_dir else None
+        if self.persist_every:  # saves fall on physics checkpoints, the ticks a resumed run is exact from
+            self.persist_every = math.lcm(self.persist_every, s.checkpoint)
 
     # ------------------------------------------------------------ persistence
 
@@ -58,6 +62,12 @@ class ArenaServer(WorldServer):
         self.tick = int(arrays["tick"])
         slots = arrays["slots"]
         self.slots[:] = np.where((slots == ACTIVE) | (slots == JOINING), JOINING, slots)
+        self.returning[:] = self.slots == JOINING
+        self.memory = persist.unpack_blobs(arrays["memory"], arrays["memory_at"])
+        payloads = persist.unpack_blobs(arrays["pending"], arrays["pending_at"])
+        pending = zip(arrays["pending_agents"].tolist(), arrays["pending_shares"].tolist(), payloads, strict=True)
+        self.pending_shared = {a: (s, p) for a, s, p in pending}
+        self.shares.restore(meta["shares"])
         self.stats.joins = int(meta["stats"]["joins"])
         self.stats.agents_lost = int(meta["stats"]["agents_lost"])
         self.stats.rejected = dict(meta["stats"]["rejected"])
@@ -70,8 +80,17 @@ class ArenaServer(WorldServer):
             return
         stats = {"joins": self.stats.joins, "agents_lost": self.stats.agents_lost, "rejected": self.stats.rejected,
                  "groups": {str(a): g for a, g in self.group_of.items()}}  # fmt: skip
-        persist.save_arrays(self.state_file, {**self.world.snapshot(), "slots": self.slots},
-                            {"scenario": self.scenario.describe(), "stats": stats})  # fmt: skip
+        w = self.world
+        world = w.checkpointed if w.checkpointed is not None and w.tick == self.tick else w.snapshot()
+        memory, memory_at = persist.pack_blobs(self.memory)
+        pending = sorted(self.pending_shared.items())  # the last tick's publications, out with the next tick's
+        payloads, payloads_at = persist.pack_blobs([p for _, (_, p) in pending])
+        arrays = {**world, "slots": self.slots, "memory": memory, "memory_at": memory_at,
+                  "pending_agents": np.array([a for a, _ in pending], np.int64),
+                  "pending_shares": np.array([s for _, (s, _) in pending], dtype=np.str_).reshape(-1),
+                  "pending": payloads, "pending_at": payloads_at}  # fmt: skip
+        meta = {"scenario": self.scenario.describe(), "stats": stats, "shares": self.shares.state()}
+        persist.save_arrays(self.state_file, arrays, meta)
 
     def _declare_shared(self, put) -> list:
         out = [self.session.declare_subscriber(self.keys.plans, lambda s: put(("plan", s)))]
@@ -109,12 +128,26 @@ class ArenaServer(WorldServer):
         return None
 
     def _free_slots(self, request: dict) -> np.ndarray:
+        """A resumed run's missing agents first (taken over where they were saved), then free slots."""
+        mine = self.controllers == request.get("controller")
         free = (self.slots == FREE) | (self.slots == LOST)
-        return np.flatnonzero(free & (self.controllers == request.get("controller")))
+        return np.concatenate([np.flatnonzero(self.returning & mine), np.flatnonzero(free & mine)])
 
     def _welcome(self, agent: int) -> dict:
-        return {"family": self.family, "controller": str(self.controllers[agent]),
-                "params": controller_params(self.scenario, agent)}  # fmt: skip
+        welcome = {"family": self.family, "controller": str(self.controllers[agent]),
+                   "params": controller_params(self.scenario, agent)}  # fmt: skip
+        if self.memory[agent] is not None:
+            welcome["memory"] = self.memory[agent]
+        return welcome
+
+    def _hand_back(self) -> None:
+        """Agents that survived the world's restart ran on past the saved tick:
+        their controllers go back to the saved memory (on the observation key,
+        so it arrives before the first observation)."""
+        for group, agents in self._groups(np.flatnonzero(self.slots == ACTIVE)).items():
+            memory = [(a, self.memory[a]) for a in agents.tolist() if self.memory[a] is not None]
+            if memory:
+                self._publisher(group).put(arena_proto.memory_message(memory))
 
     def _starting(self) -> None:
         """The robots that start the run come in together, in id order: the
@@ -123,6 +156,7 @@ class ArenaServer(WorldServer):
 
     def _reuse(self, agent: int) -> None:
         self.world.present[agent] = True
+        self.memory[agent] = None  # a newcomer in a lost agent's place starts its controller afresh
 
     def _remove(self, agent: int) -> None:
         self.world.remove_agent(agent)
@@ -133,6 +167,9 @@ class ArenaServer(WorldServer):
         self.world.enter(np.flatnonzero(self.slots == ACTIVE))  # late joiners come in beside the others
         self.ok[:] = False
         self.wheels[:] = 0.0
+        if self._saves_after(self.tick):  # an agent that does not answer this tick has no saved memory
+            for a in np.flatnonzero(self.slots == ACTIVE).tolist():
+                self.memory[a] = None
         self._pass_on_shared()
         if not self.null:
             self.readings = self.world.perceive()
@@ -142,7 +179,7 @@ class ArenaServer(WorldServer):
 
     def _observe(self, tick: int, agents: np.ndarray) -> bytes:
         readings = [{} for _ in agents] if self.null else [self.readings[a] for a in agents]
-        return arena_proto.observations(tick, agents, readings, self.shared_out)
+        return arena_proto.observations(tick, agents, readings, self.shared_out, keep=self._saves_after(tick))
 
     def _on_act(self, sample) -> None:
         received = self._receive(sample, arena_proto.parse_acts, "act")
@@ -161,6 +198,11 @@ class ArenaServer(WorldServer):
                 self.acted[a] = True
         if msg.shared:
             self._take_shared(msg, group)
+        for a, blob in msg.memory:
+            if self.acted[a] and self.group_of.get(a) == group and self._saves_after(msg.tick):
+                self.memory[a] = blob
+            else:
+                self.stats.reject("memory: not with an accepted action before a save")
 
     def _take_shared(self, msg, group: str) -> None:
         """Publications of agents whose action this tick was taken; the rest is counted and dropped."""

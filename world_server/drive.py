@@ -22,6 +22,8 @@ import math
 
 import numpy as np
 
+from world_server import contacts
+
 WALL_TYPE, ROBOT_TYPE = 1, 2
 BLOCKED_SHARE = 0.5  # moving at under half of the commanded speed counts as blocked
 
@@ -46,10 +48,13 @@ class DiffDrive:
         self.sim_seconds = 0.0
         space = pymunk.Space()
         space.collision_slop = 0.0005
+        # Every shape has a stable key (walls, then robots, then scheduled obstacles): saved contacts name them.
+        self._keyed: dict[int, object] = {}
         for rect in rects:
             self._add_static(space, box=rect)
         for seg in segments:
             self._add_static(space, segment=seg)
+        self._walls = len(self._keyed)
         self._bodies, self._discs = [], []
         for i in range(self.n):
             body = pymunk.Body(1.0, float("inf"))
@@ -61,6 +66,7 @@ class DiffDrive:
             if in_world is not None and not in_world[i]:
                 disc.filter = pymunk.ShapeFilter(categories=0, mask=0)  # parked: touches nothing
             space.add(body, disc)
+            self._key(disc, self._walls + i)
             self._bodies.append(body)
             self._discs.append(disc)
         space.on_collision(ROBOT_TYPE, WALL_TYPE, begin=self._begin)
@@ -72,7 +78,11 @@ class DiffDrive:
         self._set.set_float_buf(self._force)
         self._get = pymunk.batch.Buffer()
 
-    def _add_static(self, space, box=None, segment=None) -> list:
+    def _key(self, shape, key: int) -> None:
+        shape.key = key
+        self._keyed[key] = shape
+
+    def _add_static(self, space, box=None, segment=None, key: int | None = None) -> list:
         pm = self._pymunk
         if box is not None:
             x0, y0, x1, y1 = (float(v) for v in box)
@@ -83,6 +93,7 @@ class DiffDrive:
         shape.friction = 0.0
         shape.collision_type = WALL_TYPE
         space.add(shape)
+        self._key(shape, len(self._keyed) if key is None else key)
         return [shape]
 
     def _begin(self, arbiter, space, data) -> None:
@@ -99,8 +110,9 @@ class DiffDrive:
             shapes = self._obstacles.pop(key, [])
             if shapes:
                 self.space.remove(*shapes)
+                del self._keyed[shapes[0].key]
         elif key not in self._obstacles:
-            self._obstacles[key] = self._add_static(self.space, box=rect)
+            self._obstacles[key] = self._add_static(self.space, box=rect, key=self._walls + self.n + key)
 
     # ------------------------------------------------------------------- motion
 
@@ -147,12 +159,17 @@ class DiffDrive:
     def velocities(self) -> np.ndarray:
         return self._positions()[:, 2:]
 
-    def restore(self, i: int, pose: np.ndarray, velocity: np.ndarray, in_world: bool) -> None:
-        self.place(i, pose)
-        self._bodies[i].velocity = (float(velocity[0]), float(velocity[1]))
-        self._discs[i].filter = (
-            self._pymunk.ShapeFilter() if in_world else self._pymunk.ShapeFilter(categories=0, mask=0)
-        )
+    def contacts(self) -> dict[str, np.ndarray]:
+        """The space's cached contacts and clock (world_server.contacts)."""
+        return contacts.save(self.space, lambda shape: shape.key)
+
+    def take_contacts(self, state: dict[str, np.ndarray]) -> None:
+        """Saved contacts into this (rebuilt) space: they warm-start and are not new collisions."""
+        contacts.load(self.space, state, self._keyed.__getitem__)
+
+    def set_velocities(self, velocity: np.ndarray) -> None:
+        for body, (vx, vy) in zip(self._bodies, np.asarray(velocity, np.float64).tolist(), strict=True):
+            body.velocity = (vx, vy)
 
     def enter(self, i: int, pose: np.ndarray) -> None:
         """A parked robot comes into the world at `pose`."""

@@ -37,6 +37,22 @@ def save_arrays(path: Path, arrays: dict, meta: dict) -> None:
     os.replace(tmp, path)
 
 
+def pack_blobs(blobs: list[bytes | None]) -> tuple[np.ndarray, np.ndarray]:
+    """Byte strings as one uint8 array and (offset, length) rows; length -1: none."""
+    at = np.zeros((len(blobs), 2), np.int64)
+    offset = 0
+    for i, blob in enumerate(blobs):
+        at[i] = (offset, -1) if blob is None else (offset, len(blob))
+        offset += 0 if blob is None else len(blob)
+    joined = b"".join(b for b in blobs if b is not None)
+    return np.frombuffer(joined, np.uint8).copy(), at
+
+
+def unpack_blobs(joined: np.ndarray, at: np.ndarray) -> list[bytes | None]:
+    raw = joined.tobytes()
+    return [None if n < 0 else raw[o : o + n] for o, n in at.tolist()]
+
+
 def load_arrays(path: Path) -> tuple[dict, dict] | None:
     if not path.exists():
         return None

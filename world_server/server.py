@@ -146,6 +146,10 @@ class WorldServer:
     def save_state(self) -> None:
         """Persist the world (kinds that can resume)."""
 
+    def _saves_after(self, tick: int) -> bool:
+        """Is the world saved once `tick` is resolved (controllers' memory is wanted with its actions)?"""
+        return bool(self.persist_every) and self.state_dir is not None and (tick + 1) % self.persist_every == 0
+
     def _recorder(self, record: str, viewer: str | None):
         """A resumed run records into a new file from its resume tick: the
         first file stays as it was (rerun merges files of one recording id).

@@ -122,16 +122,25 @@ class ShareLog:
 
     def __init__(self) -> None:
         self.count: dict[int, int] = {}
-        self.hash: dict[int, Any] = {}
+        self.digest: dict[int, str] = {}  # chained: sha1(previous digest, tick, share, payload)
 
     def add(self, tick: int, shared: list[tuple[int, str, bytes]]) -> None:
         for a, share, payload in shared:
-            h = self.hash.setdefault(a, hashlib.sha1())
-            h.update(f"{tick}:{share}:{len(payload)}:".encode())
+            h = hashlib.sha1(f"{self.digest.get(a, '')}:{tick}:{share}:{len(payload)}:".encode())
             h.update(payload)
+            self.digest[a] = h.hexdigest()
             self.count[a] = self.count.get(a, 0) + 1
 
     def of(self, agent: int) -> dict[str, Any] | None:
         if agent not in self.count:
             return None
-        return {"messages": self.count[agent], "digest": self.hash[agent].hexdigest()[:16]}
+        return {"messages": self.count[agent], "digest": self.digest[agent][:16]}
+
+    def state(self) -> dict[str, list]:
+        """What a saved world keeps (JSON): a chained digest goes on from its last value."""
+        return {"agents": sorted(self.count), "count": [self.count[a] for a in sorted(self.count)],
+                "digest": [self.digest[a] for a in sorted(self.count)]}  # fmt: skip
+
+    def restore(self, state: dict[str, list]) -> None:
+        self.count = dict(zip(state["agents"], state["count"], strict=True))
+        self.digest = dict(zip(state["agents"], state["digest"], strict=True))

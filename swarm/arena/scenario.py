@@ -9,6 +9,7 @@ A TOML file with `kind = "arena"` (docs/arena.md lists every field):
     noise = "low"                     # none | low | high, or a [noise] table
     control_period = 0.064            # seconds per tick
     substeps = 4                      # physics steps per tick
+    checkpoint = 50                   # ticks between physics checkpoints (exact resume)
     max_ticks = 3000
     [[wall]]   rect = [x0, y0, x1, y1]  (or segment = [x0, y0, x1, y1]), colour = [r, g, b]
     [[zone]]   kind = "goal", rect = [...] or disc = [cx, cy, r]
@@ -128,6 +129,7 @@ class ArenaScenario:
     seed: int = 0
     control_period: float = 0.064
     substeps: int = 4
+    checkpoint: int = 50  # ticks: the physics restarts from its saved state here, in every runtime (docs/arena.md)
     noise: Noise = field(default_factory=Noise)
     max_ticks: int = 3000
     goal_radius: float = 0.07  # a robot has reached its goal within this distance (DFT code: 7 cells)
@@ -195,6 +197,7 @@ class ArenaScenario:
     def describe(self) -> dict[str, Any]:
         return {"name": self.name, "kind": "arena", "seed": self.seed, "size": list(self.size),
                 "agents": self.agents, "controller": self.controller, "noise": self.noise.level,
+                "checkpoint": self.checkpoint,
                 "walls": len(self.walls), "zones": len(self.zones), "obstacles": len(self.obstacles),
                 "groups": [{"count": g.count, "controller": g.controller, "robot": g.robot.name}
                            for g in self.groups]}  # fmt: skip
@@ -326,6 +329,7 @@ _TOP = {
     "noise",
     "control_period",
     "substeps",
+    "checkpoint",
     "max_ticks",
     "goal_radius",
     "goal_dwell",
@@ -354,7 +358,7 @@ def parse_arena(data: dict, source: str, default_name: str) -> ArenaScenario:
         "size": (size[0], size[1]),
         "description": _get(data, "description", str, source, ""),
     }
-    for key in ("seed", "substeps", "max_ticks", "goal_dwell"):
+    for key in ("seed", "substeps", "checkpoint", "max_ticks", "goal_dwell"):
         if key in data:
             kw[key] = _get(data, key, int, source)
     for key in ("control_period", "goal_radius"):
@@ -566,6 +570,8 @@ def check_arena(s: ArenaScenario, source: str) -> None:
         raise ScenarioError(source, "control_period", f"expected 0.001 to 10 s, got {s.control_period}")
     if not 1 <= s.substeps <= 1000:
         raise ScenarioError(source, "substeps", f"expected 1 to 1000, got {s.substeps}")
+    if not 1 <= s.checkpoint <= 1_000_000:
+        raise ScenarioError(source, "checkpoint", f"expected 1 to 1000000 ticks, got {s.checkpoint}")
     if not 1 <= s.max_ticks <= 100_000_000:
         raise ScenarioError(source, "max_ticks", f"expected 1 to 100000000, got {s.max_ticks}")
     if not 0 < s.goal_radius <= max(w, h) or s.goal_dwell < 1:

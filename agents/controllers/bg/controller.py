@@ -179,7 +179,7 @@ class BgController:
     def snapshot(self) -> dict[str, Any]:
         return {"tick": self.tick, "bg": {k: v.tolist() for k, v in self.bg.state().items()},
                 "nav": self.nav.to_data(), "reflex": self.reflex.state(), "acting": self.acting,
-                "colony": self.colony.to_data(), "params": asdict(self.p)}  # fmt: skip
+                "colony": self.colony.to_data(), "params": asdict(self.p), "habits": self.nav.habits()}  # fmt: skip
 
     def restore(self, state: dict[str, Any]) -> None:
         self.tick = int(state["tick"])
@@ -189,6 +189,8 @@ class BgController:
         self.colony.restore(state["colony"])
         self.reflex.restore(state["reflex"])
         self.acting = int(state["acting"])
+        if "habits" in state:
+            self.nav.take_habits(state["habits"])
 
     def record(self) -> dict[str, np.ndarray]:
         if not self.last:

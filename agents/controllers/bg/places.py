@@ -282,6 +282,18 @@ class Navigator:
 
     # ------------------------------------------------------------ state
 
+    def habits(self) -> dict[str, Any]:
+        """What steers the animat besides its map: the news count and the novelty profile, which is
+        worked out again only when the map changes (from where the animat was then), so it is memory."""
+        obs, news, use_map = self._novel_key or (-1, -1, False)
+        return {"news": self.news, "novel": self._novel.tolist(), "novel_key": [obs, news, use_map]}
+
+    def take_habits(self, data: dict[str, Any]) -> None:
+        self.news = int(data["news"])
+        self._novel = np.array(data["novel"], np.float64)
+        obs, news, use_map = data["novel_key"]
+        self._novel_key = () if obs < 0 else (int(obs), int(news), bool(use_map))
+
     def to_data(self) -> dict[str, Any]:
         """The map, what its nodes hold and the odometric frame, as plain data (to save and load)."""
         return {"map": topomap_to_data(self.map, lambda sig: np.asarray(sig).tolist()),

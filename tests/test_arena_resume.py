@@ -1,0 +1,126 @@
+"""What an exact arena resume rests on: physics checkpoints, controllers'
+memory as bytes, and the wire that carries it (the kill -9 runs themselves
+are in test_arena_distributed.py)."""
+
+import msgpack
+import numpy as np
+import pytest
+
+from agents.arena_runtime import give_back
+from agents.controllers.arena import make_controller
+from swarm import memory_codec
+from swarm import protocol_arena as arena_proto
+from swarm.arena.engine import ArenaEngine
+from swarm.arena.scenario import controller_params
+from swarm.protocol import Rejected, pack
+from swarm.scenario import load_scenario
+from tests.arena_helpers import arena
+from world_server.arena import ArenaWorld
+
+CROWD = arena('[[group]]\ncount = 12\ncontroller = "wander"\n', w=0.8, h=0.8, max_ticks=100_000)
+
+
+def _push(world: ArenaWorld, ticks: range) -> None:
+    """Every robot drives at a speed drawn per 20 ticks: they bump into each other and the walls."""
+    for t in ticks:
+        world.apply(np.random.default_rng(t // 20).uniform(0.02, 0.12, (world.n, 2)))
+
+
+@pytest.mark.parametrize("at", [50, 150])
+def test_a_world_restored_from_a_checkpoint_goes_on_bit_for_bit_with_robots_in_contact(at):
+    a = ArenaWorld(CROWD)
+    _push(a, range(at))
+    saved = a.checkpointed
+    assert a.tick % CROWD.checkpoint == 0 and saved is not None and len(saved["contacts_f"]) > 0
+    b = ArenaWorld(CROWD, parked=True)  # as a restarted world server builds it
+    b.restore(saved)
+    _push(a, range(at, 3 * at))
+    _push(b, range(at, 3 * at))
+    np.testing.assert_array_equal(a.pose, b.pose)
+    np.testing.assert_array_equal(a.bodies.collisions, b.bodies.collisions)  # touching pairs are not new collisions
+    assert a.bodies.collisions.sum() > 20
+
+
+def test_saved_contacts_are_what_keeps_collision_counts():
+    a = ArenaWorld(CROWD)
+    _push(a, range(50))
+    saved = {k: v for k, v in a.checkpointed.items() if not k.startswith("contacts")}
+    saved["space_clock"] = a.checkpointed["space_clock"]
+    b = ArenaWorld(CROWD, parked=True)
+    b.restore({**saved, "contacts_f": np.zeros((0, 28)), "contacts_i": np.zeros((0, 6), np.int64),
+               "contacts_h": np.zeros((0, 2), np.uint64)})  # fmt: skip
+    _push(a, range(50, 60))
+    _push(b, range(50, 60))
+    assert b.bodies.collisions.sum() > a.bodies.collisions.sum()  # without them, contacts begin again
+
+
+def test_memory_codec_round_trips_exactly():
+    memory = {"tick": 7, 3: [1.5, float("nan"), None, True], "fields": {"M_N": np.linspace(0, 1, 12).reshape(3, 4)},
+              "counts": np.arange(5, dtype=np.int64), "mask": np.array([True, False]),
+              "grey": np.arange(3, dtype=np.uint8),
+              "f32": np.float32(0.1), "i": np.int64(2**40), "pair": (1, 2)}  # fmt: skip
+    back = memory_codec.decode(memory_codec.encode(memory))
+    assert back["tick"] == 7 and back[3][0] == 1.5 and np.isnan(back[3][1]) and back[3][2:] == [None, True]
+    for key in ("counts", "mask", "grey"):
+        assert back[key].dtype == memory[key].dtype
+        np.testing.assert_array_equal(back[key], memory[key])
+    np.testing.assert_array_equal(back["fields"]["M_N"], memory["fields"]["M_N"])
+    assert back["fields"]["M_N"].flags.writeable and back["pair"] == [1, 2] and back["i"] == 2**40
+
+
+@pytest.mark.parametrize("blob", [
+    b"\xc1garbage",
+    msgpack.packb(msgpack.ExtType(9, b"x")),
+    msgpack.packb(msgpack.ExtType(1, msgpack.packb(["|O", [1], b"12345678"]))),
+    msgpack.packb(msgpack.ExtType(1, msgpack.packb(["<f8", [3], b"short"]))),
+    "not bytes",
+])  # fmt: skip
+def test_a_broken_memory_is_a_reason_not_a_traceback(blob):
+    assert isinstance(memory_codec.decode(blob), Rejected)
+
+
+@pytest.mark.parametrize("controller", ["carrot", "wander", "dft", "fingerprint", "bg"])
+def test_a_controller_given_back_its_memory_through_the_codec_steps_on_as_before(controller):
+    ref = {"bg": "bg-exp1", "fingerprint": "office"}.get(controller, "zmaze")
+    scenario = load_scenario(ref).with_overrides(controller=controller, max_ticks=200)
+    engine = ArenaEngine(scenario)
+    engine.step(60)
+    twin = make_controller(controller)
+    twin.reset(scenario.seed, 0, controller_params(scenario, 0))
+    assert give_back(twin, memory_codec.encode(engine.controllers[0].snapshot()))
+    readings = engine.world.perceive()[0]
+    np.testing.assert_array_equal(np.asarray(twin.step(readings)), np.asarray(engine.controllers[0].step(readings)))
+
+
+def test_a_memory_that_does_not_fit_its_controller_is_refused_and_changes_nothing():
+    scenario = load_scenario("zmaze").with_overrides(max_ticks=100)
+    brain = make_controller("carrot")
+    brain.reset(scenario.seed, 0, controller_params(scenario, 0))
+    before = memory_codec.encode(brain.snapshot())
+    assert not give_back(brain, memory_codec.encode({"nothing": 1}))
+    assert not give_back(brain, b"\x00\x01")
+    assert memory_codec.encode(brain.snapshot()) == before
+
+
+def test_actions_carry_memory_only_for_their_own_agents():
+    wheels = np.zeros((2, 2))
+    ok = arena_proto.parse_acts(arena_proto.actions(5, [1, 2], wheels, memory=[(2, b"abc")]))
+    assert ok.memory == [(2, b"abc")]
+    stray = arena_proto.parse_acts(arena_proto.actions(5, [1, 2], wheels, memory=[(3, b"abc")]))
+    assert isinstance(stray, Rejected) and "does not act for" in stray.reason
+    bad = pack({"type": "act", "family": "arena", "tick": 5, "agents": [1], "wheels": bytes(16), "memory": [[1, "x"]]})
+    assert isinstance(arena_proto.parse_acts(bad), Rejected)
+    obs = arena_proto.parse_obs(arena_proto.observations(5, [1], [{}], keep=True))
+    assert obs.keep and not arena_proto.parse_obs(arena_proto.observations(5, [1], [{}])).keep
+    back = arena_proto.parse_obs(arena_proto.memory_message([(1, b"m")]))
+    assert isinstance(back, arena_proto.ArenaMemory) and back.memory == [(1, b"m")]
+
+
+def test_the_checkpoint_is_a_scenario_key_with_a_range():
+    from swarm.scenario import ScenarioError, parse_scenario_text
+    from tests.arena_helpers import box
+
+    assert arena('[[group]]\ncount = 1\n').checkpoint == 50
+    with pytest.raises(ScenarioError) as err:
+        parse_scenario_text("checkpoint = 0\n" + box('[[group]]\ncount = 1\n'), "bad.toml")
+    assert err.value.where == "checkpoint"
