@@ -248,3 +248,52 @@ def test_more_robots_than_goals_get_a_drawn_goal_each():
     assert gaps.min() >= 2 * s.goal_radius
     assert clearance_at(goals, s.wall_rects(), s.wall_segments()).min() >= 0.037 + 0.04
     assert ArenaEngine(s).run()["reached"] >= 4
+
+
+def test_wall_distance_is_scipys_transform_up_to_the_clearance():
+    from scipy.ndimage import distance_transform_edt
+
+    from agents.controllers.navigation.astar import occupancy, wall_distance
+
+    s = load_scenario("large-maze")
+    occ = occupancy(s.size, 0.01, s.wall_rects(), s.wall_segments())
+    occ[50:53, 100:140] = True  # and a bar away from the walls
+    ref = distance_transform_edt(np.pad(~occ, 1, constant_values=False))[1:-1, 1:-1]
+    ref[ref > 5.0] = np.inf
+    np.testing.assert_array_equal(wall_distance(occ, 5.0), ref)
+
+
+def test_the_agents_compiled_astar_equals_the_jit_and_carrot_agents_run_without_numba(tmp_path):
+    import subprocess
+    import sys
+
+    from numba import njit
+
+    from agents.controllers import aot
+    from agents.controllers.navigation.astar import astar_cells
+
+    aot.build()  # once per source version (swarm up builds it too)
+    compiled, jit = aot.load("astar"), njit(astar_cells)
+    free = np.random.default_rng(3).random((60, 80)) > 0.3
+    for si, sj, gi, gj in ((0, 0, 79, 59), (5, 40, 70, 2), (10, 10, 10, 10)):
+        free[sj, si] = free[gj, gi] = True
+        (c1, p1), (c2, p2) = compiled(free, si, sj, gi, gj), jit(free, si, sj, gi, gj)
+        assert c1 == c2 and np.array_equal(p1, p2)
+    import pickle
+
+    from swarm.arena.engine import ArenaEngine
+    from swarm.arena.scenario import controller_params
+
+    s = load_scenario("zmaze")
+    given = tmp_path / "given.pkl"
+    given.write_bytes(pickle.dumps((controller_params(s, 0), ArenaEngine(s).world.perceive()[0])))
+    probe = ("import pickle, sys\nfrom agents.arena_runtime import ArenaAgentRuntime\n"
+             "from agents.controllers.arena import make_controller\n"
+             f"params, reading = pickle.loads(open({str(given)!r}, 'rb').read())\n"
+             "for name in ('carrot', 'wander'):\n"
+             "    brain = make_controller(name)\n"
+             "    brain.reset(0, 0, params)\n"
+             "    brain.step(reading)\n"
+             "print('numba' in sys.modules, 'scipy' in sys.modules)\n")  # fmt: skip
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    assert out.stdout.strip() == "False False", out.stderr[-2000:]  # an agent process of 49 MB, not 100+

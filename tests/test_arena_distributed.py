@@ -186,6 +186,7 @@ def test_swarm_up_runs_an_arena_and_equals_swarm_run():
     assert up.returncode == 0, up.stderr[-2000:]
     a, b = json.loads(ran.stdout), json.loads(up.stdout)
     assert a["robots"] == b["robots"] and a["ticks"] == b["ticks"] and b["rejected_messages"] == 0
+    assert b["agent_process_rss_mb"] < 80  # the agents' ahead-of-time A*: no numba in a carrot agent
 
 
 def test_swarm_status_answers_for_an_arena_world():

@@ -60,3 +60,13 @@ def test_stepping_agents_in_any_order_gives_the_same_run(controller):
         np.testing.assert_array_equal(reference.world.pos, w.pos, err_msg=f"tick {tick}")
         np.testing.assert_array_equal(reference.world.layers, w.layers, err_msg=f"tick {tick}")
         np.testing.assert_array_equal(reference.mem, manual.mem, err_msg=f"tick {tick}")
+
+
+def test_the_plain_python_draws_are_the_compiled_draws_bit_for_bit():
+    from swarm import rng, rng_scalar
+
+    cases = [(0, 0, 0, 0), (7, 3, 12345, 2), (2**63 - 1, 99_999, 2**40, 2**30), (123456789, 0, 1, 1 << 50)]
+    cases += [tuple(int(v) for v in row) for row in np.random.default_rng(5).integers(0, 2**31, (200, 4))]
+    for seed, agent, tick, draw in cases:
+        assert rng_scalar.draw_unit(seed, agent, tick, draw) == rng.draw_unit(seed, agent, tick, draw)
+        assert rng_scalar.draw_u64(seed, agent, tick, draw) == int(rng.draw_u64(seed, agent, tick, draw))

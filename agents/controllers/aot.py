@@ -1,8 +1,8 @@
 """Ahead-of-time build of the controllers' step, for agent processes.
 
 `import numba` alone costs an agent process 88 MB.  numba's pycc compiles
-the very same `dispatch.answer_rows` (and everything it calls) into a
-plain extension module.  Agent processes import that module, which needs only
+the very same `dispatch.answer_rows` (and everything it calls), and the
+arena's A* (`navigation.astar`), into a plain extension module.  Agent processes import that module, which needs only
 numpy, instead of the JIT.  The module is named after the source digest and lives
 in the compile cache (swarm.jitcache), so an edited controller is rebuilt
 rather than run stale.  Building needs numba and a C compiler; when the build
@@ -35,6 +35,13 @@ def signature():
                    t.int64[:, ::1], t.float64[::1], t.int64, t.int64, t.boolean)  # fmt: skip
 
 
+def astar_signature():
+    """navigation.astar._astar: free cells (C order), start and goal cells -> (cost, parents)."""
+    from numba import types as t
+
+    return t.Tuple((t.float64, t.int64[::1]))(t.boolean[:, ::1], t.int64, t.int64, t.int64, t.int64)
+
+
 def module_name() -> str:
     return f"swarm_steps_{source_digest()}"
 
@@ -54,6 +61,7 @@ def build() -> Path:
     from numba.pycc import CC
 
     from agents.controllers.dispatch import answer_rows
+    from agents.controllers.navigation.astar import astar_cells
 
     out = build_dir()
     out.mkdir(parents=True, exist_ok=True)
@@ -61,6 +69,7 @@ def build() -> Path:
         cc = CC(module_name())
         cc.output_dir = tmp
         cc.export("answer_rows", signature())(answer_rows.py_func)
+        cc.export("astar", astar_signature())(astar_cells)
         cc.compile()
         (result,) = Path(tmp).glob(f"{module_name()}.*.so")
         final = out / result.name
@@ -72,16 +81,17 @@ def build() -> Path:
     return final
 
 
-def load():
-    """The compiled `answer_rows`, or None when it has not been built for this source."""
+def load(name: str = "answer_rows"):
+    """A compiled function of the module (`answer_rows`, `astar`), or None when
+    it has not been built for this source."""
     path = built()
     if path is None:
         return None
     if str(path.parent) not in sys.path:
         sys.path.insert(0, str(path.parent))
     try:
-        return importlib.import_module(module_name()).answer_rows
-    except ImportError:
+        return getattr(importlib.import_module(module_name()), name)
+    except (ImportError, AttributeError):
         return None
 
 

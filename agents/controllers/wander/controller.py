@@ -21,7 +21,7 @@ import numpy as np
 
 from agents.controllers.tables import params_from_table
 from swarm.arena.models import IR_DISTANCE, IR_VALUE
-from swarm.rng import draw_unit
+from swarm.rng_scalar import draw_unit
 
 
 @dataclass(frozen=True)
