@@ -15,7 +15,7 @@ import numpy as np
 
 from agents.controllers.arena import as_action, deliver, make_controller, publications
 from agents.runtime import AgentRuntime
-from swarm import memory_codec
+from swarm import kernels, memory_codec
 from swarm import protocol as proto
 from swarm import protocol_arena as arena_proto
 
@@ -24,6 +24,7 @@ class ArenaAgentRuntime(AgentRuntime):
     family = proto.FAMILY_ARENA
 
     def _prepare(self, count: int) -> None:
+        kernels.use_ahead_of_time()  # before any controller is imported: no numba in this process when built
         self.brains: list = [None] * count
         self.sent_plans: dict[int, tuple] = {}  # agent -> (length, first, last point) of the last plan sent
         self.refused_shared = 0  # other robots' publications this process's controllers refused

@@ -6,7 +6,8 @@ machine, make exactly the choices it would make inside the in-process engine.
 """
 
 import numpy as np
-from numba import njit
+
+from swarm.kernels import exported, njit
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _TICK_MULT = np.uint64(0xD1B54A32D192ED03)
@@ -75,6 +76,7 @@ def fill_normal(seed, agents, tick, stream, out):
                 out[i, j + 1] = radius * np.sin(2.0 * np.pi * u2)
 
 
+@exported("rng_fill_uniform", "void(int64, int64[:], int64, int64, float64[:, :])")
 @njit(cache=True)
 def fill_uniform(seed, agents, tick, stream, out):
     """Like fill_normal, uniform in [-1, 1) (the papers' +-bounds)."""

@@ -263,37 +263,61 @@ def test_wall_distance_is_scipys_transform_up_to_the_clearance():
     np.testing.assert_array_equal(wall_distance(occ, 5.0), ref)
 
 
-def test_the_agents_compiled_astar_equals_the_jit_and_carrot_agents_run_without_numba(tmp_path):
-    import subprocess
-    import sys
+AOT_CHILD = """
+import pickle, sys
+from swarm import kernels
+assert kernels.use_ahead_of_time()
+from agents.controllers.arena import as_action, make_controller
+name, seed, params, readings = pickle.loads(open(sys.argv[1], "rb").read())
+brain = make_controller(name)
+brain.reset(seed, 0, params)
+actions = [as_action(brain.step(r)).tolist() for r in readings]
+pickle.dump((actions, "numba" in sys.modules), open(sys.argv[1] + ".out", "wb"))
+"""
 
-    from numba import njit
 
+def test_the_agents_compiled_astar_equals_the_jit():
     from agents.controllers import aot
     from agents.controllers.navigation.astar import astar_cells
 
     aot.build()  # once per source version (swarm up builds it too)
-    compiled, jit = aot.load("astar"), njit(astar_cells)
+    compiled = aot.load("astar")
     free = np.random.default_rng(3).random((60, 80)) > 0.3
     for si, sj, gi, gj in ((0, 0, 79, 59), (5, 40, 70, 2), (10, 10, 10, 10)):
         free[sj, si] = free[gj, gi] = True
-        (c1, p1), (c2, p2) = compiled(free, si, sj, gi, gj), jit(free, si, sj, gi, gj)
+        (c1, p1), (c2, p2) = compiled(free, si, sj, gi, gj), astar_cells(free, si, sj, gi, gj)
         assert c1 == c2 and np.array_equal(p1, p2)
-    import pickle
 
+
+@pytest.mark.parametrize(("controller", "ref"), [
+    ("carrot", "zmaze"), ("wander", "zmaze"), ("bg", "bg-exp1"), ("fingerprint", "office"), ("dft", "zmaze"),
+])  # fmt: skip
+def test_an_agent_process_steps_its_controller_without_numba_exactly_as_in_process(controller, ref, tmp_path):
+    """The agents' ahead-of-time kernels (swarm.kernels) give the JIT's actions, tick for tick."""
+    import pickle
+    import subprocess
+    import sys
+
+    from agents.controllers import aot
+    from agents.controllers.arena import as_action
     from swarm.arena.engine import ArenaEngine
     from swarm.arena.scenario import controller_params
 
-    s = load_scenario("zmaze")
+    aot.build()
+    s = load_scenario(ref).with_overrides(controller=controller, agents=1, max_ticks=1000)
+    engine = ArenaEngine(s)
+    brain, readings, actions = engine.controllers[0], [], []
+
+    def step(reading, inner=brain.step):
+        readings.append(reading)
+        actions.append(as_action(out := inner(reading)).tolist())
+        return out
+
+    brain.step = step
+    engine.step(40)
     given = tmp_path / "given.pkl"
-    given.write_bytes(pickle.dumps((controller_params(s, 0), ArenaEngine(s).world.perceive()[0])))
-    probe = ("import pickle, sys\nfrom agents.arena_runtime import ArenaAgentRuntime\n"
-             "from agents.controllers.arena import make_controller\n"
-             f"params, reading = pickle.loads(open({str(given)!r}, 'rb').read())\n"
-             "for name in ('carrot', 'wander'):\n"
-             "    brain = make_controller(name)\n"
-             "    brain.reset(0, 0, params)\n"
-             "    brain.step(reading)\n"
-             "print('numba' in sys.modules, 'scipy' in sys.modules)\n")  # fmt: skip
-    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
-    assert out.stdout.strip() == "False False", out.stderr[-2000:]  # an agent process of 49 MB, not 100+
+    given.write_bytes(pickle.dumps((controller, s.seed, controller_params(s, 0), readings)))
+    out = subprocess.run([sys.executable, "-c", AOT_CHILD, str(given)], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    got, numba_loaded = pickle.loads((tmp_path / "given.pkl.out").read_bytes())
+    assert got == actions and not numba_loaded

@@ -120,7 +120,7 @@ def test_the_checkpoint_is_a_scenario_key_with_a_range():
     from swarm.scenario import ScenarioError, parse_scenario_text
     from tests.arena_helpers import box
 
-    assert arena('[[group]]\ncount = 1\n').checkpoint == 50
+    assert arena("[[group]]\ncount = 1\n").checkpoint == 50
     with pytest.raises(ScenarioError) as err:
-        parse_scenario_text("checkpoint = 0\n" + box('[[group]]\ncount = 1\n'), "bad.toml")
+        parse_scenario_text("checkpoint = 0\n" + box("[[group]]\ncount = 1\n"), "bad.toml")
     assert err.value.where == "checkpoint"

@@ -14,11 +14,12 @@ from typing import Any
 
 import numpy as np
 
+from swarm.arena.models import ZONE_KINDS
 from swarm.arena.scenario import ArenaScenario
 from world_server.drive import DiffDrive
 from world_server.metabolism import ACTS, Metabolism
 from world_server.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
-from world_server.sensors import ZONE_KINDS, Suite
+from world_server.sensors import Suite
 
 ACTION_LEN = 2  # left and right wheel speeds, m/s
 ACTION_WIDTH = 3  # ... and a consummatory act (world_server.metabolism.ACTS), optional: 0 when left out

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from world_server.sensors import ZONE_KINDS
+from swarm.arena.models import ZONE_KINDS
 
 ACTS = ("none", "ReloadE", "ReloadEp")
 ACT_ZONE = {1: "digesting", 2: "ingesting"}  # the zone kind each act needs

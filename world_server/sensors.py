@@ -23,7 +23,6 @@ from world_server.raycast import MARK, SOLID
 S_SONAR_BEARING, S_SONAR_RANGE, S_IR, S_LASER, S_ODOMETRY, S_COMPASS, S_POSITION = range(1, 8)
 
 
-ZONE_KINDS = ("goal", "ingesting", "digesting", "dangerous", "start", "place")
 NOISE_LEVELS = ("none", "low", "high")
 POSITION_STD = {"none": 0.0, "low": 0.005, "high": 0.020}  # DFT paper, section 4
 MAP_NOISE = {"none": 0.005, "low": 0.05, "high": 1.0}  # DFT code: std per map cell (wall = 1)

@@ -1,12 +1,14 @@
 """Ahead-of-time build of the controllers' step, for agent processes.
 
 `import numba` alone costs an agent process 88 MB.  numba's pycc compiles
-the very same `dispatch.answer_rows` (and everything it calls), and the
-arena's A* (`navigation.astar`), into a plain extension module.  Agent processes import that module, which needs only
-numpy, instead of the JIT.  The module is named after the source digest and lives
-in the compile cache (swarm.jitcache), so an edited controller is rebuilt
-rather than run stale.  Building needs numba and a C compiler; when the build
-is missing, agent processes fall back to the JIT (same step, more memory).
+the very same `dispatch.answer_rows` (and everything it calls) and every
+kernel the arena controllers declare with `swarm.kernels.exported` (A*, the
+GPR loops, the alignments, the field steps) into a plain extension module.
+Agent processes import that module, which needs only numpy, instead of the JIT.
+The module is named after the source digest and lives in the compile cache
+(swarm.jitcache), so an edited controller is rebuilt rather than run stale.
+Building needs numba and a C compiler; when the build is missing, agent
+processes fall back to the JIT (same step, more memory).
 
     python -m agents.controllers.aot     # build now (swarm up does it by itself)
 """
@@ -22,6 +24,10 @@ from pathlib import Path
 
 from swarm.jitcache import cache_root, source_digest
 
+# Modules whose kernels agent processes call (swarm.kernels.exported).
+KERNEL_MODULES = ("swarm.rng", "agents.controllers.navigation.astar", "agents.controllers.bg.gpr",
+                  "agents.controllers.fingerprint.align", "agents.controllers.dft.fields")  # fmt: skip
+
 
 def signature():
     """dispatch.answer_rows: kind, a message's blocks (read-only), memories, slot table, action rows, params,
@@ -33,13 +39,6 @@ def signature():
 
     return t.int64(t.int64, message_block(t.int64), message_block(t.float64), t.int64[:, ::1], t.int64[::1],
                    t.int64[:, ::1], t.float64[::1], t.int64, t.int64, t.boolean)  # fmt: skip
-
-
-def astar_signature():
-    """navigation.astar._astar: free cells (C order), start and goal cells -> (cost, parents)."""
-    from numba import types as t
-
-    return t.Tuple((t.float64, t.int64[::1]))(t.boolean[:, ::1], t.int64, t.int64, t.int64, t.int64)
 
 
 def module_name() -> str:
@@ -61,7 +60,10 @@ def build() -> Path:
     from numba.pycc import CC
 
     from agents.controllers.dispatch import answer_rows
-    from agents.controllers.navigation.astar import astar_cells
+    from swarm import kernels
+
+    for module in KERNEL_MODULES:  # they declare their kernels on import
+        importlib.import_module(module)
 
     out = build_dir()
     out.mkdir(parents=True, exist_ok=True)
@@ -69,7 +71,8 @@ def build() -> Path:
         cc = CC(module_name())
         cc.output_dir = tmp
         cc.export("answer_rows", signature())(answer_rows.py_func)
-        cc.export("astar", astar_signature())(astar_cells)
+        for name, (kernel, sig) in sorted(kernels.EXPORTS.items()):
+            cc.export(name, sig)(kernel.py_func)
         cc.compile()
         (result,) = Path(tmp).glob(f"{module_name()}.*.so")
         final = out / result.name

@@ -21,6 +21,8 @@ DEG = math.pi / 180.0
 IR_DISTANCE = np.array([0.0, 0.005, 0.01, 0.015, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07])
 IR_VALUE = np.array([4095.0, 2133.0, 1465.0, 601.0, 383.0, 234.0, 158.0, 120.0, 104.0, 67.0])
 SENSOR_KINDS = ("camera", "sonar", "ir", "laser", "odometry", "compass", "position", "contact", "zones")
+# The `zones` reading is a bit field: bit k set when the robot is in a zone of kind ZONE_KINDS[k].
+ZONE_KINDS = ("goal", "ingesting", "digesting", "dangerous", "start", "place")
 
 
 @dataclass(frozen=True)

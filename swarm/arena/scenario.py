@@ -33,6 +33,7 @@ from agents.controllers.arena import ARENA_CONTROLLERS, REQUIRES, check_table
 from swarm.arena.models import (
     IR,
     MODELS,
+    ZONE_KINDS,
     Camera,
     Compass,
     Laser,
@@ -43,7 +44,7 @@ from swarm.arena.models import (
 )
 from swarm.scenario import ScenarioError, no_unknown, typed
 from world_server.metabolism import MetabolismParams
-from world_server.sensors import NOISE_LEVELS, ZONE_KINDS, Noise
+from world_server.sensors import NOISE_LEVELS, Noise
 
 START_STREAM = 0x53544152  # keeps start-pose draws apart from every other use of the seed
 GOAL_STREAM = 0x474F414C

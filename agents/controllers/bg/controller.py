@@ -25,7 +25,7 @@ from agents.controllers.bg.places import DIRECTIONS, Navigator, NavParams
 from agents.controllers.bg.saliences import SALIENCES, Drives, plan_vector, saliences
 from agents.controllers.bg.senses import RESOURCES, Reflex, proximity, resource_pixels
 from agents.controllers.tables import params_from_table
-from world_server.sensors import ZONE_KINDS
+from swarm.arena.models import ZONE_KINDS
 
 USABLE_ZONE = {"DA": "dangerous", "Ep": "ingesting", "E": "digesting"}
 DORSAL_ACTS = ("ReloadE", "ReloadEp")  # channel order; world_server.metabolism.ACTS codes 1, 2

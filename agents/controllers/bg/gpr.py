@@ -26,7 +26,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+
+from swarm.kernels import exported, njit
 
 # Nuclei, in the order of the state's rows.
 D1, D2, STN, GP, EP, VL, TRN, CTX = range(8)
@@ -57,6 +58,7 @@ def _out(a: float, eps: float, m: float) -> float:
     return 0.0 if y < 0.0 else (1.0 if y > 1.0 else y)
 
 
+@exported("bg_outputs", "void(float64[:, :], float64[:, :], float64[:], float64[:])")
 @njit(cache=True)
 def _outputs(a: np.ndarray, y: np.ndarray, eps: np.ndarray, slope: np.ndarray) -> None:
     for k in range(a.shape[0]):
@@ -95,6 +97,9 @@ def _inputs(y: np.ndarray, salience: np.ndarray, feedback: float, ctx_rest: np.n
         out[CTX, i] = y[VL, i]
 
 
+@exported("bg_run_loops", "void(float64[:, :], float64[:, :], float64[:], float64[:], float64, float64, "
+          "float64[:], float64[:], float64[:, :], float64[:, :], float64, int64, float64, float64, float64[:], "
+          "float64[:])")  # fmt: skip
 @njit(cache=True)
 def run_loops(a_d: np.ndarray, a_v: np.ndarray, s_d: np.ndarray, s_v: np.ndarray, fb_d: float, fb_v: float,
               rest_d: np.ndarray, rest_v: np.ndarray, lat_d: np.ndarray, lat_v: np.ndarray, cross: float, steps: int,

@@ -31,8 +31,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft as sfft
-from numba import njit
 
+from swarm import rng_scalar
+from swarm.kernels import exported, njit
 from swarm.rng import mix64
 
 DTYPE = np.float32
@@ -167,6 +168,7 @@ def normal_ih(key, k):
     return (np.float32(s) * _IH_SCALE - np.float32(2.0)) * np.float32(1.7320508075688772)
 
 
+@exported("dft_fill_noise", "void(uint64, float32[:])")
 @njit(cache=True)
 def fill_noise(key, out):
     """Field noise for every cell of `out` (flat float32), keyed by one 64-bit word."""
@@ -174,6 +176,7 @@ def fill_noise(key, out):
         out[k] = normal_ih(key, k)
 
 
+@exported("dft_noise_key", "uint64(int64, int64, int64, int64)")
 @njit(cache=True)
 def noise_key(seed, agent, tick, stream):
     h = mix64(np.uint64(seed) + _GOLDEN * np.uint64(agent + 1))
@@ -181,6 +184,7 @@ def noise_key(seed, agent, tick, stream):
     return mix64(h ^ (np.uint64(stream) * np.uint64(0xA24BAED4963EE407)))
 
 
+@exported("dft_euler", "void(float32[:, :], float32[:, :], float32[:], float32[:], float32[:], uint64)")
 @njit(cache=True)
 def _euler(u, inp, taus, hs, amps, key):
     """u[k] += (-u + h + input + amp * xi) / tau for every field k of a stack (F, n)."""
@@ -197,6 +201,8 @@ def _euler(u, inp, taus, hs, amps, key):
                 uk[c] += (h - uk[c] + ik[c]) * inv
 
 
+@exported("dft_mac", "void(complex64[:, :], complex64[:, :], complex64[:, :], int64[:], boolean[:], int64[:], "
+          "complex64[:, :])")  # fmt: skip
 @njit(cache=True)
 def _mac(acc, dyn, ext, src, is_ext, tgt, transfer):
     """acc[t] = sum over pairs p of transfer[p] * spectrum of source p (dynamic or input)."""
@@ -344,7 +350,7 @@ class Engine:
                 times[f"couplings {grp.label}"] = times.get(f"couplings {grp.label}", 0.0) + t1 - t0
                 t0 = t1
         for g, grp in enumerate(self.groups):
-            grp.update(np.uint64(mix64(np.uint64(key) ^ np.uint64(g + 1))))
+            grp.update(np.uint64(rng_scalar.mix64(int(key) ^ (g + 1))))  # swarm.rng's mix64, bit for bit
             if clock:
                 t1 = clock()
                 times[f"fields {grp.label}"] = times.get(f"fields {grp.label}", 0.0) + t1 - t0

@@ -29,9 +29,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from agents.controllers.tables import params_from_table
+from swarm.kernels import exported, njit
 
 HUES = 16  # symbols 0..15: hue bins 'A'..'P'
 V, C, N = 16, 17, 18  # vertical edge, laser corner; N + k - 1: a run of k empty-space quanta
@@ -126,6 +126,7 @@ def _global(a, b, sub, gap):  # pragma: no cover - compiled
     return row[m]
 
 
+@exported("fp_cyclic_cost_exact", "int64(int8[:], int8[:], int64[:, :], int64[:])")
 @njit(cache=True)
 def cyclic_cost_exact(a, b, sub, gap):  # pragma: no cover - compiled
     """min over rotations r of the global alignment of a with b rotated by r."""
@@ -184,6 +185,7 @@ def _cyclic(qsub, qgap, b, gap):  # pragma: no cover - compiled
     return best
 
 
+@exported("fp_cyclic_cost", "int64(int8[:], int8[:], int64[:, :], int64[:])")
 @njit(cache=True)
 def cyclic_cost(a, b, sub, gap):  # pragma: no cover - compiled
     """One pass over b written twice (see the module's docstring).  A cell holds
@@ -199,6 +201,7 @@ def cyclic_cost(a, b, sub, gap):  # pragma: no cover - compiled
     return _cyclic(qsub, qgap, b, gap)
 
 
+@exported("fp_localize_costs", "int64[:](int8[:], int8[:], int64[:], int64[:, :], int64[:])")
 @njit(cache=True)
 def localize_costs(a, codes, offsets, sub, gap):  # pragma: no cover - compiled
     """cyclic_cost of `a` against every node k: codes[offsets[k]:offsets[k+1]]."""

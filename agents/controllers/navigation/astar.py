@@ -7,9 +7,8 @@ Ours is exact A* (octile heuristic, consistent, cells may be re-opened), where
 the original code stopped at the first chain that reached the start; our L_o is
 therefore never longer than theirs (docs/arena.md).
 
-The search is compiled: by the agents' ahead-of-time module when it is built
-(agent processes then run without numba: agents/controllers/aot.py), else by
-the JIT.  Both compile this one function.
+The search is a compiled kernel (swarm.kernels): the JIT's in process, the
+agents' ahead-of-time build in agent processes, which then run without numba.
 """
 
 from __future__ import annotations
@@ -18,8 +17,9 @@ import math
 
 import numpy as np
 
+from swarm.kernels import exported, njit
+
 SQRT2 = math.sqrt(2.0)
-_kernel = None
 
 
 def occupancy(size: tuple[float, float], cell: float, rects: np.ndarray, segments: np.ndarray) -> np.ndarray:
@@ -56,20 +56,8 @@ def wall_distance(occ: np.ndarray, up_to: float) -> np.ndarray:
     return dist
 
 
-def _search():
-    """The compiled A*: the ahead-of-time build's when there is one, else the JIT's."""
-    global _kernel
-    if _kernel is None:
-        from agents.controllers import aot
-
-        _kernel = aot.load("astar")
-        if _kernel is None:
-            from numba import njit
-
-            _kernel = njit(cache=True)(astar_cells)
-    return _kernel
-
-
+@exported("astar", "Tuple((float64, int64[::1]))(boolean[:, :], int64, int64, int64, int64)")
+@njit(cache=True)
 def astar_cells(free, si, sj, gi, gj):
     ny, nx = free.shape
     inf = np.inf
@@ -171,7 +159,7 @@ class Planner:
         free = self._free(a, b)
         if not (free[a[1], a[0]] and free[b[1], b[0]]):
             return math.inf, np.zeros((0, 2))
-        cost, parent = _search()(np.ascontiguousarray(free), a[0], a[1], b[0], b[1])
+        cost, parent = astar_cells(free, a[0], a[1], b[0], b[1])
         if not math.isfinite(cost):
             return math.inf, np.zeros((0, 2))
         nx = self.occ.shape[1]
