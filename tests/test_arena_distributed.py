@@ -74,6 +74,8 @@ def test_bad_arena_traffic_is_counted_and_never_acted_on():
             s.put(keys.act("intruder"), proto.pack({"type": "act", "family": "arena", "tick": 0, "agents": [0],
                                                     "wheels": b"short"}))  # fmt: skip
             s.put(keys.act("intruder"), proto.actions(0, [0], np.zeros((1, 8), np.int64), [False]))  # grid family
+            s.put(keys.act("intruder"), arena_proto.actions(0, [0], np.array([[0.1, 0.1]]), memory=[(0, b"x")]))
+            s.put(keys.act("intruder"), arena_proto.actions(0, [0], np.array([[0.1, 0.1]]), memory=[(5, b"x")]))
             s.put(keys.plan("intruder"), arena_proto.plan_message(0, 0, np.zeros((3, 2))))  # another's plan
             s.put(keys.plan("intruder"), b"\x01plan?")
         finally:
@@ -87,6 +89,8 @@ def test_bad_arena_traffic_is_counted_and_never_acted_on():
     assert any("another process" in r or "unknown agent" in r for r in reasons)  # before or after it joined
     assert any("unknown controller family" in r for r in reasons)
     assert reasons.get("plan: names an agent of another process") == 1 and reasons.get("plan: not msgpack") == 1
+    assert reasons.get("memory: not with an accepted action before a save") == 1  # another's memory: never stored
+    assert reasons.get("act: memory: names an agent the message does not act for") == 1
 
 
 def test_nan_and_huge_wheel_speeds_from_an_agent_are_refused():
