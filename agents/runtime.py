@@ -30,15 +30,17 @@ class JoinRefused(RunError):
 
 
 def load_step():
-    """The ahead-of-time build of `dispatch.answer_rows` when it exists (no numba
-    in this process), else the JIT's (compiled or loaded from the cache now)."""
-    step = aot.load()
-    if step is None:
-        from agents.controllers.dispatch import answer_rows, warm_up
+    """(`envelope.answer_message`, `dispatch.answer_rows`): the ahead-of-time build's
+    when it exists (no numba in this process), else the JIT's (compiled or loaded
+    from the cache now)."""
+    built = aot.load("answer_message"), aot.load("answer_rows")
+    if None not in built:
+        return built
+    from agents.controllers.dispatch import answer_rows, warm_up
+    from agents.controllers.envelope import answer_message
 
-        warm_up()
-        step = answer_rows
-    return step
+    warm_up()
+    return answer_message, answer_rows
 
 
 class AgentRuntime:
@@ -83,6 +85,11 @@ class AgentRuntime:
     def _answer(self, obs) -> int:
         raise NotImplementedError
 
+    def _answer_raw(self, raw: bytes) -> int | None:
+        """Answer a plain observation straight from its bytes (agents answered),
+        or None: the message goes through `_parse` (families without a fast path)."""
+        return None
+
     def _restore(self, memory) -> None:
         """A resumed world hands back the controllers' memory of its saved tick."""
 
@@ -119,9 +126,15 @@ class AgentRuntime:
             batch = [self.inbox.recv()]
             while (more := self.inbox.try_recv()) is not None:  # behind (real time): answer only the newest
                 batch.append(more)
-            latest = None
-            for sample in batch:
-                msg = self._parse(sample.payload.to_bytes())
+            latest, last = None, len(batch) - 1
+            for i, sample in enumerate(batch):
+                raw = sample.payload.to_bytes()
+                if i == last and (fast := self._answer_raw(raw)) is not None:  # a plain observation, answered
+                    self._heard = time.monotonic()
+                    answered += fast
+                    latest = None  # older observations of the batch are superseded
+                    break
+                msg = self._parse(raw)
                 if isinstance(msg, dict):
                     if msg.get("type") == "stop":
                         return answered
@@ -188,9 +201,11 @@ class GridAgentRuntime(AgentRuntime):
 
     def _prepare(self, count: int) -> None:
         self.kind = controller_kind(self.controller)
-        self.answer_rows = load_step()
+        self.answer_message, self.answer_rows = load_step()
         self.mem = new_memory(count)
-        self.rows = np.zeros((count, proto.ACT_ROW), dtype=np.int64)  # the action message, reused
+        self.rows = np.zeros((count, proto.ACT_ROW), dtype=np.int64)  # the action rows, reused
+        self.out = np.zeros(proto.ENVELOPE + count * proto.ACT_ROW * 8, dtype=np.uint8)  # the action message's bytes
+        self.info = np.zeros(3, dtype=np.int64)  # rows, any mark write, tick
         self.slot_table = np.full(0, -1, dtype=np.int64)  # agent id -> its slot (memory row), -1: not ours
         self.seed = np.int64(0)
         self.params = np.zeros(1)
@@ -208,14 +223,30 @@ class GridAgentRuntime(AgentRuntime):
     def _parse(self, data: bytes):
         return proto.obs_blocks(data)
 
+    def _answer_raw(self, raw: bytes) -> int | None:
+        """Step every agent of ours in the observation and send the action
+        message, envelope and all from one compiled call (`envelope`); a mark
+        write that lowers a mark also goes out on the marks key space."""
+        size = self.answer_message(self.kind, np.frombuffer(raw, np.uint8), self.mem, self.slot_table, self.rows,
+                                   self.params, self.seed, self.null, self.out, self.info)  # fmt: skip
+        if size == proto.NOT_PLAIN:
+            return None
+        if size < 0:
+            return 0  # a malformed observation: not answered (the world counts the miss)
+        n, marked, _ = self.info.tolist()
+        if marked:
+            self._send_marks(proto.obs_blocks(raw), self.rows[:n])
+        self.act_publisher.put(self.out[:size].tobytes())
+        return n
+
     def _restore(self, memory: proto.Memory) -> None:
         for agent, *words in memory.rows.tolist():
             if (slot := self.slot_of.get(agent)) is not None:
                 self.mem[slot] = words
 
     def _answer(self, obs: proto.ObsBlocks) -> int:
-        """Step every agent of ours in the batch; one action message, and one
-        mark message when a write lowers a mark."""
+        """An observation in another layout than our world's (its keys in another
+        order, say): the same step through the parsed blocks."""
         n = self.answer_rows(self.kind, np.frombuffer(obs.ints, "<i8"), np.frombuffer(obs.pf, "<f8"), self.mem,
                              self.slot_table, self.rows, self.params, self.seed, obs.tick, self.null)  # fmt: skip
         if n < 0:

@@ -104,3 +104,50 @@ def test_the_batch_answer_equals_the_engine_step_agent_by_agent():
     assert answer_rows(kind, ints_ro, pf_ro, mems, slot_of, out, params, seed, 13, True) == 4
     assert (out[:4, proto.R_ACT + A_MOVE] == 4).all()
     np.testing.assert_array_equal(mems, before)
+
+
+def _answer(message: bytes, kind, params, count=5):
+    from agents.controllers.envelope import answer_message
+
+    mems, rows = new_memory(count), np.zeros((count, proto.ACT_ROW), np.int64)
+    out, info = np.zeros(proto.ENVELOPE + count * proto.ACT_ROW * 8, np.uint8), np.zeros(3, np.int64)
+    size = answer_message(kind, np.frombuffer(message, np.uint8), mems, np.arange(count, dtype=np.int64), rows,
+                          params, np.int64(9), False, out, info)  # fmt: skip
+    return size, out[: max(size, 0)].tobytes(), rows, mems, info
+
+
+def test_the_compiled_envelope_writes_the_action_message_byte_for_byte():
+    """The agent's one-call answer (agents/controllers/envelope.py) equals parse, step and pack_actions."""
+    scenario, w = _world(agents=5, seed=9)
+    kind, params = controller_kind(scenario.controller), controller_params(scenario)
+    ints, pf = np.zeros((5, proto.OBS_INTS), np.int64), np.zeros((5, 5))
+    observe_rows(w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked,
+                 np.arange(5, dtype=np.int64), ints, pf, False)  # fmt: skip
+    for tick in (0, 127, 128, 300, 70_000, 2**33):  # every msgpack width of the tick
+        message = proto.observations(tick, ints, pf)
+        size, written, _, mems, info = _answer(message, kind, params)
+        blocks = proto.obs_blocks(message)
+        ref_mems, ref_rows = new_memory(5), np.zeros((5, proto.ACT_ROW), np.int64)
+        n = answer_rows(kind, np.frombuffer(blocks.ints, "<i8"), np.frombuffer(blocks.pf, "<f8"), ref_mems,
+                        np.arange(5, dtype=np.int64), ref_rows, params, np.int64(9), tick, False)  # fmt: skip
+        assert written == proto.pack_actions(tick, ref_rows[:n]) and size == len(written)
+        assert info.tolist() == [n, int(ref_rows[:n, proto.R_MARKED].any()), tick]
+        np.testing.assert_array_equal(mems, ref_mems)
+
+
+def test_the_compiled_envelope_leaves_every_other_message_to_the_parser():
+    scenario, _ = _world(agents=5, seed=9)
+    kind, params = controller_kind(scenario.controller), controller_params(scenario)
+    good = proto.observations(4, np.zeros((5, proto.OBS_INTS), np.int64), np.zeros((5, 5)))
+    others = [proto.stop_message("done"), proto.pack({"type": "wake"}), proto.memory_message(np.zeros(1, np.int64),
+              new_memory(1)), b"", b"\x85", proto.pack({"type": "obs", "ints": b"", "pf": b"", "tick": 4})]  # fmt: skip
+    others += [good[:k] for k in range(0, len(good), 7)]  # every truncation: never a read past the end
+    others += [good + b"\x00"]
+    for message in others:
+        assert _answer(message, kind, params)[0] == proto.NOT_PLAIN, message[:40]
+    lying = bytearray(good)
+    lying[lying.index(b"ints") + 5] = 0xFF  # a bin length past the end
+    assert _answer(bytes(lying), kind, params)[0] == proto.NOT_PLAIN
+    nan = proto.observations(4, np.zeros((5, proto.OBS_INTS), np.int64), np.full((5, 5), np.nan))
+    size, _, _, mems, _ = _answer(nan, kind, params)
+    assert size == -1 and (mems == new_memory(5)).all()  # a plain observation that is malformed: nobody stepped

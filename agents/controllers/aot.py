@@ -41,6 +41,15 @@ def signature():
                    t.int64[:, ::1], t.float64[::1], t.int64, t.int64, t.boolean)  # fmt: skip
 
 
+def envelope_signature():
+    """envelope.answer_message: kind, the message's bytes (read-only), memories, slot table, action rows, params,
+    seed, null, the action message's bytes, info."""
+    from numba import types as t
+
+    return t.int64(t.int64, t.Array(t.uint8, 1, "C", readonly=True), t.int64[:, ::1], t.int64[::1],
+                   t.int64[:, ::1], t.float64[::1], t.int64, t.boolean, t.uint8[::1], t.int64[::1])  # fmt: skip
+
+
 def module_name() -> str:
     return f"swarm_steps_{source_digest()}"
 
@@ -60,6 +69,7 @@ def build() -> Path:
     from numba.pycc import CC
 
     from agents.controllers.dispatch import answer_rows
+    from agents.controllers.envelope import answer_message
     from swarm import kernels
 
     for module in KERNEL_MODULES:  # they declare their kernels on import
@@ -71,6 +81,7 @@ def build() -> Path:
         cc = CC(module_name())
         cc.output_dir = tmp
         cc.export("answer_rows", signature())(answer_rows.py_func)
+        cc.export("answer_message", envelope_signature())(answer_message.py_func)
         for name, (kernel, sig) in sorted(kernels.EXPORTS.items()):
             cc.export(name, sig)(kernel.py_func)
         cc.compile()
