@@ -230,8 +230,10 @@ def test_kill_9_the_arena_world_then_a_restart_ends_exactly_as_swarm_run(ref, ag
     import sys
     import time
 
+    from agents.controllers.arena import ShareLog
     from swarm.scenario import BUNDLED_DIR
     from world_server import persist
+    from world_server.history import SharedHistory
 
     text = (BUNDLED_DIR / f"{ref}.toml").read_text()
     (scenario_file := tmp_path / f"{ref}.toml").write_text(re.sub(r"(?m)^max_ticks = .*$", f"max_ticks = {max_ticks}",
@@ -277,6 +279,11 @@ def test_kill_9_the_arena_world_then_a_restart_ends_exactly_as_swarm_run(ref, ag
         assert summary["agents_lost"] == 0  # killed agents: newcomers took their places where they were saved
         final, _ = persist.load_arrays(state)
         np.testing.assert_array_equal(final["pose"], engine.world.pose)
+        history = SharedHistory(tmp_path / "aresume.arena.shared.msgpack")
+        replayed = ShareLog()  # every publication of the run on disk, once each, in order, across the restart
+        for tick, share, agent, payload in history._read(keep_before=2**62):
+            replayed.add(tick, [(agent, share, payload)])
+        assert [replayed.of(r["agent"]) for r in expected["robots"]] == [r.get("shared") for r in expected["robots"]]
     finally:
         stop(procs)
 

@@ -124,3 +124,24 @@ def test_the_checkpoint_is_a_scenario_key_with_a_range():
     with pytest.raises(ScenarioError) as err:
         parse_scenario_text("checkpoint = 0\n" + box("[[group]]\ncount = 1\n"), "bad.toml")
     assert err.value.where == "checkpoint"
+
+
+def test_the_publication_history_keeps_what_came_before_the_save_and_survives_a_cut_record(tmp_path):
+    from world_server.history import SharedHistory
+
+    path = tmp_path / "run.arena.shared.msgpack"
+    h = SharedHistory(path)
+    h.open(keep_before=None)
+    for tick in range(6):
+        h.add(tick, "map", tick % 2, bytes([tick]))
+    h.close()
+    path.write_bytes(path.read_bytes() + msgpack.packb([6, "map", 0, b"cut short"])[:-4])  # a kill mid-write
+    resumed = SharedHistory(path)
+    resumed.open(keep_before=4)  # saved at tick 5: ticks 4 on are published again
+    assert resumed.of("map") == [(0, [b"\x00", b"\x02"]), (1, [b"\x01", b"\x03"])] and resumed.of("context") == []
+    resumed.add(4, "map", 0, b"\x04")
+    resumed.close()
+    again = SharedHistory(path)
+    again.open(keep_before=100)
+    assert again.of("map")[0] == (0, [b"\x00", b"\x02", b"\x04"])
+    again.close()

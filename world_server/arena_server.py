@@ -24,6 +24,7 @@ from swarm.arena.engine import arena_summary
 from swarm.arena.scenario import controller_params
 from world_server import persist
 from world_server.arena import ArenaWorld
+from world_server.history import SharedHistory
 from world_server.server import ACTIVE, FREE, JOINING, LOST, WorldServer
 
 
@@ -40,10 +41,11 @@ class ArenaServer(WorldServer):
         self.readings: list[dict[str, np.ndarray]] = []
         self.pending_shared: dict[int, tuple[str, bytes]] = {}  # this tick's publications, by agent
         self.shared_out: list[tuple[int, str, bytes]] = []  # last tick's, going out with this tick's observations
-        self.shared_history: dict[tuple[str, int], list[bytes]] = {}  # every publication, for `get <share>/**`
         self.shares = ShareLog()
         self.memory: list[bytes | None] = [None] * self.world.n  # each controller's memory at the last save
         self.state_file = Path(self.state_dir) / f"{self.keys.run}.arena.npz" if self.state_dir else None
+        # every publication, for `get <share>/**`, kept across a restart
+        self.shared_history = SharedHistory(self.state_file.with_suffix(".shared.msgpack") if self.state_file else None)
         if self.persist_every:  # saves fall on physics checkpoints, the ticks a resumed run is exact from
             self.persist_every = math.lcm(self.persist_every, s.checkpoint)
 
@@ -68,6 +70,7 @@ class ArenaServer(WorldServer):
         pending = zip(arrays["pending_agents"].tolist(), arrays["pending_shares"].tolist(), payloads, strict=True)
         self.pending_shared = {a: (s, p) for a, s, p in pending}
         self.shares.restore(meta["shares"])
+        self.shared_history.open(keep_before=self.tick - 1)  # the last tick's publications go out again
         self.stats.joins = int(meta["stats"]["joins"])
         self.stats.agents_lost = int(meta["stats"]["agents_lost"])
         self.stats.rejected = dict(meta["stats"]["rejected"])
@@ -90,6 +93,7 @@ class ArenaServer(WorldServer):
                   "pending_shares": np.array([s for _, (s, _) in pending], dtype=np.str_).reshape(-1),
                   "pending": payloads, "pending_at": payloads_at}  # fmt: skip
         meta = {"scenario": self.scenario.describe(), "stats": stats, "shares": self.shares.state()}
+        self.shared_history.flush()
         persist.save_arrays(self.state_file, arrays, meta)
 
     def _declare_shared(self, put) -> list:
@@ -153,6 +157,7 @@ class ArenaServer(WorldServer):
         """The robots that start the run come in together, in id order: the
         same draws as the in-process engine when every agent starts it."""
         self.world.enter(np.flatnonzero(self.slots == ACTIVE))
+        self.shared_history.open(keep_before=None)  # a fresh run (a resumed one opened it already)
 
     def _reuse(self, agent: int) -> None:
         self.world.present[agent] = True
@@ -176,6 +181,7 @@ class ArenaServer(WorldServer):
 
     def _finish(self) -> None:
         self._pass_on_shared()  # the last tick's publications go on their keys too: nothing written is lost
+        self.shared_history.flush()
 
     def _observe(self, tick: int, agents: np.ndarray) -> bytes:
         readings = [{} for _ in agents] if self.null else [self.readings[a] for a in agents]
@@ -224,7 +230,7 @@ class ArenaServer(WorldServer):
         if self.shared_out:
             self.shares.add(self.tick - 1, self.shared_out)
         for a, share, payload in self.shared_out:
-            self.shared_history.setdefault((share, a), []).append(payload)
+            self.shared_history.add(self.tick - 1, share, a, payload)
             self.session.put(f"{self.keys.prefix}/{share}/{a}", payload)
             if self.recorder is not None and share == "map":
                 data = proto.unpack(payload, len(payload) + 1)
@@ -234,14 +240,17 @@ class ArenaServer(WorldServer):
     def _on_shared_query(self, share: str, query) -> None:
         """Every publication of every agent in the key space, one reply per agent."""
         try:
-            for (s, a), history in sorted(self.shared_history.items()):
-                if s == share:
-                    query.reply(f"{self.keys.prefix}/{share}/{a}", proto.pack({"agent": a, "updates": history}))
+            for a, history in self.shared_history.of(share):
+                query.reply(f"{self.keys.prefix}/{share}/{a}", proto.pack({"agent": a, "updates": history}))
         finally:
             query.drop()
 
     def _resolve(self, tick: int) -> None:
         self.world.apply(self.wheels, self.ok)
+
+    def close(self) -> None:
+        self.shared_history.close()
+        super().close()
 
     def done(self) -> bool:
         return self.world.done()
