@@ -58,3 +58,15 @@ def resumed_pair(scenario, ticks: int):
     a.step(ticks)
     b.step(ticks)
     return a, b
+
+
+class MapSharer:
+    """A robot of the `map` share whose maps `target` (a SharedMap, a ColonyMap) receives: for `deliver`."""
+
+    shares = "map"
+
+    def __init__(self, target):
+        self.target = target
+
+    def receive(self, sender, data):
+        self.target.receive(sender, data)

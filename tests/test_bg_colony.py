@@ -14,7 +14,7 @@ from agents.controllers.bg.senses import RESOURCES
 from swarm.arena.bg_colony import colony_scenario
 from swarm.arena.engine import ArenaEngine
 from swarm.protocol import pack
-from tests.arena_helpers import resumed_pair
+from tests.arena_helpers import MapSharer, resumed_pair
 
 
 def _place(k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -79,16 +79,7 @@ def test_malformed_holds_are_refused_and_nothing_of_them_is_merged(holds):
     data["holds"] = holds
     nodes = len(a.map.nodes)
 
-    class Animat:
-        shares = "map"
-
-        def __init__(self, colony):
-            self.colony = colony
-
-        def receive(self, sender, data):
-            self.colony.receive(sender, data)
-
-    assert deliver([Animat(ca), Animat(cb)], [0, 1], [(1, "map", pack(data))]) == 1
+    assert deliver([MapSharer(ca), MapSharer(cb)], [0, 1], [(1, "map", pack(data))]) == 1
     assert len(a.map.nodes) == nodes and ca.shared.added == 0
 
 

@@ -405,17 +405,9 @@ def test_a_malformed_map_from_another_robot_is_refused_and_merges_nothing():
     assert a.map.nodes == []
     from agents.controllers.arena import deliver
     from swarm.protocol import pack
+    from tests.arena_helpers import MapSharer
 
-    class Robot:
-        shares = "map"
-
-        def __init__(self, shared):
-            self.shared = shared
-
-        def receive(self, sender, data):
-            self.shared.receive(sender, data)
-
-    robots = [Robot(a), Robot(b)]
+    robots = [MapSharer(a), MapSharer(b)]
     refused = deliver(
         robots, [0, 1], [(1, "map", b"\xc1garbage"), (1, "map", pack({"nodes": 1})), (1, "map", pack(good))]
     )

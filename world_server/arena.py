@@ -265,7 +265,7 @@ class ArenaWorld:
         self._track_goals()
         if self.tick % self.scenario.checkpoint == 0:  # the physics restarts from its saved state, in every runtime
             self.checkpointed = self.snapshot()
-            self.restore(self.checkpointed)
+            self._rebuild_bodies(self.checkpointed)
 
     def _limit(self, wheels: np.ndarray) -> np.ndarray:
         """The model's forward-speed and turn-rate limits scale the wheel speeds down."""
@@ -360,24 +360,26 @@ class ArenaWorld:
     def restore(self, state: dict[str, np.ndarray]) -> None:
         for k in self.STATE:
             getattr(self, k)[...] = state[k]
-        for k in self.BODY_STATE:
-            getattr(self.bodies, k)[...] = state[f"body_{k}"]
         self.tick = int(state["tick"])
         self.optimum = [None if np.isnan(v) else float(v) for v in state["optimum"]]
         self.rejected = dict.fromkeys(REJECT_REASONS, 0)
         self.rejected.update({k: int(v) for k, v in zip(REJECT_REASONS, state["rejected"], strict=False)})
         if self.metabolism is not None:
             self.metabolism.restore(state)
-        counters = {k: getattr(self.bodies, k) for k in self.BODY_STATE}
-        self.bodies = self._new_bodies(state["pose"])  # a fresh space: the same one in every runtime
-        for k, v in counters.items():
-            setattr(self.bodies, k, v)
+        self._rebuild_bodies(state)
+        self._update_zones()
+
+    def _rebuild_bodies(self, state: dict[str, np.ndarray]) -> None:
+        """A fresh physics space from a snapshot (the same one in every runtime): bodies,
+        their velocities and counters, the obstacles present now, the cached contacts."""
+        self.bodies = self._new_bodies(state["pose"])
+        for k in self.BODY_STATE:
+            getattr(self.bodies, k)[...] = state[f"body_{k}"]
         self.bodies.sim_seconds = float(state["sim_seconds"])
         self.bodies.set_velocities(state["velocity"])
         self._obstacles_at(self.tick)
         if "contacts_f" in state:
             self.bodies.take_contacts(state)
-        self._update_zones()
 
     def remove_agent(self, agent: int) -> None:
         """The agent is gone: its body stops where it is and stays an obstacle."""

@@ -27,48 +27,52 @@ _PF_KEY = np.frombuffer(b"pf", np.uint8).copy()
 _ROWS_KEY = np.frombuffer(b"\xa4rows", np.uint8).copy()
 
 
-@njit(cache=True, inline="always")
-def _uint(buf, at, size):
-    """Big-endian unsigned integer of `size` bytes at `at` (the caller checked the bounds)."""
+@njit(cache=True)
+def _tagged(buf, at, first_tag, widths):
+    """(value, next offset) of a tag byte in first_tag .. first_tag + widths - 1 at `at`,
+    followed by a big-endian unsigned value of 1, 2, 4 or 8 bytes (msgpack's uint and
+    bin headers), or (-1, -1) when the tag is another or the bytes run out."""
+    n = len(buf)
+    if at >= n or not first_tag <= buf[at] < first_tag + widths:
+        return -1, -1
+    size = 1 << (buf[at] - first_tag)
+    if at + 1 + size > n:
+        return -1, -1
     v = np.uint64(0)
     for k in range(size):
-        v = (v << np.uint64(8)) | np.uint64(buf[at + k])
-    return v
-
-
-@njit(cache=True)
-def _read_int(buf, at):
-    """(value, next offset) of a non-negative msgpack integer at `at`, or (-1, -1)."""
-    n = len(buf)
-    if at >= n:
-        return -1, -1
-    b = buf[at]
-    if b <= 0x7F:
-        return np.int64(b), at + 1
-    size = 1 if b == 0xCC else (2 if b == 0xCD else (4 if b == 0xCE else (8 if b == 0xCF else 0)))
-    if size == 0 or at + 1 + size > n:
-        return -1, -1
-    v = _uint(buf, at + 1, size)
+        v = (v << np.uint64(8)) | np.uint64(buf[at + 1 + k])
     if v > np.uint64(2**62):
         return -1, -1
     return np.int64(v), at + 1 + size
 
 
 @njit(cache=True)
+def _read_int(buf, at):
+    """(value, next offset) of a non-negative msgpack integer at `at`, or (-1, -1)."""
+    if at < len(buf) and buf[at] <= 0x7F:
+        return np.int64(buf[at]), at + 1
+    return _tagged(buf, at, 0xCC, 4)  # uint 8, 16, 32, 64
+
+
+@njit(cache=True)
 def _read_bin(buf, at):
     """(start, length) of a msgpack bin at `at`, or (-1, -1)."""
-    n = len(buf)
-    if at >= n:
-        return -1, -1
-    b = buf[at]
-    size = 1 if b == 0xC4 else (2 if b == 0xC5 else (4 if b == 0xC6 else 0))
-    if size == 0 or at + 1 + size > n:
-        return -1, -1
-    length = np.int64(_uint(buf, at + 1, size))
-    start = at + 1 + size
-    if start + length > n:
+    length, start = _tagged(buf, at, 0xC4, 3)  # bin 8, 16, 32
+    if start < 0 or start + length > len(buf):
         return -1, -1
     return start, length
+
+
+@njit(cache=True)
+def _words(buf, at, count):
+    """`count` little-endian 64-bit words from `at`, at any alignment."""
+    out = np.empty(count, np.uint64)
+    for j in range(count):
+        v = np.uint64(0)
+        for k in range(8):
+            v |= np.uint64(buf[at + 8 * j + k]) << np.uint64(8 * k)
+        out[j] = v
+    return out
 
 
 @njit(cache=True)
@@ -84,20 +88,13 @@ def _key(buf, at, key):
 
 
 @njit(cache=True)
-def _write_uint(out, at, v):
-    """msgpack's shortest form of non-negative `v` at `at`; returns the next offset."""
-    if v <= 0x7F:
-        out[at] = v
-        return at + 1
-    if v <= 0xFF:
-        size, tag = 1, 0xCC
-    elif v <= 0xFFFF:
-        size, tag = 2, 0xCD
-    elif v <= 0xFFFFFFFF:
-        size, tag = 4, 0xCE
-    else:
-        size, tag = 8, 0xCF
-    out[at] = tag
+def _write_tagged(out, at, v, first_tag, widths):
+    """`v` after the tag of its narrowest width (1, 2, 4, then 8 bytes, big-endian); returns the next offset."""
+    w = 0
+    while w < widths - 1 and v >= 1 << (8 << w):
+        w += 1
+    size = 1 << w
+    out[at] = first_tag + w
     for k in range(size):
         out[at + size - k] = (v >> (8 * k)) & 0xFF
     return at + 1 + size
@@ -133,19 +130,9 @@ def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info
         return NOT_PLAIN
     if ints_len % 8 or pf_len % 8:
         return -1
-    ints = np.empty(ints_len // 8, np.int64)
-    for j in range(len(ints)):  # little-endian words at any alignment
-        v = np.uint64(0)
-        for k in range(8):
-            v |= np.uint64(buf[ints_at + 8 * j + k]) << np.uint64(8 * k)
-        ints[j] = np.int64(v)
-    pf_bits = np.empty(pf_len // 8, np.uint64)
-    for j in range(len(pf_bits)):
-        v = np.uint64(0)
-        for k in range(8):
-            v |= np.uint64(buf[pf_at + 8 * j + k]) << np.uint64(8 * k)
-        pf_bits[j] = v
-    got = answer_rows(kind, ints, pf_bits.view(np.float64), mems, slot_of, rows, params, seed, tick, null)
+    ints = _words(buf, ints_at, ints_len // 8).view(np.int64)
+    pf = _words(buf, pf_at, pf_len // 8).view(np.float64)
+    got = answer_rows(kind, ints, pf, mems, slot_of, rows, params, seed, tick, null)
     if got < 0:
         return -1
     marked = 0
@@ -159,21 +146,15 @@ def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info
     for k in range(len(act_header)):
         out[at] = act_header[k]
         at += 1
-    at = _write_uint(out, at, tick)
+    if tick <= 0x7F:  # positive fixint
+        out[at] = tick
+        at += 1
+    else:
+        at = _write_tagged(out, at, tick, 0xCC, 4)  # uint 8, 16, 32, 64
     for k in range(len(rows_key)):
         out[at] = rows_key[k]
         at += 1
-    if size <= 0xFF:
-        out[at], out[at + 1] = 0xC4, size
-        at += 2
-    elif size <= 0xFFFF:
-        out[at], out[at + 1], out[at + 2] = 0xC5, size >> 8, size & 0xFF
-        at += 3
-    else:
-        out[at] = 0xC6
-        for k in range(4):
-            out[at + 4 - k] = (size >> (8 * k)) & 0xFF
-        at += 5
+    at = _write_tagged(out, at, size, 0xC4, 3)  # bin 8, 16, 32
     for i in range(got):
         for c in range(ACT_ROW):
             v = np.uint64(rows[i, c])
