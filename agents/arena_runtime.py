@@ -15,7 +15,7 @@ import numpy as np
 
 from agents.controllers.arena import as_action, deliver, make_controller, publications
 from agents.runtime import AgentRuntime
-from swarm import kernels, memory_codec
+from swarm import heap, kernels, memory_codec
 from swarm import protocol as proto
 from swarm import protocol_arena as arena_proto
 
@@ -36,6 +36,7 @@ class ArenaAgentRuntime(AgentRuntime):
         self.brains[slot] = brain
         if isinstance(msg.get("memory"), bytes):  # a missing agent's place, taken over where it was saved
             self.refused_memory += not give_back(brain, msg["memory"])
+        heap.give_back()  # what building the controller used and freed (a DFT robot's kernels: ~5 MB)
 
     def _restore(self, msg: arena_proto.ArenaMemory) -> None:
         for agent, blob in msg.memory:
@@ -57,9 +58,15 @@ class ArenaAgentRuntime(AgentRuntime):
             agents.append(agent)
             wheels.append(np.zeros(3) if self.null else as_action(self.brains[slot].step(reading)))
         shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
-        memory = [(a, memory_codec.encode(b.snapshot())) for a, b in mine] if obs.keep and not self.null else []
+        keep = obs.keep and not self.null
+        if keep:  # memory is packed several times over (MBs for a DFT robot): start from a trimmed heap ...
+            heap.give_back()
+        memory = [(a, memory_codec.encode(b.snapshot())) for a, b in mine] if keep else []
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory)
         self.act_publisher.put(payload)
+        if keep:  # ... and give those copies back to the system once sent, rather than keep them in the heap
+            del memory, payload
+            heap.give_back()
         if not self.null:
             self._send_plans(obs.tick, agents)
         return len(agents)

@@ -26,7 +26,8 @@ def _default(value: Any) -> Any:
         a = np.ascontiguousarray(value)
         if a.dtype.hasobject:
             return a.tolist()
-        return msgpack.ExtType(_ARRAY, msgpack.packb([a.dtype.str, list(a.shape), a.tobytes()], use_bin_type=True))
+        raw = memoryview(a.reshape(-1).view(np.uint8))  # the array's bytes where they are: no copy (fields are MBs)
+        return msgpack.ExtType(_ARRAY, msgpack.packb([a.dtype.str, list(a.shape), raw], use_bin_type=True))
     if isinstance(value, np.bool_):
         return bool(value)
     if isinstance(value, np.integer):

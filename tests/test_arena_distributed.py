@@ -178,19 +178,23 @@ def test_real_time_arena_run_reaches_its_goal():
     assert summary["mode"] == "realtime" and summary["robots"][0]["reached"]
 
 
-def test_swarm_up_runs_an_arena_and_equals_swarm_run():
+@pytest.mark.parametrize(("args", "finishes"), [
+    (["zmaze", "--noise", "high", "--seed", "5"], True),
+    (["large-maze", "--controller", "dft", "--max-ticks", "120"], False),  # the largest agent: 16 fields of 210 x 210
+])  # fmt: skip
+def test_swarm_up_runs_an_arena_and_equals_swarm_run(args, finishes):
     import json
     import subprocess
     import sys
 
-    args = ["zmaze", "--noise", "high", "--seed", "5", "--json"]
+    args = [*args, "--json"]
     ran = subprocess.run([sys.executable, "-m", "swarm", "run", *args], capture_output=True, text=True, timeout=300)
     up = subprocess.run([sys.executable, "-m", "swarm", "up", *args, "--no-record", "--listen", free_endpoint()],
                         capture_output=True, text=True, timeout=300)  # fmt: skip
-    assert up.returncode == 0, up.stderr[-2000:]
+    assert up.returncode == ran.returncode == (0 if finishes else 1), up.stderr[-2000:]  # 1: stopped short of the goal
     a, b = json.loads(ran.stdout), json.loads(up.stdout)
     assert a["robots"] == b["robots"] and a["ticks"] == b["ticks"] and b["rejected_messages"] == 0
-    assert b["agent_process_rss_mb"] < 80  # the agents' ahead-of-time A*: no numba in a carrot agent
+    assert b["agent_process_rss_mb"] < 80  # ahead-of-time kernels, no numba, no scipy in these agents
 
 
 def test_swarm_status_answers_for_an_arena_world():

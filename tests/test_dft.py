@@ -81,6 +81,58 @@ def test_a_shift_moves_activity_by_its_cells():
     assert np.unravel_index(np.argmax(e.input_of("b")), shape) == (8, 3)
 
 
+def test_the_engines_transforms_are_scipy_fft_bit_for_bit_without_importing_it():
+    """agents.controllers.dft.pocketfft calls scipy's compiled pocketfft as scipy.fft does (the same
+    numbers) while an agent process never imports scipy (issue 12's 80 MB)."""
+    import subprocess
+    import sys
+
+    import scipy.fft
+
+    from agents.controllers.dft import pocketfft
+
+    assert pocketfft.standalone()
+    rng = np.random.default_rng(7)
+    for shape, axes in (((3, 210, 210), (1, 2)), ((5, 100), (1,)), ((2, 9, 13), (1, 2))):
+        for dtype in (np.float32, np.float64):
+            x = rng.standard_normal(shape).astype(dtype)
+            spec = scipy.fft.rfftn(x, axes=axes)
+            assert np.array_equal(pocketfft.rfftn(x, axes), spec)
+            out = np.empty_like(spec)
+            assert pocketfft.rfftn(x, axes, out) is out and np.array_equal(out, spec)
+            back = scipy.fft.irfftn(spec, s=shape[1:], axes=axes)
+            got = np.empty_like(back)
+            pocketfft.irfftn(spec, shape[1:], axes, got)
+            assert np.array_equal(got, back) and np.array_equal(pocketfft.irfftn(spec, shape[1:], axes), back)
+    from agents.controllers import aot
+
+    aot.build()  # once per source version: an agent process's kernels (else it would fall back to numba)
+    child = ("import sys; from swarm import kernels; assert kernels.use_ahead_of_time(); "
+             "from agents.controllers.arena import make_controller; make_controller('dft'); "
+             "print(sorted({m.split('.')[0] for m in sys.modules} & {'scipy', 'numba'}))")  # fmt: skip
+    out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "[]", out.stderr[-2000:]
+
+
+def test_known_walls_grow_as_scipy_ndimage_dilates_them():
+    from scipy.ndimage import binary_dilation
+
+    from agents.controllers.dft.context import grown
+
+    rng = np.random.default_rng(3)
+    for shape, density, by in (((50, 70), 0.02, 3), ((210, 210), 0.01, 4), ((5, 5), 0.2, 7), ((1, 9), 0.3, 2)):
+        mask = rng.random(shape) < density
+        want = binary_dilation(mask, np.ones((2 * by + 1, 2 * by + 1), bool))
+        assert np.array_equal(grown(mask, by), want)
+
+
+def test_pairs_with_the_same_kernel_share_one_transfer_function():
+    """The SPA's four directions repeat their kernels: one spectrum each, not one per pair."""
+    group = Engine(spa_architecture((60, 80))).groups[0]
+    assert len(group.transfer) < len(group.src)
+    assert len({row.tobytes() for row in group.transfer}) == len(group.transfer)
+
+
 def test_an_architecture_that_cannot_be_stepped_is_refused_in_one_line():
     a, b = Field("a", (10,), 5, -5, 4), Field("b", (10, 10), 5, -5, 4)
     with pytest.raises(ValueError, match="joins shapes"):

@@ -19,12 +19,29 @@ import math
 from typing import Any
 
 import numpy as np
-from scipy.ndimage import binary_dilation
 
 from swarm.arena.models import IR_DISTANCE, IR_VALUE
 
 NEVER = -1
 MAX_CELLS = 4096  # most cells one publication may name
+
+
+def grown(mask: np.ndarray, by: int) -> np.ndarray:
+    """`mask` dilated by a (2 by + 1)-cell square, nothing beyond the edge: scipy.ndimage's
+    binary_dilation with that square, one axis at a time (a square is separable), in numpy so an
+    agent process need not import scipy (issue 12's memory budget)."""
+    out = mask
+    for axis in range(mask.ndim):
+        wide = out.copy()
+        n = mask.shape[axis]
+        for d in range(1, min(by, n - 1) + 1):
+            ahead = [slice(None)] * mask.ndim
+            behind = [slice(None)] * mask.ndim
+            ahead[axis], behind[axis] = slice(d, None), slice(None, n - d)
+            wide[tuple(ahead)] |= out[tuple(behind)]
+            wide[tuple(behind)] |= out[tuple(ahead)]
+        out = wide
+    return out
 
 
 class SensedContext:
@@ -34,7 +51,7 @@ class SensedContext:
         self.bearings = np.asarray(bearings, np.float64)
         self.memory, self.min_reading = memory, min_reading
         grow = max(1, round(margin / cell))
-        self.known = binary_dilation(walls, np.ones((2 * grow + 1, 2 * grow + 1), bool))
+        self.known = grown(np.asarray(walls, bool), grow)
         r = max(1, round(mark_radius / cell))
         dj, di = np.mgrid[-r : r + 1, -r : r + 1]
         inside = dj**2 + di**2 <= r * r
