@@ -220,6 +220,25 @@ def test_the_markov_filter_tells_apart_places_that_look_alike():
     assert int(np.argmax(belief)) == 2 and belief[2] > 0.8  # the filter: b, surely
 
 
+def test_a_sharper_correction_brings_a_belief_back_from_a_look_alike_place_sooner():
+    """The belief sits on 'a' while the robot stands at 'b', which looks like it (P 0.6 against 0.9):
+    weighing nodes by P ** 2 (the fingerprint controller's sharpness) moves it to 'b' in fewer views."""
+    from dataclasses import replace
+
+    def views_until_right(sharpness: float) -> int:
+        m = corridor_map()
+        m.params = replace(m.params, sharpness=sharpness)
+        m.belief = np.eye(4)[0]  # sure, and wrong: at a
+        for views in range(1, 50):
+            _, belief = m.localize("b", np.zeros(2))  # standing still at b
+            if int(np.argmax(belief)) == 2:
+                return views
+        return 50
+
+    plain, sharp = views_until_right(1.0), views_until_right(2.0)
+    assert sharp < plain < 50
+
+
 def test_a_loop_is_closed_through_localization():
     m = corridor_map()
     nodes = len(m.nodes)

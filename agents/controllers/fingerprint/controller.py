@@ -41,6 +41,7 @@ class FingerprintParams:
     theta: float = 0.5  # largest dissimilarity at which a fingerprint joins the current node
     keep: int = 30  # fingerprints a node keeps for its mean
     closure: float = 0.5  # belief in a known node that closes a loop
+    sharpness: float = 2.0  # the Markov filter weighs nodes by P(match) ** sharpness (docs/fingerprint.md)
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> FingerprintParams:
@@ -50,8 +51,9 @@ class FingerprintParams:
             raise ValueError(f"[fingerprint].drive: {p.drive!r}; expected one of {', '.join(DRIVES)}")
         if p.mode not in MODES:
             raise ValueError(f"[fingerprint].mode: {p.mode!r}; expected one of {', '.join(MODES)}")
-        if not (p.spacing > 0 and 0 < p.theta < 1 and p.keep >= 1):
-            raise ValueError("[fingerprint]: spacing > 0, 0 < theta < 1 and keep >= 1 are required")
+        if not (p.spacing > 0 and 0 < p.theta < 1 and p.keep >= 1 and 0 < p.sharpness <= 10):
+            raise ValueError("[fingerprint]: spacing > 0, 0 < theta < 1, keep >= 1 and 0 < sharpness <= 10 "
+                             "are required")  # fmt: skip
         return p
 
 
@@ -84,7 +86,8 @@ class FingerprintController:
         self.features = FeatureParams.from_table(table.get("features"))
         self.matcher = Matcher(AlignParams.from_table(table.get("align")))
         self.signatures = FingerprintSignatures(self.matcher)
-        map_params = MapParams(theta=self.p.theta, keep=self.p.keep, closure=self.p.closure)
+        map_params = MapParams(theta=self.p.theta, keep=self.p.keep, closure=self.p.closure,
+                               sharpness=self.p.sharpness)  # fmt: skip
         if self.p.mode == "localize":
             if params.get("topomap") is None:
                 raise ValueError(

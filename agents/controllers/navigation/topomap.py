@@ -103,6 +103,7 @@ class MapParams:
     kappa: float = 2.0  # concentration of the link direction model (von Mises)
     spread: float = 1e-2  # belief spread to every node at each prediction (kidnapping, errors)
     floor: float = 1e-3  # likelihood floor: one bad match never rules a node out
+    sharpness: float = 1.0  # the correction weighs each node by likelihood ** sharpness (see correct)
     closure_radius: float | None = None  # a loop closes only onto a node this near by odometry (None: anywhere)
 
 
@@ -202,7 +203,12 @@ class TopoMap:
         return out / out.sum()
 
     def correct(self, prior: np.ndarray, likelihood: np.ndarray) -> np.ndarray:
-        post = prior * (likelihood + self.params.floor)
+        """The belief after an observation.  With `sharpness` above 1 a view that matches one node
+        clearly better than another moves the belief more: a signature model whose P(match) is
+        flat between places that look somewhat alike (a fingerprint's logistic) lets a belief left
+        on the wrong one come back in fewer observations."""
+        weight = likelihood if self.params.sharpness == 1.0 else likelihood**self.params.sharpness
+        post = prior * (weight + self.params.floor)
         total = post.sum()
         return post / total if total > 0 else np.full(len(prior), 1.0 / len(prior))
 
