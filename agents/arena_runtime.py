@@ -29,6 +29,7 @@ class ArenaAgentRuntime(AgentRuntime):
         self.sent_plans: dict[int, tuple] = {}  # agent -> (length, first, last point) of the last plan sent
         self.refused_shared = 0  # other robots' publications this process's controllers refused
         self.refused_memory = 0  # memories handed back that could not be decoded
+        self.kept = False  # the last answer carried the controllers' memory
 
     def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
         brain = make_controller(msg.get("controller", self.controller))
@@ -59,12 +60,13 @@ class ArenaAgentRuntime(AgentRuntime):
             wheels.append(np.zeros(3) if self.null else as_action(self.brains[slot].step(reading)))
         shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
         keep = obs.keep and not self.null
-        if keep:  # memory is packed several times over (MBs for a DFT robot): start from a trimmed heap ...
-            heap.give_back()
+        if keep or self.kept:  # memory is packed several times over (MBs for a DFT robot): start from a
+            heap.give_back()  # trimmed heap; the tick after, zenoh has sent and freed its own copy of it too
+        self.kept = keep
         memory = [(a, memory_codec.encode(b.snapshot())) for a, b in mine] if keep else []
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory)
         self.act_publisher.put(payload)
-        if keep:  # ... and give those copies back to the system once sent, rather than keep them in the heap
+        if keep:  # ... and give our copies back once zenoh has taken the message, rather than keep them in the heap
             del memory, payload
             heap.give_back()
         if not self.null:
