@@ -59,16 +59,12 @@ class ArenaAgentRuntime(AgentRuntime):
             agents.append(agent)
             wheels.append(np.zeros(3) if self.null else as_action(self.brains[slot].step(reading)))
         shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
-        keep = obs.keep and not self.null
-        if keep or self.kept:  # memory is packed several times over (MBs for a DFT robot): start from a
-            heap.give_back()  # trimmed heap; the tick after, zenoh has sent and freed its own copy of it too
-        self.kept = keep
+        if self.kept:  # the memory sent last tick was packed several times over (MBs for a DFT robot), and
+            heap.give_back()  # zenoh has sent and freed its own copy by now: all of it back, not kept in the heap
+        self.kept = keep = obs.keep and not self.null
         memory = [(a, memory_codec.encode(b.snapshot())) for a, b in mine] if keep else []
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory)
         self.act_publisher.put(payload)
-        if keep:  # ... and give our copies back once zenoh has taken the message, rather than keep them in the heap
-            del memory, payload
-            heap.give_back()
         if not self.null:
             self._send_plans(obs.tick, agents)
         return len(agents)
