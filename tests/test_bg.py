@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from agents.controllers.bg import BgController
-from agents.controllers.bg.places import ANGLES, Navigator, NavParams
+from agents.controllers.bg.places import ANGLES, Navigator, NavParams, _explore_channel
 from agents.controllers.bg.saliences import Drives, plan_vector, saliences
-from agents.controllers.bg.senses import Reflex, proximity, resource_pixels
+from agents.controllers.bg.senses import Reflex, proximity, resource_pixels, to_allocentric
+from agents.controllers.navigation.dijkstra import shortest_routes
 from swarm import protocol_arena as proto
 from swarm.arena.engine import ArenaEngine
 from swarm.arena.scenario import controller_params
@@ -123,6 +124,44 @@ def test_prox_counts_the_run_through_each_direction_within_seven_pixels():
     assert counts[27] == 7 and counts[20] == 4 and counts[35] == 4  # a large one fills windows inside it
 
 
+def test_prox_is_the_run_through_the_centre_cut_to_the_window_on_random_views():
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        pixels = rng.random((3, 36)) < rng.uniform(0.1, 0.9)
+        expected = np.zeros((3, 36))
+        for r, d in np.argwhere(pixels):  # walk out from the centre pixel, at most 3 each way
+            after = next((k for k in range(1, 4) if not pixels[r, (d + k) % 36]), 4) - 1
+            before = next((k for k in range(1, 4) if not pixels[r, (d - k) % 36]), 4) - 1
+            expected[r, d] = (1 + after + before) / 7
+        assert np.array_equal(proximity(pixels), expected)
+
+
+def test_allocentric_resampling_gives_numpys_numbers_to_the_bit():
+    rng = np.random.default_rng(4)
+    for n in (8, 36):
+        for _ in range(40):
+            readings, heading = rng.uniform(0, 5, n), float(rng.uniform(-10, 10))
+            pos = (np.arange(n) - heading * n / (2 * math.pi)) % n  # the formula as numpy arrays
+            lo = np.floor(pos).astype(np.int64)
+            f = pos - lo
+            expected = readings[lo] * (1 - f) + readings[(lo + 1) % n] * f
+            assert np.array_equal(to_allocentric(readings, heading), expected)
+    assert np.array_equal(to_allocentric(np.arange(8.0), 0.0), np.arange(8.0))  # heading east: unchanged
+
+
+def test_the_exploration_channel_is_numpys_interp_clip_and_argmax_to_the_bit():
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        sonar, novel = rng.uniform(0, 3, 8), rng.uniform(0, 1, 36)
+        wander = rng.uniform(0, 0.5, 36) if rng.random() < 0.8 else np.zeros(36)
+        open_range = float(rng.choice([0.5, 1.0, 2.0]))
+        room = np.interp(ANGLES, np.arange(9) * (2 * math.pi / 8), np.append(sonar, sonar[0]))
+        score = np.clip(room / open_range - 0.5, 0.0, 1.0) * (0.5 * novel + wander)
+        expected = int(np.argmax(score)) if score.max() > 0 else -1
+        assert _explore_channel(sonar, open_range, novel, wander) == expected
+    assert _explore_channel(np.full(8, 0.1), 1.0, np.ones(36), np.zeros(36)) == -1  # no room anywhere
+
+
 def test_resource_pixels_are_turned_allocentric_by_the_compass():
     grey = np.full(36, 180, np.uint8)
     grey[0] = 127  # straight ahead: an ingesting zone
@@ -168,11 +207,46 @@ def test_plan_combines_needs_and_fear_subtracts_danger():
     assert plan_vector(_drives(e=0.0, ep=0.5, plan=p), True)[7] < plan_vector(_drives(e=0.0, ep=0.5, plan=p), False)[7]
 
 
+def _numpy_saliences(d: Drives, kind: str, w_plan: float, w_taxon: float) -> tuple[np.ndarray, np.ndarray]:
+    """Eqs. 1 and 15-20 as numpy array expressions: what the compiled kernel must give to the bit."""
+    m_e, m_ep, m_bka = d.m_e, d.m_ep, d.disorientation
+    mprox, a = d.prox.max(axis=1), d.usable.astype(np.float64)
+    if kind == "tmaze":
+        dorsal = np.array([0.9 * a[2] * m_e + 0.1 * mprox[2] * m_e, 0.9 * a[1] * m_ep + 0.1 * mprox[1] * m_ep])
+    else:
+        dorsal = np.array([1.2 * a[2] * m_e + 0.6 * mprox[2] * m_e, a[1] * m_ep + 0.2 * mprox[1] * m_ep])
+    planned = 1.0 - (1.0 - m_e * d.plan[2]) * (1.0 - m_ep * d.plan[1])
+    plan = np.sqrt(np.maximum(planned - d.fear * d.plan[0] if kind == "fear" else planned, 0.0))
+    sq = np.sqrt(d.prox)
+    if kind == "fear":
+        return dorsal, (0.45 * plan + 0.35 * sq[2] * m_e + 0.35 * sq[1] * m_ep + 0.19 * (1.0 - d.prox[0]) * d.fear
+                        + 0.4 * d.bka * m_bka
+                        + d.expl * (0.05 + 0.05 * (1 - mprox[1]) * m_ep + 0.05 * (1 - mprox[2]) * m_e))  # fmt: skip
+    term = 0.55 * plan * (1.0 - mprox[2]) * (1.0 - mprox[1]) if kind == "tmaze" else w_plan * plan
+    return dorsal, (term + 0.55 * sq[2] * m_e + w_taxon * sq[1] * m_ep + 0.4 * d.bka * m_bka
+                    + d.expl * (0.25 + 0.05 * (1 - mprox[1]) * m_ep + 0.05 * (1 - mprox[2]) * m_e))  # fmt: skip
+
+
+def test_the_compiled_saliences_are_the_equations_numbers_to_the_bit():
+    rng = np.random.default_rng(6)
+    for k in range(60):
+        prox = np.where(rng.random((3, 36)) < 0.3, rng.integers(1, 8, (3, 36)) / 7, 0.0)
+        d = _drives(e=float(rng.random()), ep=float(rng.random()), fear=float(rng.random()),
+                    disorientation=float(rng.random()), prox=prox, usable=rng.random(3) < 0.5,
+                    plan=rng.random((3, 36)) * (rng.random((3, 36)) < 0.5), bka=rng.random(36),
+                    expl=rng.random(36))  # fmt: skip
+        kind = ("survival", "fear", "tmaze")[k % 3]
+        dorsal, ventral, planned = saliences(d, kind, 0.65, 0.55)
+        want_dorsal, want_ventral = _numpy_saliences(d, kind, 0.65, 0.55)
+        assert np.array_equal(dorsal, want_dorsal) and np.array_equal(ventral, want_ventral)
+        assert np.array_equal(planned, plan_vector(d, kind == "fear"))
+
+
 def test_usable_food_drives_the_dorsal_loop_and_lower_weights_in_the_tmaze():
     prox = np.zeros((3, 36))
     prox[1, 3:10] = 1.0
     d = _drives(e=1.0, ep=0.2, prox=prox, usable=np.array([False, True, False]))
-    dorsal, _ = saliences(d, "survival", 0.65, 0.55)
+    dorsal, _, _ = saliences(d, "survival", 0.65, 0.55)
     assert dorsal[1] == pytest.approx(0.8 + 0.2 * 0.8) and dorsal[0] == 0.0  # eq. 16
     assert saliences(d, "tmaze", 0.65, 0.55)[0][1] == pytest.approx(0.9 * 0.8 + 0.1 * 0.8)  # eq. 20
 
@@ -187,6 +261,27 @@ def _nav() -> Navigator:
 def _place(k: int) -> tuple[np.ndarray, np.ndarray]:
     grey = np.full(36, 40 + 60 * k, np.uint8)
     return grey, np.full(8, 1.0 + 1.0 * k)
+
+
+def test_routes_are_scipys_dijkstra_to_the_bit():
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    rng = np.random.default_rng(7)
+    for _ in range(30):
+        n = int(rng.integers(2, 60))
+        pairs = {(int(a), int(b)) for a, b in rng.integers(0, n, (2 * n, 2)) if a != b}
+        heads, tails = np.array([p[0] for p in pairs], np.int64), np.array([p[1] for p in pairs], np.int64)
+        lengths = rng.uniform(1e-3, 2.0, len(pairs))
+        lengths[rng.random(len(pairs)) < 0.1] = 0.0  # zero-length edges are edges (the map's sure sources)
+        source = int(rng.integers(0, n))
+        dist, pred = shortest_routes(n, source, heads, tails, lengths)
+        want_dist, want_pred = dijkstra(csr_matrix((lengths, (heads, tails)), shape=(n, n)), directed=True,
+                                        indices=source, return_predecessors=True)  # fmt: skip
+        assert np.array_equal(dist, want_dist)
+        # predecessors agree wherever the shortest route is unique (random lengths; zero edges can tie)
+        unique = [v for v in range(n) if not any(lengths[e] == 0.0 for e in range(len(heads)) if tails[e] == v)]
+        assert np.array_equal(pred[unique], want_pred[unique])
 
 
 def test_the_map_learns_where_food_is_forgets_it_when_gone_and_plans_to_it():

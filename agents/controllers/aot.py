@@ -25,7 +25,9 @@ from pathlib import Path
 from swarm.jitcache import cache_root, source_digest
 
 # Modules whose kernels agent processes call (swarm.kernels.exported).
-KERNEL_MODULES = ("swarm.rng", "agents.controllers.navigation.astar", "agents.controllers.bg.gpr",
+KERNEL_MODULES = ("swarm.rng", "agents.controllers.navigation.astar", "agents.controllers.navigation.dijkstra",
+                  "agents.controllers.bg.gpr", "agents.controllers.bg.senses", "agents.controllers.bg.saliences",
+                  "agents.controllers.bg.places",
                   "agents.controllers.fingerprint.align", "agents.controllers.dft.fields")  # fmt: skip
 
 

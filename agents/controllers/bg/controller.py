@@ -22,12 +22,13 @@ import numpy as np
 from agents.controllers.bg.colony import ColonyMap
 from agents.controllers.bg.gpr import BasalGanglia, select_dorsal, select_ventral
 from agents.controllers.bg.places import DIRECTIONS, Navigator, NavParams
-from agents.controllers.bg.saliences import SALIENCES, Drives, plan_vector, saliences
+from agents.controllers.bg.saliences import SALIENCES, Drives, saliences
 from agents.controllers.bg.senses import RESOURCES, Reflex, proximity, resource_pixels
 from agents.controllers.tables import params_from_table
 from swarm.arena.models import ZONE_KINDS
 
 USABLE_ZONE = {"DA": "dangerous", "Ep": "ingesting", "E": "digesting"}
+USABLE_BITS = {r: 1 << ZONE_KINDS.index(z) for r, z in USABLE_ZONE.items()}  # in the world's `zones` reading
 DORSAL_ACTS = ("ReloadE", "ReloadEp")  # channel order; world_server.metabolism.ACTS codes 1, 2
 
 
@@ -113,13 +114,14 @@ class BgController:
         heading = float(perception["compass"])
         grey, sonar = perception["camera_grey"], np.asarray(perception["sonar"], np.float64)
         zones = int(perception.get("zones", 0))
-        usable = {r: bool(zones & (1 << ZONE_KINDS.index(z))) for r, z in USABLE_ZONE.items()}
+        usable = {r: bool(zones & bit) for r, bit in USABLE_BITS.items()}
         self.nav.move(float(perception["odometry"][0]), heading)
         prox = proximity(resource_pixels(grey, heading))
         if self.p.planning:
             if self.p.learn_map and self.nav.due():
                 self.colony.adopt(self.nav.observe(grey, sonar, heading))
-            self.nav.learn(usable, {r: bool(prox[k].any()) for k, r in enumerate(RESOURCES)}, self.dt)
+            seen = prox.any(axis=1)
+            self.nav.learn(usable, {r: bool(seen[k]) for k, r in enumerate(RESOURCES)}, self.dt)
             plan = np.stack([self.nav.plan(r) for r in RESOURCES])
             bka, disorientation = self.nav.back_to_known(), self.nav.D
         else:
@@ -127,8 +129,8 @@ class BgController:
         drives = Drives(energy, potential, self.p.fear, disorientation, prox,
                         np.array([usable[r] for r in RESOURCES]), plan, bka,
                         self.nav.explore(sonar, heading, self.tick * self.dt, self.p.planning))  # fmt: skip
-        s_dorsal, s_ventral = saliences(drives, self.p.saliences, self.p.w_plan if self.p.planning else 0.0,
-                                        self.p.w_taxon)  # fmt: skip
+        s_dorsal, s_ventral, planned = saliences(drives, self.p.saliences,
+                                                 self.p.w_plan if self.p.planning else 0.0, self.p.w_taxon)  # fmt: skip
         self.bg.run(s_dorsal, s_ventral, self.dt)
         d, v = self.bg.disinhibition()
         chosen = select_dorsal(d, self.p.dorsal_threshold, self.acting)
@@ -145,11 +147,11 @@ class BgController:
             forward, turn, act = 0.0, 0.0, 0
         # both wheels within their limit: the turn is kept, the forward speed gives way
         room = max(self.max_wheel - abs(turn) * self.axle / 2, 0.0)
-        forward = float(np.clip(forward, -room, room))
+        forward = min(max(forward, -room), room)
         self.tick += 1
         self.last = {"drives": drives, "s_dorsal": s_dorsal, "s_ventral": s_ventral, "dorsal": d, "ventral": v,
                      "act": act, "direction": direction if strength > 0 else math.nan, "reflex": reflex is not None,
-                     "plan": plan_vector(drives, self.p.saliences == "fear")}  # fmt: skip
+                     "plan": planned}  # fmt: skip
         return np.array([forward - turn * self.axle / 2, forward + turn * self.axle / 2, float(act)])
 
     def _steer(self, direction: float, heading: float, ahead: float) -> tuple[float, float]:
@@ -157,8 +159,8 @@ class BgController:
         within `align` of it, slower the farther off and the nearer a wall ahead: a turn made while
         driving at full speed would carry the animat a metre sideways into the walls."""
         err = (direction - heading + math.pi) % (2 * math.pi) - math.pi
-        turn = float(np.clip(err / self.dt, -self.max_turn, self.max_turn))
-        room = float(np.clip((ahead - self.p.too_close) / self.p.too_close, 0.0, 1.0))
+        turn = min(max(err / self.dt, -self.max_turn), self.max_turn)  # np.clip's numbers, without its cost
+        room = min(max((ahead - self.p.too_close) / self.p.too_close, 0.0), 1.0)
         forward = self.max_speed * max(0.0, 1.0 - abs(err) / self.p.align) * (0.25 + 0.75 * room)
         return forward, turn
 

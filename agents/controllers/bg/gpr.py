@@ -23,6 +23,7 @@ dt is not the cure: the instability is in the coupling, not in each neuron.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,8 +55,7 @@ def lateral_circular(n: int) -> np.ndarray:
 
 @njit(cache=True, inline="always")
 def _out(a: float, eps: float, m: float) -> float:
-    y = m * (a - eps)
-    return 0.0 if y < 0.0 else (1.0 if y > 1.0 else y)
+    return min(max(m * (a - eps), 0.0), 1.0)  # without branches, so the loops over channels vectorise
 
 
 @exported("bg_outputs", "void(float64[:, :], float64[:, :], float64[:], float64[:])")
@@ -67,34 +67,46 @@ def _outputs(a: np.ndarray, y: np.ndarray, eps: np.ndarray, slope: np.ndarray) -
 
 
 @njit(cache=True)
-def _inputs(y: np.ndarray, salience: np.ndarray, feedback: float, ctx_rest: np.ndarray, lateral: np.ndarray,
-            stn_other: float, dopamine: float, out: np.ndarray, active: np.ndarray) -> None:  # fmt: skip
-    """Eqs. 5-14 for one loop into `out` (8, N); `stn_other` is the sum of the
-    other loop's STN outputs this loop's EP/SNr receives (eq. 10, times 0.4)."""
+def _euler(a: np.ndarray, y: np.ndarray, salience: np.ndarray, feedback: float, ctx_rest: np.ndarray,
+           lateral: np.ndarray, stn_other: float, dopamine: float, h: float, sums: np.ndarray) -> None:  # fmt: skip
+    """One Euler step of one loop in place: a += h (I - a), the inputs I of eqs. 5-14 from the outputs `y`.
+    `stn_other` is the sum of the other loop's STN outputs this loop's EP/SNr receives (eq. 10, times 0.4);
+    `sums` (2, N) is scratch for the lateral sums; `lateral` is symmetric.  One simple loop per nucleus
+    (the compiler vectorises those; one loop computing all eight did not), each input in the same order of
+    operations as eqs. 5-14 are written, so the result is the same to the bit."""
     n = y.shape[1]
     stn_sum, trn_sum = 0.0, 0.0
-    k = 0  # striatal channels with output go in `active`: few, so the lateral sums skip the rest
     for j in range(n):
         stn_sum += y[STN, j]
         trn_sum += y[TRN, j]
-        if y[D1, j] > 0.0 or y[D2, j] > 0.0:
-            active[k] = j
-            k += 1
     for i in range(n):
-        s = salience[i] + feedback * max(y[CTX, i] - ctx_rest[i], 0.0)
-        li1, li2 = 0.0, 0.0
-        for q in range(k):
-            j = active[q]
-            li1 += lateral[i, j] * y[D1, j]
-            li2 += lateral[i, j] * y[D2, j]
-        out[D1, i] = (1.0 + dopamine) * s - li1
-        out[D2, i] = (1.0 - dopamine) * s - li2
-        out[STN, i] = s - y[GP, i]
-        out[GP, i] = -y[D2, i] + 0.8 * stn_sum
-        out[EP, i] = -y[D1, i] - 0.4 * y[GP, i] + 0.8 * stn_sum + stn_other
-        out[VL, i] = y[CTX, i] - y[EP, i] - 0.13 * (trn_sum - y[TRN, i])
-        out[TRN, i] = y[VL, i] + y[CTX, i]
-        out[CTX, i] = y[VL, i]
+        sums[0, i] = 0.0
+        sums[1, i] = 0.0
+    for j in range(n):  # over the striatal channels with output (few), along a row of `lateral`
+        y1, y2 = y[D1, j], y[D2, j]
+        if y1 > 0.0 or y2 > 0.0:
+            for i in range(n):
+                sums[0, i] += lateral[j, i] * y1
+            for i in range(n):
+                sums[1, i] += lateral[j, i] * y2
+    up, down = 1.0 + dopamine, 1.0 - dopamine
+    for i in range(n):
+        c = y[CTX, i] - ctx_rest[i]
+        s = salience[i] + feedback * (c if c > 0.0 else 0.0)
+        a[D1, i] += h * ((up * s - sums[0, i]) - a[D1, i])
+        a[D2, i] += h * ((down * s - sums[1, i]) - a[D2, i])
+        a[STN, i] += h * ((s - y[GP, i]) - a[STN, i])
+    diffuse = 0.8 * stn_sum
+    for i in range(n):
+        a[GP, i] += h * ((-y[D2, i] + diffuse) - a[GP, i])
+    for i in range(n):
+        a[EP, i] += h * ((-y[D1, i] - 0.4 * y[GP, i] + diffuse + stn_other) - a[EP, i])
+    for i in range(n):
+        a[VL, i] += h * ((y[CTX, i] - y[EP, i] - 0.13 * (trn_sum - y[TRN, i])) - a[VL, i])
+    for i in range(n):
+        a[TRN, i] += h * ((y[VL, i] + y[CTX, i]) - a[TRN, i])
+    for i in range(n):
+        a[CTX, i] += h * (y[VL, i] - a[CTX, i])
 
 
 @exported("bg_run_loops", "void(float64[:, :], float64[:, :], float64[:], float64[:], float64, float64, "
@@ -107,21 +119,23 @@ def run_loops(a_d: np.ndarray, a_v: np.ndarray, s_d: np.ndarray, s_v: np.ndarray
     """`steps` Euler steps of h = dt / tau of both loops in place; `cross` weighs
     the dorsal STN's sum onto the ventral EP/SNr (0.4 in eq. 10; 0 for a lone loop)."""
     y_d, y_v = np.empty_like(a_d), np.empty_like(a_v)
-    i_d, i_v = np.empty_like(a_d), np.empty_like(a_v)
-    act_d, act_v = np.empty(a_d.shape[1], np.int64), np.empty(a_v.shape[1], np.int64)
+    sums_d, sums_v = np.empty((2, a_d.shape[1])), np.empty((2, a_v.shape[1]))
     for _ in range(steps):
         _outputs(a_d, y_d, eps, slope)
         _outputs(a_v, y_v, eps, slope)
         dorsal_stn = 0.0
         for j in range(a_d.shape[1]):
             dorsal_stn += y_d[STN, j]
-        _inputs(y_d, s_d, fb_d, rest_d, lat_d, 0.0, dopamine, i_d, act_d)
-        _inputs(y_v, s_v, fb_v, rest_v, lat_v, cross * dorsal_stn, dopamine, i_v, act_v)
-        for k in range(8):
-            for i in range(a_d.shape[1]):
-                a_d[k, i] += h * (i_d[k, i] - a_d[k, i])
-            for i in range(a_v.shape[1]):
-                a_v[k, i] += h * (i_v[k, i] - a_v[k, i])
+        _euler(a_d, y_d, s_d, fb_d, rest_d, lat_d, 0.0, dopamine, h, sums_d)
+        _euler(a_v, y_v, s_v, fb_v, rest_v, lat_v, cross * dorsal_stn, dopamine, h, sums_v)
+
+
+@exported("bg_disinhibition", "void(float64[:, :], float64, float64, float64[:], float64[:])")
+@njit(cache=True)
+def _disinhibition(a: np.ndarray, eps: float, slope: float, rest: np.ndarray, out: np.ndarray) -> None:
+    """Per channel 1 - y_EP / max(rest, 1e-9): how far below its resting level the EP/SNr output is."""
+    for i in range(out.shape[0]):
+        out[i] = 1.0 - _out(a[EP, i], eps, slope) / max(rest[i], 1e-9)
 
 
 def outputs(a: np.ndarray) -> np.ndarray:
@@ -153,6 +167,8 @@ class BasalGanglia:
         self.dorsal, self.ventral, self.cross = dorsal, ventral, cross
         self.h, self.dopamine, self.dt = dt / tau, dopamine, dt
         self.lat_d, self.lat_v = dorsal.lateral(), ventral.lateral()
+        if not (np.array_equal(self.lat_d, self.lat_d.T) and np.array_equal(self.lat_v, self.lat_v.T)):
+            raise ValueError("the striatal lateral weights must be symmetric (_euler sums along rows)")
         self.a_d = np.zeros((8, dorsal.channels))
         self.a_v = np.zeros((8, ventral.channels))
         # The resting state (zero salience), settled: the feedback counts from its cortex level and
@@ -181,8 +197,9 @@ class BasalGanglia:
     def disinhibition(self) -> tuple[np.ndarray, np.ndarray]:
         """Per channel, how far below its resting level the EP/SNr output is, as a
         share of that level (1: fully released, 0 or less: not)."""
-        d = 1.0 - self.y_dorsal()[EP] / np.maximum(self.rest_d, 1e-9)
-        v = 1.0 - self.y_ventral()[EP] / np.maximum(self.rest_v, 1e-9) if self.ventral.channels else np.zeros(0)
+        d, v = np.empty(self.dorsal.channels), np.empty(self.ventral.channels)
+        _disinhibition(self.a_d, EPSILON[EP], SLOPE[EP], self.rest_d, d)
+        _disinhibition(self.a_v, EPSILON[EP], SLOPE[EP], self.rest_v, v)
         return d, v
 
     def state(self) -> dict[str, np.ndarray]:
@@ -202,17 +219,25 @@ def select_dorsal(disinhibition: np.ndarray, threshold: float, incumbent: int = 
     return k if disinhibition[k] > floor else -1
 
 
+@functools.cache
+def _circle(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """cos and sin of the N channels' directions (channel i points at i * 360/N degrees)."""
+    angle = np.arange(n) * (2 * np.pi / n)
+    return np.cos(angle), np.sin(angle)
+
+
 def select_ventral(disinhibition: np.ndarray, threshold: float) -> tuple[float, float]:
     """(direction, strength): the vector sum of the channels released beyond
     `threshold`, each weighted by how far beyond it (channel i points at
     i * 360/N degrees); strength 0 (direction nan) when none is, or when the
     released channels point every way (their sum is under a tenth of their weight)."""
-    n = len(disinhibition)
-    w = np.where(disinhibition > threshold, disinhibition - threshold, 0.0)
-    if not w.any():
+    w = np.maximum(disinhibition - threshold, 0.0)  # each channel's weight: how far beyond the threshold
+    total = float(w.sum())
+    if total == 0.0:  # none beyond it
         return float("nan"), 0.0
-    angle = np.arange(n) * (2 * np.pi / n)
-    x, y = float(w @ np.cos(angle)), float(w @ np.sin(angle))
-    if np.hypot(x, y) < 0.1 * w.sum():
+    cos, sin = _circle(len(disinhibition))
+    x, y = float(w @ cos), float(w @ sin)
+    length = float(np.hypot(x, y))
+    if length < 0.1 * total:
         return float("nan"), 0.0
-    return float(np.arctan2(y, x) % (2 * np.pi)), float(np.hypot(x, y))
+    return float(np.arctan2(y, x) % (2 * np.pi)), length

@@ -30,16 +30,17 @@ system:
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 
 from agents.controllers.bg.senses import to_allocentric
+from agents.controllers.navigation.dijkstra import shortest_routes
 from agents.controllers.navigation.topomap import MapParams, TopoMap, topomap_from_data, topomap_to_data
+from swarm.kernels import exported, njit
 from swarm.rng import fill_uniform
 
 DIRECTIONS = 36
@@ -78,11 +79,13 @@ class PlaceSignatures:
 
     def __init__(self, grey_scale: float, sonar_scale: float):
         self.gs, self.ss = grey_scale, sonar_scale
+        self._rows = np.zeros((0, DIRECTIONS + 8))  # np.stack of the means last asked about ...
+        self._held: list[Any] = []  # ... and the arrays they were copied from
 
     def likelihoods(self, observation: Any, means: list[Any]) -> np.ndarray:
         if not means:
             return np.zeros(0)
-        m = np.stack(means)
+        m = self._stacked(means)
         g = ((m[:, :DIRECTIONS] - observation[:DIRECTIONS]) / self.gs) ** 2
         s = ((m[:, DIRECTIONS:] - observation[DIRECTIONS:]) / self.ss) ** 2
         return np.exp(-0.5 * (g.mean(axis=1) + s.mean(axis=1)))
@@ -90,10 +93,76 @@ class PlaceSignatures:
     def mean(self, members: list[Any]) -> Any:
         return np.mean(members, axis=0)
 
+    def _stacked(self, means: list[Any]) -> np.ndarray:
+        """np.stack(means), copying only the rows whose array is not the one copied last time: a map
+        changes a node's mean at a time, and always by a new array (never in place), so the rest hold."""
+        if len(means) > len(self._rows):
+            grown = np.zeros((max(2 * len(self._rows), len(means), 16), DIRECTIONS + 8))
+            grown[: len(self._rows)] = self._rows
+            self._rows = grown
+        held = self._held
+        for i, mean in enumerate(means):
+            if i >= len(held):
+                held.append(mean)
+                self._rows[i] = mean
+            elif held[i] is not mean:
+                held[i] = mean
+                self._rows[i] = mean
+        return self._rows[: len(means)]
+
 
 def bump(direction: float, strength: float, width: float) -> np.ndarray:
     """A von Mises bump over the 36 directions, peak `strength` at `direction`."""
     return strength * np.exp(width * (np.cos(ANGLES - direction) - 1.0))
+
+
+@functools.cache
+def _bump_at(channel: int, width: float) -> np.ndarray:
+    return bump(ANGLES[channel], 1.0, width)
+
+
+def _channel_bump(channel: int, width: float) -> np.ndarray:
+    """bump(ANGLES[channel], 1, width), worked out once per channel: the exploration vector is one of these."""
+    return _bump_at(channel, width).copy()
+
+
+@exported("bg_hebbian", "void(float64[::1], float64[::1], float64, boolean)")
+@njit(cache=True)
+def _hebbian(w: np.ndarray, b: np.ndarray, rate: float, usable: bool) -> None:
+    """In place: w += min(rate b, 1) (1 - w) while usable, else w -= rate b w (numpy's numbers, to the bit)."""
+    for i in range(w.shape[0]):
+        if usable:
+            w[i] += min(rate * b[i], 1.0) * (1.0 - w[i])
+        else:
+            w[i] -= rate * b[i] * w[i]
+
+
+_SONAR_ANGLES = np.arange(9) * (2 * math.pi / 8)  # the 8 sonars' directions, the first again at 360 degrees
+
+
+@exported("bg_explore_channel", "int64(float64[::1], float64, float64[::1], float64[::1])")
+@njit(cache=True)
+def _explore_channel(sonar: np.ndarray, open_range: float, novel: np.ndarray, wander: np.ndarray) -> int:
+    """The direction channel with most room (the 8 allocentric sonar ranges interpolated over the 36
+    channels), novelty and wander, -1 if none has any: what numpy's interp, clip and argmax gave, to the
+    bit (interp's formula and its exact-node case as numpy/_core/src/multiarray/compiled_base.c has them)."""
+    best, best_score = -1, 0.0
+    for k in range(DIRECTIONS):
+        x = ANGLES[k]
+        j = 0
+        while j < 7 and _SONAR_ANGLES[j + 1] <= x:
+            j += 1
+        lo, hi = sonar[j], sonar[(j + 1) % 8]
+        if _SONAR_ANGLES[j] == x:
+            room = lo
+        else:
+            room = (hi - lo) / (_SONAR_ANGLES[j + 1] - _SONAR_ANGLES[j]) * (x - _SONAR_ANGLES[j]) + lo
+        o = room / open_range - 0.5
+        o = 1.0 if o > 1.0 else (0.0 if o < 0.0 else o)
+        score = o * (0.5 * novel[k] + wander[k])
+        if score > best_score:
+            best, best_score = k, score
+    return best
 
 
 class Navigator:
@@ -118,6 +187,8 @@ class Navigator:
         self._novel_key: tuple = ()
         self._novel = np.ones(DIRECTIONS)
         self._wander_key = -1
+        self._known_key: tuple = ()
+        self._known = np.zeros(0)
         self._wander = np.zeros(DIRECTIONS)
         self.news = 0  # changes from other animats (their nodes, links, what nodes hold): caches key on it too
 
@@ -181,12 +252,12 @@ class Navigator:
         b = self.map.belief
         if len(b) == 0:
             return
+        b = np.ascontiguousarray(b, np.float64)
         for r in self.resources:
-            w = self.assoc[r]
             if usable.get(r):
-                w += np.minimum(self.p.gain * dt * b, 1.0) * (1.0 - w)
+                _hebbian(self.assoc[r], b, self.p.gain * dt, True)
             elif not seen.get(r):
-                w -= self.p.forget * dt * b * w
+                _hebbian(self.assoc[r], b, self.p.forget * dt, False)
 
     # ----------------------------------------------------------- vectors
 
@@ -195,7 +266,8 @@ class Navigator:
         key = (len(self.map.nodes), len(self.map.links), self.observations, self.news)
         if self._edge_key != key:
             ab = np.array(list(self.map.links), np.int64).reshape(-1, 2)
-            d = np.array([max(link.distance, 1e-3) for link in self.map.links.values()])
+            shift = np.array([link.displacement for link in self.map.links.values()]).reshape(-1, 2)
+            d = np.maximum(np.hypot(shift[:, 0], shift[:, 1]), 1e-3)  # each Link.distance, floored
             self._edge_cache = (np.concatenate([ab[:, 0], ab[:, 1]]), np.concatenate([ab[:, 1], ab[:, 0]]),
                                 np.concatenate([d, d]))  # fmt: skip
             self._edge_key = key
@@ -205,17 +277,16 @@ class Navigator:
         """36-vector pointing along the route to the nodes of largest strength * exp(-route / reach)."""
         k = len(self.map.nodes)
         here = self.map.current
-        if k == 0 or here < 0 or not (strength > 1e-3).any():
+        if k == 0 or here < 0 or len(strength) == 0 or not strength.max() > 1e-3:
             return np.zeros(DIRECTIONS)
-        key = (self.observations, self.news, here, np.round(strength, 2).tobytes())
+        key = (self.observations, self.news, here, np.rint(strength * 100).tobytes())  # np.round(strength, 2)'s classes
         if key in self._towards:
             return self._towards[key]
         rows, cols, lengths = self._edges()
         sources = np.flatnonzero(strength > 1e-3)  # a virtual source k reaches each by what it holds
-        g = csr_matrix((np.concatenate([lengths, -self.p.reach * np.log(strength[sources])]),
-                        (np.concatenate([rows, np.full(len(sources), k)]), np.concatenate([cols, sources]))),
-                       shape=(k + 1, k + 1))  # fmt: skip
-        dist, pred = dijkstra(g, directed=True, indices=k, return_predecessors=True)
+        dist, pred = shortest_routes(k + 1, k, np.concatenate([rows, np.full(len(sources), k)]),
+                                     np.concatenate([cols, sources]),
+                                     np.concatenate([lengths, -self.p.reach * np.log(strength[sources])]))  # fmt: skip
         out = np.zeros(DIRECTIONS)
         if np.isfinite(dist[here]):
             value = math.exp(-dist[here] / self.p.reach)
@@ -240,7 +311,10 @@ class Navigator:
         return self.towards(self.assoc[resource])
 
     def back_to_known(self) -> np.ndarray:
-        known = (self.observations - np.array(self.born) >= self.p.known_age).astype(np.float64)
+        if self._known_key != (self.observations, len(self.born)):  # it changes only with these
+            self._known = (self.observations - np.array(self.born) >= self.p.known_age).astype(np.float64)
+            self._known_key = (self.observations, len(self.born))
+        known = self._known
         if len(known) and self.map.current >= 0 and known[self.map.current]:
             return np.zeros(DIRECTIONS)
         return self.towards(known)
@@ -250,9 +324,6 @@ class Navigator:
         yet, and a random preference (turning every `wander_period` seconds, drawn from seed, agent and
         that period's index) points.  One bump, not a broad profile: a broad salience over the 36
         channels excites the diffuse STN so much that no channel is released (docs/bg.md)."""
-        alloc = to_allocentric(sonar, heading)
-        room = np.interp(ANGLES, np.arange(9) * (2 * math.pi / 8), np.append(alloc, alloc[0]))
-        open_ = np.clip(room / self.p.open_range - 0.5, 0.0, 1.0)
         if self._novel_key != (self.observations, self.news, use_map):  # coverage changes only with these
             self._novel = self._novelty(use_map)
             self._novel_key = (self.observations, self.news, use_map)
@@ -262,10 +333,8 @@ class Navigator:
             fill_uniform(np.int64(self.seed), np.array([self.agent]), np.int64(period), np.int64(S_EXPLORE), u)
             self._wander = bump(float(u[0, 0]) * math.pi, self.p.wander_weight, 2.0)
             self._wander_key = period
-        score = open_ * (0.5 * self._novel + self._wander)
-        if score.max() <= 0:
-            return np.zeros(DIRECTIONS)
-        return bump(ANGLES[int(np.argmax(score))], 1.0, self.p.width)
+        best = _explore_channel(to_allocentric(sonar, heading), self.p.open_range, self._novel, self._wander)
+        return np.zeros(DIRECTIONS) if best < 0 else _channel_bump(best, self.p.width)
 
     def _novelty(self, use_map: bool) -> np.ndarray:
         """Per direction, 1 where no node of the map lies within `novelty_radius`, falling with each one that does."""
@@ -313,6 +382,7 @@ class Navigator:
             self.xy, self.since = np.array(data["xy"], np.float64), np.array(data["since"], np.float64)
             self.D, self.created = float(data["D"]), int(data["created"])
             self.born, self.observations = [int(b) for b in data["born"]], int(data["observations"])
+            self._known_key = ()
             self.relocalize = bool(data.get("relocalize", False))
             self.news = int(data.get("news", 0))
             if len(self.born) != len(self.map.nodes):

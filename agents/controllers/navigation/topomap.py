@@ -119,6 +119,8 @@ class TopoMap:
     likelihood: np.ndarray = field(default_factory=lambda: np.zeros(0))  # of the last observation
     odometer: float = 0.0  # distance travelled, for `recent`
     folded: dict[int, int] = field(default_factory=dict)  # young nodes found to be a known one: node -> that one
+    # per node: (observations of `seen_at` read, the largest odometer among them); see _last_seen
+    _latest: list[tuple[int, float]] = field(default_factory=list, repr=False, compare=False)
 
     @property
     def size(self) -> int:
@@ -348,16 +350,34 @@ class TopoMap:
         self.current = i
         self.belief = np.eye(len(self.nodes))[i]
 
+    def _last_seen(self, j: int) -> float:
+        """The largest odometer node j was observed at (-inf if never).  A node's `seen_at` only grows
+        (joins and folds append to it), so only what was appended since the last call is read: over a
+        long life a new node would otherwise convert every observation the map ever made."""
+        seen = self.nodes[j].seen_at
+        while len(self._latest) <= j:
+            self._latest.append((0, -math.inf))
+        count, latest = self._latest[j]
+        if count > len(seen):  # replaced by a shorter record: read it whole
+            count, latest = 0, -math.inf
+        for entry in seen[count:]:
+            latest = max(latest, entry[2])
+        self._latest[j] = (len(seen), latest)
+        return latest
+
     def _new_node(self, observation: Any, position: np.ndarray) -> int:
         here = (float(position[0]), float(position[1]), self.odometer)
         self.nodes.append(Node(observation, [observation], position.copy(), seen_at=[here]))
         i = len(self.nodes) - 1
         if self.current >= 0:
             self._link(self.current, i)
+        horizon = self.odometer - self.params.recent
         for j, node in enumerate(self.nodes[:-1]):
+            if j == self.current or self._last_seen(j) < horizon:
+                continue  # not observed within the last `recent` metres: no link by nearness
             seen = np.asarray(node.seen_at).reshape(-1, 3)
-            seen = seen[seen[:, 2] >= self.odometer - self.params.recent]
-            if j != self.current and len(seen) and np.hypot(*(seen[:, :2] - position).T).min() <= self.params.near:
+            seen = seen[seen[:, 2] >= horizon]
+            if np.hypot(*(seen[:, :2] - position).T).min() <= self.params.near:
                 self._link(j, i)
         self.current = i
         self.belief = np.eye(len(self.nodes))[i]
