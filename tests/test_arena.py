@@ -272,7 +272,7 @@ name, seed, params, readings = pickle.loads(open(sys.argv[1], "rb").read())
 brain = make_controller(name)
 brain.reset(seed, 0, params)
 actions = [as_action(brain.step(r)).tolist() for r in readings]
-pickle.dump((actions, "numba" in sys.modules), open(sys.argv[1] + ".out", "wb"))
+pickle.dump((actions, "numba" in sys.modules, "scipy" in sys.modules), open(sys.argv[1] + ".out", "wb"))
 """
 
 
@@ -293,7 +293,8 @@ def test_the_agents_compiled_astar_equals_the_jit():
     ("carrot", "zmaze"), ("wander", "zmaze"), ("bg", "bg-exp1"), ("fingerprint", "office"), ("dft", "zmaze"),
 ])  # fmt: skip
 def test_an_agent_process_steps_its_controller_without_numba_exactly_as_in_process(controller, ref, tmp_path):
-    """The agents' ahead-of-time kernels (swarm.kernels) give the JIT's actions, tick for tick."""
+    """The agents' ahead-of-time kernels (swarm.kernels) give the JIT's actions, tick for tick, in a process
+    without numba or scipy (each costs an agent process tens of MB: docs/distributed.md)."""
     import pickle
     import subprocess
     import sys
@@ -319,5 +320,6 @@ def test_an_agent_process_steps_its_controller_without_numba_exactly_as_in_proce
     given.write_bytes(pickle.dumps((controller, s.seed, controller_params(s, 0), readings)))
     out = subprocess.run([sys.executable, "-c", AOT_CHILD, str(given)], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
-    got, numba_loaded = pickle.loads((tmp_path / "given.pkl.out").read_bytes())
+    got, numba_loaded, scipy_loaded = pickle.loads((tmp_path / "given.pkl.out").read_bytes())
     assert got == actions and not numba_loaded
+    assert not scipy_loaded  # bg's routes and dft's transforms are compiled or loaded without the package
