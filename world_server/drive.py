@@ -21,11 +21,40 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from world_server import contacts
 
 WALL_TYPE, ROBOT_TYPE = 1, 2
 BLOCKED_SHARE = 0.5  # moving at under half of the commanded speed counts as blocked
+
+
+@njit(cache=True)
+def _push(v: np.ndarray, cos: np.ndarray, sin: np.ndarray, state: np.ndarray, dt: float, force: np.ndarray) -> None:
+    """The force that brings each disc's velocity (state[:, 2:]) to v along its heading in one substep,
+    into `force` as [fx0, fy0, fx1, ...] (pymunk's batch layout)."""
+    for i in range(v.shape[0]):
+        force[2 * i] = (v[i] * cos[i] - state[i, 2]) / dt
+        force[2 * i + 1] = (v[i] * sin[i] - state[i, 3]) / dt
+
+
+@njit(cache=True)
+def _moved(after: np.ndarray, state: np.ndarray, cos: np.ndarray, sin: np.ndarray, v: np.ndarray, w: np.ndarray,
+           dt: float, distance: np.ndarray, forward: np.ndarray, blocked: np.ndarray,
+           pose: np.ndarray) -> None:  # fmt: skip
+    """A substep's bookkeeping from where the discs went (`after`) and were (`state`): distance travelled,
+    forward progress along the heading, time blocked (under BLOCKED_SHARE of the commanded speed), and the
+    pose, its heading turned by w dt.  Each in the order of operations of the numpy expressions it replaced
+    (their numbers to the bit: numba's hypot and float modulo are numpy's)."""
+    for i in range(v.shape[0]):
+        sx, sy = after[i, 0] - state[i, 0], after[i, 1] - state[i, 1]
+        d = math.hypot(sx, sy)
+        distance[i] += d
+        forward[i] += sx * cos[i] + sy * sin[i]
+        speed = abs(v[i])
+        blocked[i] += dt if (speed > 1e-9 and d < BLOCKED_SHARE * speed * dt) else 0.0
+        pose[i, 0], pose[i, 1] = after[i, 0], after[i, 1]
+        pose[i, 2] = (pose[i, 2] + w[i] * dt) % (2 * math.pi)
 
 
 class DiffDrive:
@@ -135,22 +164,15 @@ class DiffDrive:
         state = self._positions()
         for _ in range(self.substeps):
             heading = self.pose[:, 2]
-            wanted = np.column_stack([v * np.cos(heading), v * np.sin(heading)])
-            self._force[: 2 * self.n] = ((wanted - state[:, 2:]) / self.dt).ravel()
+            cos, sin = np.cos(heading), np.sin(heading)  # numpy's (its SIMD values), once a substep
+            _push(v, cos, sin, state, self.dt, self._force)
             self._batch.set_space_bodies(self.space, self._batch.BodyFields.FORCE, self._set)
             self.space.step(self.dt)
             for i in pinned_at:
                 self._bodies[i].position = (float(pinned_at[i][0]), float(pinned_at[i][1]))
                 self._bodies[i].velocity = (0.0, 0.0)
             after = self._positions()
-            step = after[:, :2] - state[:, :2]
-            dist = np.hypot(step[:, 0], step[:, 1])
-            self.distance += dist
-            forward += step[:, 0] * np.cos(heading) + step[:, 1] * np.sin(heading)
-            slow = (np.abs(v) > 1e-9) & (dist < BLOCKED_SHARE * np.abs(v) * self.dt)
-            self.blocked_seconds += np.where(slow, self.dt, 0.0)
-            self.pose[:, :2] = after[:, :2]
-            self.pose[:, 2] = (heading + w * self.dt) % (2 * math.pi)
+            _moved(after, state, cos, sin, v, w, self.dt, self.distance, forward, self.blocked_seconds, self.pose)
             state = after
         self.motion[:, 0] = forward
         self.motion[:, 1] = (self.pose[:, 2] - start[:, 2] + math.pi) % (2 * math.pi) - math.pi
