@@ -11,6 +11,8 @@ from __future__ import annotations
 import time
 from statistics import median
 
+TARGET_REAL_TIME = 1000  # issue 15: one animat in-process, the GPR at its stable step included
+
 
 def _engine(ticks: int):
     from swarm.arena.engine import ArenaEngine
@@ -97,6 +99,9 @@ def format_bg_bench(r: dict) -> str:
     animat_and_world = r["ms"]["animat"] + r["ms"]["world"]
     lines.append(f"{'animat + world (in-process engine)':52s} {animat_and_world:9.3f} "
                  f"{round(r['period_s'] * 1000 / animat_and_world):12,d}")  # fmt: skip
+    factor = r["real_time"].get("animat", 0)
+    verdict = "met" if factor >= TARGET_REAL_TIME else "not met"
+    lines += ["", f"target: the whole animat at least {TARGET_REAL_TIME:,d}x real time: {factor:,d}x ({verdict})"]
     return "\n".join(lines)
 
 
