@@ -71,6 +71,41 @@ def test_bad_actions_are_counted_and_never_acted_on():
     assert w.tick == 5
 
 
+def test_the_compiled_wheel_checks_and_limits_are_numpys_to_the_bit():
+    from world_server.wheels import limited, refusals
+
+    rng = np.random.default_rng(8)
+    for width in (2, 3):
+        actions = rng.normal(0, 0.2, (400, width))
+        actions[rng.random((400, width)) < 0.05] = rng.choice([math.nan, math.inf, -math.inf])
+        if width == 3:
+            actions[:, 2] = rng.choice([0.0, 1.0, 2.0, 3.0, -1.0, 0.5, -0.0, 1e300], 400)
+        robots = rng.integers(0, 4, 400)
+        max_wheel = np.array([0.1, 0.2, 0.13, 0.3])
+        for with_acts in (True, False):
+            finite = np.isfinite(actions).all(axis=1)  # the numpy expressions the kernel replaced
+            wheels = np.where(finite[:, None], actions[:, :2], 0.0)
+            over = (np.abs(wheels) > max_wheel[robots, None] * (1 + 1e-9)).any(axis=1)
+            want = np.where(~finite, 0, np.where(over, 1, -1))
+            if width == 3:
+                act = np.where(finite, actions[:, -1], 0.0)
+                known = (act == np.round(act)) & (act >= 0) & (act < 3)
+                if not with_acts:
+                    known &= act == 0
+                want = np.where((want < 0) & ~known, 3, want)
+            got = np.empty(400, np.int64)
+            refusals(actions, max_wheel, robots, 3, with_acts, got)
+            assert np.array_equal(got, want)
+    wheels, axle = rng.normal(0, 0.3, (400, 2)), rng.uniform(0.05, 0.3, 400)
+    top, turn = rng.uniform(0.05, 0.3, 400), rng.uniform(0.1, 3.0, 400)
+    v, w = (wheels[:, 0] + wheels[:, 1]) / 2, (wheels[:, 1] - wheels[:, 0]) / axle
+    v = v * np.where(np.abs(v) > top, top / np.maximum(np.abs(v), 1e-12), 1.0)
+    w = w * np.where(np.abs(w) > turn, turn / np.maximum(np.abs(w), 1e-12), 1.0)
+    got = np.empty((400, 2))
+    limited(wheels, axle, top, turn, got)
+    assert np.array_equal(got, np.column_stack([v - w * axle / 2, v + w * axle / 2]))
+
+
 def test_a_scheduled_obstacle_blocks_only_while_present():
     extra = "[[obstacle]]\nrect = [0.6, 0.3, 0.7, 0.7]\nappear = 2\nvanish = 4\n"
     w = _world(0.4, 0.5, 0.0, extra=extra)

@@ -52,6 +52,42 @@ def test_a_full_energy_lasts_33_minutes_then_the_animat_dies_and_stops():
     assert np.array_equal(w.pose, pose)  # a dead animat does not move
 
 
+def test_a_metabolism_step_gives_the_numpy_formulas_numbers_to_the_bit():
+    from swarm.arena.models import ZONE_KINDS
+    from world_server.metabolism import Metabolism, MetabolismParams
+
+    rng = np.random.default_rng(9)
+    n, p, dt = 64, MetabolismParams(lifetime=30.0, danger_rate=0.05), 0.25
+    m = Metabolism(n, p, dt, [("food", "ingesting", (0.0, 0.0)), ("rest", "digesting", (1.0, 0.0))])
+    m.energy, m.potential = rng.uniform(0, 1, n), rng.uniform(0, 1, n)
+    energy, potential, alive = m.energy.copy(), m.potential.copy(), m.alive.copy()
+    acts_done, idle, died_tick = m.acts.copy(), m.idle_acts.copy(), m.died_tick.copy()
+    for tick in range(60):
+        acts, bits, moving = rng.integers(0, 3, n), rng.integers(0, 64, n), rng.random(n) < 0.9
+        m.step(acts, bits, moving, np.zeros((n, 2)), tick)
+        live = alive & moving  # the numpy formulas the kernel replaced
+        zone = {k: (bits & (1 << ZONE_KINDS.index(k))) != 0 for k in ("ingesting", "digesting", "dangerous")}
+        for code, kind in ((1, "digesting"), (2, "ingesting")):
+            works = live & (acts == code) & zone[kind]
+            idle += live & (acts == code) & ~works
+            acts_done[:, code] += works
+            if code == 2:
+                potential = np.where(works, np.minimum(1.0, potential + p.ingest_rate * dt), potential)
+            else:
+                gain = np.minimum.reduce([np.full(n, p.digest_rate * dt), potential, 1.0 - energy])
+                gain = np.where(works, np.maximum(gain, 0.0), 0.0)
+                energy, potential = energy + gain, potential - gain
+        loss = dt / p.lifetime + np.where(zone["dangerous"], p.danger_rate * dt, 0.0)
+        energy = np.where(alive, np.maximum(energy - loss, 0.0), energy)
+        died = alive & (energy <= 0.0)
+        died_tick[died] = tick
+        alive &= ~died
+        assert np.array_equal(m.energy, energy) and np.array_equal(m.potential, potential)
+        assert np.array_equal(m.alive, alive) and np.array_equal(m.died_tick, died_tick)
+        assert np.array_equal(m.acts, acts_done) and np.array_equal(m.idle_acts, idle)
+    assert 0 < alive.sum() < n  # some died on the way, some lived: every branch ran
+
+
 def test_reloading_works_only_in_a_zone_of_its_kind():
     w = _world(x=1.2, extra="potential = 0.5\nenergy = 0.5\n")  # 0.6 m from the food's centre: within reach
     before = w.metabolism.levels(np.array([0]))[0].copy()

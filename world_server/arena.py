@@ -20,9 +20,8 @@ from world_server.drive import DiffDrive
 from world_server.metabolism import ACTS, Metabolism
 from world_server.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
 from world_server.sensors import Suite
+from world_server.wheels import ACTION_LEN, ACTION_WIDTH, limited, refusals
 
-ACTION_LEN = 2  # left and right wheel speeds, m/s
-ACTION_WIDTH = 3  # ... and a consummatory act (world_server.metabolism.ACTS), optional: 0 when left out
 REJECT_REASONS = ("not finite", "over the wheel limit", "wrong shape", "unknown act")
 
 
@@ -207,16 +206,9 @@ class ArenaWorld:
     def _refusals(self, actions: np.ndarray, robots: np.ndarray) -> np.ndarray:
         """Per row of (k, 2) wheel speeds, or (k, 3) with an act, for these
         robots: the index in REJECT_REASONS of why it cannot be acted on, or -1."""
-        finite = np.isfinite(actions).all(axis=1)
-        wheels = np.where(finite[:, None], actions[:, :ACTION_LEN], 0.0)
-        over = (np.abs(wheels) > self.max_wheel[robots, None] * (1 + 1e-9)).any(axis=1)
-        why = np.where(~finite, 0, np.where(over, 1, -1))
-        if actions.shape[1] == ACTION_WIDTH:
-            act = np.where(finite, actions[:, -1], 0.0)
-            known = (act == np.round(act)) & (act >= 0) & (act < len(ACTS))
-            if self.metabolism is None:
-                known &= act == 0  # no metabolism here: no act means anything
-            why = np.where((why < 0) & ~known, 3, why)
+        why = np.empty(len(actions), np.int64)
+        refusals(np.ascontiguousarray(actions, np.float64), self.max_wheel, np.ascontiguousarray(robots, np.int64),
+                 len(ACTS), self.metabolism is not None, why)  # no metabolism here: no act means anything
         return why
 
     def judge(self, agent: int, wheels: np.ndarray) -> str | None:
@@ -269,12 +261,9 @@ class ArenaWorld:
 
     def _limit(self, wheels: np.ndarray) -> np.ndarray:
         """The model's forward-speed and turn-rate limits scale the wheel speeds down."""
-        v = (wheels[:, 0] + wheels[:, 1]) / 2
-        w = (wheels[:, 1] - wheels[:, 0]) / self.axle
-        sv = np.where(np.abs(v) > self.max_speed, self.max_speed / np.maximum(np.abs(v), 1e-12), 1.0)
-        sw = np.where(np.abs(w) > self.max_turn, self.max_turn / np.maximum(np.abs(w), 1e-12), 1.0)
-        v, w = v * sv, w * sw
-        return np.column_stack([v - w * self.axle / 2, v + w * self.axle / 2])
+        out = np.empty((self.n, ACTION_LEN))
+        limited(np.ascontiguousarray(wheels, np.float64), self.axle, self.max_speed, self.max_turn, out)
+        return out
 
     def _obstacles_at(self, tick: int) -> None:
         for k, o in enumerate(self.scenario.obstacles):

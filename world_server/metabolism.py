@@ -19,12 +19,50 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from swarm.arena.models import ZONE_KINDS
 
 ACTS = ("none", "ReloadE", "ReloadEp")
 ACT_ZONE = {1: "digesting", 2: "ingesting"}  # the zone kind each act needs
 STOPS = ("death", "ingest")
+
+
+_INGESTING, _DIGESTING, _DANGEROUS = (1 << ZONE_KINDS.index(k) for k in ("ingesting", "digesting", "dangerous"))
+
+
+@njit(cache=True)
+def _metabolise(acts: np.ndarray, zone_bits: np.ndarray, moving: np.ndarray, alive: np.ndarray, energy: np.ndarray,
+                potential: np.ndarray, done: np.ndarray, idle: np.ndarray, died_tick: np.ndarray, tick: int,
+                ingest: float, digest: float, loss: float, danger: float, ingest_tick: np.ndarray,
+                first: np.ndarray) -> bool:  # fmt: skip
+    """One control period in place (`ingest`, `digest`, `loss`, `danger` are the period's amounts): living robots
+    in `moving` do their acts where their zone bits allow (else the act is idle), every living robot's E runs
+    down (more within a dangerous area's reach), and one whose E reaches 0 dies.  Marks in `first` the robots
+    whose ReloadEp worked for the first time; True if any.  Each amount in the order of operations of the
+    numpy expressions this replaced (their numbers to the bit)."""
+    any_first = False
+    for i in range(acts.shape[0]):
+        code = acts[i]
+        if alive[i] and moving[i] and (code == 1 or code == 2):
+            if (zone_bits[i] & (_DIGESTING if code == 1 else _INGESTING)) == 0:
+                idle[i] += 1
+            elif code == 2:  # ReloadEp
+                done[i, 2] += 1
+                potential[i] = min(1.0, potential[i] + ingest)
+                if ingest_tick[i] < 0:
+                    first[i] = any_first = True
+            else:  # ReloadE: Ep becomes E, as much as there is of one and room for the other
+                done[i, 1] += 1
+                gain = max(min(min(digest, potential[i]), 1.0 - energy[i]), 0.0)
+                energy[i] = energy[i] + gain
+                potential[i] = potential[i] - gain
+        if alive[i]:
+            energy[i] = max(energy[i] - (loss + (danger if zone_bits[i] & _DANGEROUS else 0.0)), 0.0)
+            if energy[i] <= 0.0:
+                died_tick[i] = tick
+                alive[i] = False
+    return any_first
 
 
 @dataclass(frozen=True)
@@ -82,29 +120,14 @@ class Metabolism:
         """One control period: robots in `moving` (alive, present, acting) do their
         acts where their zones allow; every living robot's E runs down."""
         p, dt = self.p, self.dt
-        live = self.alive & moving
-        in_zone = {k: (zone_bits & (1 << ZONE_KINDS.index(k))) != 0 for k in ("ingesting", "digesting", "dangerous")}
-        for code, kind in ACT_ZONE.items():
-            asked = live & (acts == code)
-            works = asked & in_zone[kind]
-            self.idle_acts += asked & ~works
-            self.acts[:, code] += works
-            if code == 2:  # ReloadEp
-                self.potential = np.where(works, np.minimum(1.0, self.potential + p.ingest_rate * dt), self.potential)
-                first = works & (self.ingest_tick < 0)
-                for a in np.flatnonzero(first):
-                    self.ingest_tick[a] = tick
-                    self.ingest_resource[a] = self._nearest(xy[a], kind)
-            else:  # ReloadE: Ep becomes E, as much as there is of one and room for the other
-                gain = np.minimum.reduce([np.full(len(acts), p.digest_rate * dt), self.potential, 1.0 - self.energy])
-                gain = np.where(works, np.maximum(gain, 0.0), 0.0)
-                self.energy = self.energy + gain
-                self.potential = self.potential - gain
-        loss = dt / p.lifetime + np.where(in_zone["dangerous"], p.danger_rate * dt, 0.0)
-        self.energy = np.where(self.alive, np.maximum(self.energy - loss, 0.0), self.energy)
-        died = self.alive & (self.energy <= 0.0)
-        self.died_tick[died] = tick
-        self.alive &= ~died
+        first = np.zeros(len(acts), np.bool_)
+        if _metabolise(np.ascontiguousarray(acts, np.int64), np.ascontiguousarray(zone_bits, np.int64),
+                       np.ascontiguousarray(moving, np.bool_), self.alive, self.energy, self.potential, self.acts,
+                       self.idle_acts, self.died_tick, tick, p.ingest_rate * dt, p.digest_rate * dt,
+                       dt / p.lifetime, p.danger_rate * dt, self.ingest_tick, first):  # fmt: skip
+            for a in np.flatnonzero(first):  # a first ReloadEp that worked: at which resource
+                self.ingest_tick[a] = tick
+                self.ingest_resource[a] = self._nearest(xy[a], ACT_ZONE[2])
 
     def _nearest(self, xy: np.ndarray, kind: str) -> int:
         best, which = np.inf, -1
