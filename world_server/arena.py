@@ -227,9 +227,11 @@ class ArenaWorld:
             self.rejected["wrong shape"] += self.n
             return np.zeros(self.n, np.bool_)
         why = self._refusals(actions, np.arange(self.n))
-        for k in (0, 1, 3):
-            self.rejected[REJECT_REASONS[k]] += int((why == k).sum())
-        return why < 0
+        ok = why < 0
+        if not ok.all():  # count the refused by reason (most ticks refuse nothing)
+            for k in (0, 1, 3):
+                self.rejected[REJECT_REASONS[k]] += int((why == k).sum())
+        return ok
 
     def apply(self, actions: np.ndarray, ok: np.ndarray | None = None) -> None:
         """Integrate one control period from validated wheel speeds (rows with
