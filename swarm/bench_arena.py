@@ -77,18 +77,18 @@ def _measure(world: ArenaWorld, ticks: int) -> dict:
         t2 = time.perf_counter()
         senses.append(t1 - t0)
         physics_times.append(t2 - t1)
-    # medians: a shared machine's hiccups land in single ticks, and the big worlds run only a few dozen
-    sense, physics = median(senses) * ticks, median(physics_times) * ticks
+    # per tick, medians: a shared machine's hiccups land in single ticks, and the big worlds run only a few dozen
+    sense, physics = median(senses), median(physics_times)
     rays = n * sum(s.per_robot for s in world.suites) // max(len(world.suites), 1)
-    total = sense + physics
+    tick = sense + physics
     return {
         "robots": n,
         "rays_per_tick": rays,
-        "sense_ms": round(1000 * sense / ticks, 3),
-        "physics_ms": round(1000 * physics / ticks, 3),
-        "ticks_per_second": round(ticks / total, 1),
-        "robot_steps_per_second": round(n * ticks / total),
-        "rays_per_second": round(rays * ticks / sense) if sense else None,
+        "sense_ms": round(1000 * sense, 3),
+        "physics_ms": round(1000 * physics, 3),
+        "ticks_per_second": round(1 / tick, 1),
+        "robot_steps_per_second": round(n / tick),
+        "rays_per_second": round(rays / sense) if sense else None,
     }
 
 

@@ -20,9 +20,16 @@ from world_server.drive import DiffDrive
 from world_server.metabolism import ACTS, Metabolism
 from world_server.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
 from world_server.sensors import Suite
-from world_server.wheels import ACTION_LEN, ACTION_WIDTH, limited, refusals
-
-REJECT_REASONS = ("not finite", "over the wheel limit", "wrong shape", "unknown act")
+from world_server.wheels import (
+    ACTION_LEN,
+    ACTION_WIDTH,
+    NOT_FINITE,
+    OVER_LIMIT,
+    REJECT_REASONS,
+    UNKNOWN_ACT,
+    limited,
+    refusals,
+)
 
 
 def rect_edges(rect) -> list[tuple[float, float, float, float]]:
@@ -229,7 +236,7 @@ class ArenaWorld:
         why = self._refusals(actions, np.arange(self.n))
         ok = why < 0
         if not ok.all():  # count the refused by reason (most ticks refuse nothing)
-            for k in (0, 1, 3):
+            for k in (NOT_FINITE, OVER_LIMIT, UNKNOWN_ACT):
                 self.rejected[REJECT_REASONS[k]] += int((why == k).sum())
         return ok
 

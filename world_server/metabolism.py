@@ -28,7 +28,8 @@ ACT_ZONE = {1: "digesting", 2: "ingesting"}  # the zone kind each act needs
 STOPS = ("death", "ingest")
 
 
-_INGESTING, _DIGESTING, _DANGEROUS = (1 << ZONE_KINDS.index(k) for k in ("ingesting", "digesting", "dangerous"))
+_ZONE_OF_ACT = np.array([0] + [1 << ZONE_KINDS.index(ACT_ZONE[code]) for code in (1, 2)], np.int64)  # by ACTS code
+_DANGEROUS = 1 << ZONE_KINDS.index("dangerous")
 
 
 @njit(cache=True)
@@ -45,7 +46,7 @@ def _metabolise(acts: np.ndarray, zone_bits: np.ndarray, moving: np.ndarray, ali
     for i in range(acts.shape[0]):
         code = acts[i]
         if alive[i] and moving[i] and (code == 1 or code == 2):
-            if (zone_bits[i] & (_DIGESTING if code == 1 else _INGESTING)) == 0:
+            if (zone_bits[i] & _ZONE_OF_ACT[code]) == 0:
                 idle[i] += 1
             elif code == 2:  # ReloadEp
                 done[i, 2] += 1
