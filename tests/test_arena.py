@@ -133,6 +133,9 @@ def test_zones_are_sensed():
     ('[[group]]\ncount = 1\nspeed = 3\n', "speed"),
     ('[[zone]]\nkind = "lava"\ndisc = [0.5, 0.5, 0.1]\n[[group]]\n', "zone 1.kind"),
     ("[[obstacle]]\nrect = [0.3, 0.3, 0.4, 0.4]\nappear = 5\nvanish = 5\n[[group]]\n", "obstacle 1"),
+    ('[[group]]\ncount = 1\nrobot = { model = "epuck", ir = { mounts = [0.03] } }\n', "group 1.robot.ir.mounts"),
+    ('[[group]]\ncount = 1\nrobot = { model = "epuck", ir = { mounts = [0.05, 0.03, 0.03, 0.03, 0.03, 0.03, 0.03, '
+     '0.03] } }\n', "group 1.robot.ir.mounts"),
 ])  # fmt: skip
 def test_broken_arena_scenarios_name_the_field(body, where):
     with pytest.raises(ScenarioError) as err:

@@ -62,14 +62,30 @@ def _one(body_extra: str, start: str, robot: str = "epuck", noise: str = "none")
     (255, 1.0), (128, 0.2 + 0.8 * 128 / 255), ("[150, 110, 70]", 0.2 + 0.8 * 150 / 255),
 ])  # fmt: skip
 def test_ir_reads_the_response_curve_at_the_hand_computed_distance(colour, factor):
-    # A wall face at x = 0.55, the e-puck (radius 37 mm) at x = 0.5 facing it.  As Webots' infra-red
-    # sensors, a surface reflects by 0.2 + 0.8 * its red level: a white wall reads the curve at the true
-    # distance, a darker one as if farther.
+    # A wall face at x = 0.55, the e-puck at x = 0.5 facing it.  Its front sensors sit 31.6 mm from its
+    # centre (E-puck.proto), inside the 37 mm rim, and measure from there, as Webots does.  As Webots'
+    # infra-red sensors, a surface reflects by 0.2 + 0.8 * its red level: a white wall reads the curve
+    # at the true distance, a darker one as if farther.
     p = _one(f"[[wall]]\nrect = [0.55, 0.3, 0.6, 0.7]\ncolour = {colour}\n", "[0.5, 0.5, 0.0]")
     for k, bearing in ((0, -0.30), (7, 0.30)):
-        d = 0.05 / math.cos(bearing) - 0.037
+        d = 0.05 / math.cos(bearing) - 0.0316
         assert p["ir"][k] == pytest.approx(np.interp(d / factor, IR_DISTANCE, IR_VALUE), rel=1e-9)
     assert p["ir"][1] > 0 and p["ir"][3] == 0.0 and p["ir"][4] == 0.0  # the back sees nothing within 7 cm
+
+
+def test_ir_measures_from_each_sensor_so_a_touching_wall_reads_the_curve_at_rim_minus_mount():
+    # The e-puck's rim touches a white wall ahead: ps0 and ps7 (31.6 mm from the centre) read the curve
+    # at 5.4 mm, not at 0 (4095), and a model with its sensors on the rim reads it at 0.
+    wall = "[[wall]]\nrect = [0.537, 0.3, 0.6, 0.7]\ncolour = 255\n"
+    p = _one(wall, "[0.5, 0.5, 0.0]")
+    d = 0.037 / math.cos(0.30) - 0.0316
+    assert p["ir"][0] == pytest.approx(np.interp(d, IR_DISTANCE, IR_VALUE), rel=1e-9)
+    assert p["ir"][0] < 4095 * 0.6
+    on_rim = 'robot = { model = "epuck", ir = { mounts = [0.037, 0.037, 0.037, 0.037, 0.037, 0.037, 0.037, 0.037] } }'
+    body = wall + f'[[group]]\ncount = 1\ncontroller = "wander"\nstart = [0.5, 0.5, 0.0]\n{on_rim}\n'
+    rim = ArenaWorld(arena(body, noise="none")).perceive()[0]
+    assert rim["ir"][0] == pytest.approx(np.interp(0.037 / math.cos(0.30) - 0.037, IR_DISTANCE, IR_VALUE), rel=1e-9)
+    assert rim["ir"][0] > p["ir"][0]
 
 
 def test_camera_sector_sees_the_coloured_wall_ahead_and_its_grey_level():

@@ -46,7 +46,7 @@ class Noise:
 
 
 def ir_response(distance: np.ndarray) -> np.ndarray:
-    """Reading of an IR sensor whose ray met something `distance` from the rim."""
+    """Reading of an IR sensor whose ray met something `distance` from the sensor."""
     return np.interp(distance, IR_DISTANCE, IR_VALUE)
 
 
@@ -89,7 +89,7 @@ class Suite:
             centres = np.arange(o.count) * 2 * math.pi / o.count
             add("sonar", (centres[:, None] + cone[None, :]).ravel(), o.range)
         if s.ir:
-            add("ir", np.array(s.ir.bearings), s.ir.range, model.radius)
+            add("ir", np.array(s.ir.bearings), s.ir.range, model.ir_mounts())
         if s.laser:
             la = s.laser
             full = la.fov >= 2 * math.pi - 1e-9

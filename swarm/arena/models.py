@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 DEG = math.pi / 180.0
-# IR response: reading against distance from the rim (m), piecewise linear, 0 when the
+# IR response: reading against distance from the sensor (m), piecewise linear, 0 when the
 # ray meets nothing within range.  The shape of the e-puck calibration curves Webots
 # uses (4095 at contact, about 67 at 7 cm); the DFT controller only uses log(1 + p/50).
 IR_DISTANCE = np.array([0.0, 0.005, 0.01, 0.015, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07])
@@ -51,11 +51,15 @@ class Sonar:
 
 @dataclass(frozen=True)
 class IR:
-    """Infrared proximity sensors on the rim: a reading from the documented
-    response curve of the distance from the rim (docs/arena.md)."""
+    """Infrared proximity sensors looking out from the robot: a reading from the
+    documented response curve of the distance from the sensor (docs/arena.md)."""
 
     bearings: tuple[float, ...] = (-0.30, -0.80, -1.57, -2.64, 2.64, 1.57, 0.80, 0.30)  # e-puck ps0..ps7
     range: float = 0.07
+    # How far each sensor sits from the robot's centre (m); None: on the rim.  Distances are measured
+    # from the sensor, as Webots measures them, so a sensor inside the body reads a touching wall as
+    # (rim - mount) away, not as 0.
+    mounts: tuple[float, ...] | None = None
     noise: float = 0.0  # relative std of a reading
     # Webots' infra-red model (the DFT paper's simulator): a surface reflects by f = 0.2 + 0.8 * red level,
     # and the sensor reads the curve at d + (d / f - d) * red_sensitivity (Webots' redColorSensitivity,
@@ -122,6 +126,19 @@ class RobotModel:
     def with_sensors(self, **changes) -> RobotModel:
         return replace(self, sensors=replace(self.sensors, **changes))
 
+    def ir_mounts(self) -> np.ndarray:
+        """Each IR sensor's distance from the centre, where its range is measured from (ValueError if unusable)."""
+        ir = self.sensors.ir
+        if ir is None:
+            return np.zeros(0)
+        if ir.mounts is None:
+            return np.full(len(ir.bearings), self.radius)
+        mounts = np.asarray(ir.mounts, np.float64)
+        if mounts.shape != (len(ir.bearings),) or not np.all((mounts > 0) & (mounts <= self.radius)):
+            raise ValueError(f"ir.mounts: give one distance in (0, radius = {self.radius}] per bearing "
+                             f"({len(ir.bearings)}), or leave it out for sensors on the rim")  # fmt: skip
+        return mounts
+
 
 # Girard et al. (2005), section 3.2: 30 cm, 40 cm/s, 10 deg/s, a 36-sector camera,
 # 8 sonars (5 m, +-5 deg, +-10 cm), encoders +-5%, compass +-10 deg.
@@ -138,6 +155,10 @@ ANIMAT = RobotModel(
     sensors=Sensors(camera=Camera(rays_per_sector=1), sonar=Sonar(), odometry=Odometry(), compass=Compass()),
 )
 
+# Distance from the e-puck's centre of each of ps0..ps7 (E-puck.proto's sensor translations: (0.030, 0.010),
+# (0.022, 0.025), (0, 0.031), (0.030, 0.015), mirrored): the sensors sit 3.5-6 mm inside the 37 mm rim.
+EPUCK_IR_MOUNTS = (0.0316, 0.0333, 0.0310, 0.0335, 0.0335, 0.0310, 0.0333, 0.0316)
+
 # The e-puck of Billing et al. (2015) (Mondada et al. 2009): 74 mm, 53 mm axle,
 # 12.9 cm/s per wheel, 8 IR proximity sensors, the noisy position sensor, a compass
 # (the DFT robot reads its heading without noise: compass error 0).
@@ -149,7 +170,9 @@ EPUCK = RobotModel(
     max_speed=0.129,
     max_turn_rate=2 * 0.129 / 0.053,
     colour=(40, 160, 40),
-    sensors=Sensors(ir=IR(), position=Position(), compass=Compass(error=0.0), odometry=Odometry(error=0.0)),
+    sensors=Sensors(
+        ir=IR(mounts=EPUCK_IR_MOUNTS), position=Position(), compass=Compass(error=0.0), odometry=Odometry(error=0.0)
+    ),
 )
 
 # A mobile base with a 360-degree laser scanner and a panoramic colour camera

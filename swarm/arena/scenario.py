@@ -431,7 +431,12 @@ def _robot(value, source: str, where: str) -> RobotModel:
                      (int(v) if isinstance(getattr(base, k), int) and not isinstance(getattr(base, k), bool)
                       else float(v)) for k, v in table.items()}  # fmt: skip
             sensors = replace(sensors, **{key: replace(base, **typed)})
-    return replace(model, sensors=sensors)
+    model = replace(model, sensors=sensors)
+    try:
+        model.ir_mounts()
+    except ValueError as exc:
+        raise ScenarioError(source, f"{where}.ir.mounts", str(exc).partition(": ")[2]) from None
+    return model
 
 
 def _noise(value, source: str) -> Noise:
@@ -722,6 +727,7 @@ def controller_params(s: ArenaScenario, agent: int) -> dict[str, Any]:
             "max_turn_rate": m.max_turn_rate,
             "laser_range": m.sensors.laser.range if m.sensors.laser else None,
             "ir_bearings": list(m.sensors.ir.bearings) if m.sensors.ir else None,
+            "ir_mounts": m.ir_mounts().tolist() if m.sensors.ir else None,
         },
         "control_period": s.control_period,
         "noise": s.noise.level,

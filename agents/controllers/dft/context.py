@@ -45,10 +45,12 @@ def grown(mask: np.ndarray, by: int) -> np.ndarray:
 
 
 class SensedContext:
-    def __init__(self, walls: np.ndarray, cell: float, radius: float, bearings, margin: float,
+    def __init__(self, walls: np.ndarray, cell: float, radius: float, bearings, mounts, margin: float,
                  mark_radius: float, memory: int, min_reading: float):  # fmt: skip
+        """`mounts`: each sensor's distance from the robot's centre, where its range is measured from."""
         self.shape, self.cell, self.radius = walls.shape, cell, radius
         self.bearings = np.asarray(bearings, np.float64)
+        self.mounts = np.broadcast_to(np.asarray(mounts, np.float64), self.bearings.shape)
         self.memory, self.min_reading = memory, min_reading
         grow = max(1, round(margin / cell))
         self.known = grown(np.asarray(walls, bool), grow)
@@ -82,7 +84,7 @@ class SensedContext:
         hit = ir >= self.min_reading
         marked = cleared = np.zeros((0, 2), np.int64)
         if hit.any():
-            rng = self.radius + np.interp(ir[hit], IR_VALUE[::-1], IR_DISTANCE[::-1])
+            rng = self.mounts[hit] + np.interp(ir[hit], IR_VALUE[::-1], IR_DISTANCE[::-1])
             points = np.column_stack([x + rng * np.cos(angle[hit]), y + rng * np.sin(angle[hit])])
             cj = np.clip(np.floor(points[:, 1] / self.cell).astype(int), 0, self.shape[0] - 1)
             ci = np.clip(np.floor(points[:, 0] / self.cell).astype(int), 0, self.shape[1] - 1)
@@ -90,10 +92,9 @@ class SensedContext:
             marked = self._cells(points[unknown], self.disc)
         free = ir <= 0
         if free.any():
-            steps = self.radius + np.arange(0.0, IR_DISTANCE[-1] + 1e-9, self.cell)
+            steps = self.mounts[free][:, None] + np.arange(0.0, IR_DISTANCE[-1] + 1e-9, self.cell)[None, :]
             a = angle[free][:, None]
-            points = np.column_stack([(x + steps[None, :] * np.cos(a)).ravel(),
-                                      (y + steps[None, :] * np.sin(a)).ravel()])  # fmt: skip
+            points = np.column_stack([(x + steps * np.cos(a)).ravel(), (y + steps * np.sin(a)).ravel()])
             cleared = self._cells(points, np.zeros((1, 2), np.int64))
         if len(cleared):  # only what was marked is news to the others
             cleared = cleared[self.seen[cleared[:, 0], cleared[:, 1]] != NEVER]

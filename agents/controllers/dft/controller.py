@@ -49,7 +49,7 @@ class DftParams:
     sense_margin: float = 0.03  # sensed: a point this close to a wall of the map is the wall
     mark_radius: float = 0.04  # sensed: the disc a point marks (the robot's radius: the room it takes from one passing)
     memory: int = 300  # sensed: ticks a mark lasts unless seen again (about 19 s)
-    min_reading: float = 120.0  # sensed: IR readings from this up count (about 5 cm from the rim)
+    min_reading: float = 120.0  # sensed: IR readings from this up count (5 cm from the sensor, a white wall)
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> DftParams:
@@ -96,7 +96,8 @@ class DftController:
         self.shares = None
         self.received = 0  # cells other robots marked that reached this one
         if self.p.obstacles == "sensed":
-            self.sensed = SensedContext(walls, self.p.cell, float(robot["radius"]), robot["ir_bearings"],
+            mounts = robot.get("ir_mounts") or float(robot["radius"])  # sensors on the rim unless told
+            self.sensed = SensedContext(walls, self.p.cell, float(robot["radius"]), robot["ir_bearings"], mounts,
                                         self.p.sense_margin, self.p.mark_radius, self.p.memory,
                                         self.p.min_reading)  # fmt: skip
             self.shares = "context"
