@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from agents.controllers.tables import params_from_table
-from swarm.arena.models import IR_DISTANCE, IR_VALUE
+from swarm.arena.models import IR, IR_DISTANCE, IR_VALUE
 from swarm.rng_scalar import draw_unit
 
 
@@ -37,6 +37,7 @@ class WanderParams:
 
 
 FRONT = math.radians(60)
+EPUCK_IR_BEARINGS = IR().bearings
 
 
 class WanderController:
@@ -46,6 +47,10 @@ class WanderController:
         robot = params["robot"]
         self.radius, self.axle = float(robot["radius"]), float(robot["axle"])
         self.max_wheel = float(robot["max_wheel_speed"])
+        # where the IR sensors look and sit (their readings count from their mounts); the e-puck's if not told
+        self.ir_bearings = np.asarray(robot.get("ir_bearings") or EPUCK_IR_BEARINGS, np.float64)
+        mounts = robot.get("ir_mounts")
+        self.ir_mounts = np.full(len(self.ir_bearings), self.radius) if mounts is None else np.asarray(mounts, float)
         self.tick = 0
         self.turning = 0  # ticks of random turn left (sign: direction)
 
@@ -56,9 +61,9 @@ class WanderController:
                 continue
             values = np.asarray(perception[name], np.float64)
             n = len(values)
-            if name == "ir":  # readings to distances: invert the response curve, from the rim
-                dist = np.where(values > 0, np.interp(-values, -IR_VALUE, IR_DISTANCE) + self.radius, np.inf)
-                bearings = np.array([-0.30, -0.80, -1.57, -2.64, 2.64, 1.57, 0.80, 0.30])[:n]
+            if name == "ir":  # readings to distances from the centre: invert the response curve, add the mount
+                dist = np.where(values > 0, np.interp(-values, -IR_VALUE, IR_DISTANCE) + self.ir_mounts[:n], np.inf)
+                bearings = self.ir_bearings[:n]
             else:
                 dist, bearings = values, np.arange(n) * 2 * math.pi / n
             bearings = (bearings + math.pi) % (2 * math.pi) - math.pi
