@@ -17,16 +17,22 @@ from pathlib import Path
 
 import numpy as np
 
-from swarm.arena.experiments import LARGE_HEADING, _fmt, pool_map, random_pairs, run_pair, write_runs, zmaze_pairs
+from swarm.arena.experiments import (
+    LARGE_HEADING,
+    RUN_FIELDS,
+    _fmt,
+    pool_map,
+    random_pairs,
+    run_pair,
+    write_runs,
+    zmaze_pairs,
+)
 from swarm.experiments import _pyplot, _save
 from swarm.scenario import ScenarioError
 
 CONDITIONS = (("dft", "low"), ("dft", "high"), ("carrot", "none"), ("carrot", "low"), ("carrot", "high"))
 PAPER_F = {"zmaze": 0.97, "large-maze": 0.98}
 CASE_SCENARIO = {"dft-case1": "zmaze", "dft-case2": "large-maze", "dft-case3": "zmaze", "dft-together": "zmaze"}
-PAIR_FIELDS = ["scenario", "controller", "noise", "pair", "start_x", "start_y", "goal_x", "goal_y", "reached",
-               "ticks", "ticks_to_goal", "path_length", "optimal_length", "path_ratio", "collisions",
-               "wall_seconds"]  # fmt: skip
 
 # Case 3 (parameters.md, zmaze.toml [case3]): start east of the middle bar on the goal's row (our choice:
 # the repository does not keep it; north route 1.00 m, south 1.19 m by A*), goal = the green marker's cell.
@@ -425,7 +431,7 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
         order = [label(c, n) for c, n in CONDITIONS]
         rows.sort(key=lambda r: (order.index(label(r["controller"], r["noise"])), r["pair"]))
         summary, md = summarise_pairs(rows)
-        write_runs(out, "runs.csv", PAIR_FIELDS, rows, summary)
+        write_runs(out, "runs.csv", RUN_FIELDS, rows, summary)
         plot_pairs(rows, out / "plot.png")
         number = case[-1]
         title = (f"# Case {number} (Billing et al. 2015): SPA beside follow the carrot in {expected}\n\n{reps} "

@@ -29,8 +29,11 @@ SCENARIOS = ("zmaze", "large-maze")
 PAIR_STREAM = 0x50414952
 LARGE_HEADING = 4.983
 CLEARANCE = 0.04
+# one start/goal run (run_pair), for the carrot and the dft experiments; where the robot ended tells a
+# failure's place (a run that stalls in a passage, say) without running it again
 RUN_FIELDS = ["scenario", "controller", "noise", "pair", "start_x", "start_y", "goal_x", "goal_y", "reached", "ticks",
-              "ticks_to_goal", "path_length", "optimal_length", "path_ratio", "collisions", "wall_seconds"]  # fmt: skip
+              "ticks_to_goal", "path_length", "optimal_length", "path_ratio", "collisions", "final_x", "final_y",
+              "wall_seconds"]  # fmt: skip
 # The paper reports these results as bar charts only (Figures 7, 8; not available to us) and, in
 # its text, F of a one-way ANOVA over all five conditions (SPA and FTC) of path length.
 PAPER_F = {"zmaze": 0.97, "large-maze": 0.98}
@@ -84,7 +87,8 @@ def run_pair(job: tuple) -> dict:
             "goal_x": gx, "goal_y": gy,
             "reached": r["reached"], "ticks": summary["ticks"], "ticks_to_goal": r["ticks_to_goal"],
             "path_length": r["path_length"], "optimal_length": r["optimal_length"], "path_ratio": r["path_ratio"],
-            "collisions": r["collisions"], "wall_seconds": summary["wall_seconds"]}  # fmt: skip
+            "collisions": r["collisions"], "final_x": r["pose"][0], "final_y": r["pose"][1],
+            "wall_seconds": summary["wall_seconds"]}  # fmt: skip
 
 
 def plan_jobs(scenarios: list[str], reps: int, seed: int) -> list[tuple]:
