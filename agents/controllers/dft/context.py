@@ -50,7 +50,7 @@ class SensedContext:
         """`mounts`: each sensor's distance from the robot's centre, where its range is measured from."""
         self.shape, self.cell, self.radius = walls.shape, cell, radius
         self.bearings = np.asarray(bearings, np.float64)
-        self.mounts = np.broadcast_to(np.asarray(mounts, np.float64), self.bearings.shape)
+        self.mounts = np.asarray(mounts, np.float64)
         self.memory, self.min_reading = memory, min_reading
         grow = max(1, round(margin / cell))
         self.known = grown(np.asarray(walls, bool), grow)

@@ -96,8 +96,8 @@ class DftController:
         self.shares = None
         self.received = 0  # cells other robots marked that reached this one
         if self.p.obstacles == "sensed":
-            mounts = robot.get("ir_mounts") or float(robot["radius"])  # sensors on the rim unless told
-            self.sensed = SensedContext(walls, self.p.cell, float(robot["radius"]), robot["ir_bearings"], mounts,
+            self.sensed = SensedContext(walls, self.p.cell, float(robot["radius"]), robot["ir_bearings"],
+                                        robot["ir_mounts"],
                                         self.p.sense_margin, self.p.mark_radius, self.p.memory,
                                         self.p.min_reading)  # fmt: skip
             self.shares = "context"

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from agents.controllers.tables import params_from_table
-from swarm.arena.models import IR, IR_DISTANCE, IR_VALUE
+from swarm.arena.models import IR_DISTANCE, IR_VALUE
 from swarm.rng_scalar import draw_unit
 
 
@@ -37,7 +37,6 @@ class WanderParams:
 
 
 FRONT = math.radians(60)
-EPUCK_IR_BEARINGS = IR().bearings
 
 
 class WanderController:
@@ -47,10 +46,9 @@ class WanderController:
         robot = params["robot"]
         self.radius, self.axle = float(robot["radius"]), float(robot["axle"])
         self.max_wheel = float(robot["max_wheel_speed"])
-        # where the IR sensors look and sit (their readings count from their mounts); the e-puck's if not told
-        self.ir_bearings = np.asarray(robot.get("ir_bearings") or EPUCK_IR_BEARINGS, np.float64)
-        mounts = robot.get("ir_mounts")
-        self.ir_mounts = np.full(len(self.ir_bearings), self.radius) if mounts is None else np.asarray(mounts, float)
+        # where the IR sensors look and sit (their readings count from their mounts); none without IR
+        self.ir_bearings = np.asarray(robot.get("ir_bearings") or (), np.float64)
+        self.ir_mounts = np.asarray(robot.get("ir_mounts") or (), np.float64)
         self.tick = 0
         self.turning = 0  # ticks of random turn left (sign: direction)
 
