@@ -156,7 +156,7 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument(
         "--scenario",
         help="carrot: zmaze or large-maze (default both); fingerprint-*: a floor with "
-        "'mapping' and 'localize' routes and place zones (default office)",
+        "'mapping', 'localize' and 'localize-off-map' routes and place zones (default office)",
     )
     exp.add_argument("--reps", type=_positive, help="runs per configuration (default per experiment)")
     exp.add_argument("--noise", choices=["none", "low", "high"], help="dft-*: only the conditions at this noise level")

@@ -97,6 +97,7 @@ def test_office_tours_have_the_documented_lengths_and_the_mapping_tour_is_driven
     lengths = {k: sum(math.dist(a, b) for a, b in itertools.pairwise(r)) for k, r in s.routes.items()}
     assert lengths["mapping"] == pytest.approx(75, rel=0.05)
     assert lengths["localize"] == pytest.approx(250, rel=0.05)
+    assert lengths["localize-off-map"] == pytest.approx(250, rel=0.05)
     summary = ArenaEngine(s).run()
     robot = summary["robots"][0]
     assert summary["finished"] and robot["collisions"] == 0 and robot["path_ratio"] < 1.1

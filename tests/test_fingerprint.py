@@ -239,6 +239,61 @@ def test_a_sharper_correction_brings_a_belief_back_from_a_look_alike_place_soone
     assert sharp < plain < 50
 
 
+def _dark_walk(localize) -> list[tuple[float, int]]:
+    """From a known start at 'a', walk the corridor in the dark (views that match no node better than another):
+    (true position, believed node) after each step of 0.25 m."""
+    out, pos = [], 0.0
+    localize("a", np.zeros(2))  # the lights are on at the start
+    while pos < 7.0:
+        pos += 0.25
+        out.append((pos, int(np.argmax(localize("dark", np.array([0.25, 0.0]))))))
+    return out
+
+
+def test_the_grid_belief_follows_the_odometry_where_the_views_say_nothing():
+    """Places a, x, b, y along a corridor; in the dark only odometry can say where the robot is.
+    On the map's odometric grid the belief moves with it, node by node; over the links alone a
+    node is left at a constant rate per view, wherever in the node the robot is."""
+    from agents.controllers.navigation.gridbelief import GridBelief, GridParams
+
+    m = corridor_map()  # a at x 0-1, x at 2-3, b at 4-5, y at 6-7 (observations every 0.5 m)
+    grid = GridBelief(m, GridParams(cell=0.1))
+
+    def on_grid(label, moved):  # in the dark a view favours no node, and no place off the map either
+        like = m.signatures.likelihoods(label, m.means()) if label != "dark" else np.full(4, grid.p.off_map)
+        return grid.update(like, moved)
+
+    def over_links(label, moved):
+        return m.localize(label, moved)[1]
+
+    def node_at(x: float) -> int:
+        return min(3, int((x + 0.5) // 2))
+
+    away = [(x, b) for x, b in _dark_walk(on_grid) if abs((x + 0.5) % 2 - 1.0) < 0.7 and x <= 7.0]
+    assert away and all(b == node_at(x) for x, b in away)  # right wherever the robot is not near a boundary
+    m.belief = np.zeros(0)
+    wrong = [(x, b) for x, b in _dark_walk(over_links) if abs((x + 0.5) % 2 - 1.0) < 0.7 and b != node_at(x)]
+    assert wrong  # the links alone lose count in the dark
+
+
+def test_a_grid_belief_is_saved_and_restored_exactly():
+    from agents.controllers.navigation.gridbelief import GridBelief
+
+    m = corridor_map()
+    a = GridBelief(m)
+    for label in "aaxx":
+        a.update(m.signatures.likelihoods(label, m.means()), np.array([0.37, 0.0]))
+    b = GridBelief(m)
+    b.restore(json.loads(json.dumps(a.to_data())))
+    for label in "xbb":
+        like = m.signatures.likelihoods(label, m.means())
+        assert np.array_equal(a.update(like, np.array([0.37, 0.0])), b.update(like, np.array([0.37, 0.0])))
+    with pytest.raises(ValueError, match="cells saved"):
+        b.restore({"belief": [1.0], "residual": [0.0, 0.0]})
+    with pytest.raises(ValueError, match="seen_at"):
+        GridBelief(TopoMap(Labels()))
+
+
 def test_a_loop_is_closed_through_localization():
     m = corridor_map()
     nodes = len(m.nodes)
@@ -285,10 +340,34 @@ def test_the_mapping_tour_takes_about_500_fingerprints_and_maps_every_place_it_p
 def test_localization_on_the_second_tour_beats_matching_alone_and_chance():
     from swarm.arena.fingerprint import localize_job
 
-    row = localize_job(("office", "low", 0))
-    assert row["fingerprints"] >= 1000 and row["on_map"] >= 900
+    row = localize_job(("office", "low", 0, "localize"))
+    assert row["fingerprints"] >= 1000 and row["on_map"] >= 0.95 * row["fingerprints"]  # it stays on the map
     assert row["match_correct"] > 5 * row["chance"]  # matching alone well above chance
-    assert row["markov_correct"] > row["match_correct"] + 0.03  # the filter clearly above matching alone
+    assert row["links_markov_correct"] > row["match_correct"] + 0.03  # a filter clearly above matching alone
+    assert row["markov_correct"] >= 0.98 and row["markov_correct"] > row["links_markov_correct"]  # the grid more
+
+
+def test_a_restored_localizing_controller_goes_on_exactly_as_the_one_it_was_taken_from():
+    from swarm.arena.engine import ArenaEngine
+    from swarm.arena.fingerprint import tour_scenario
+    from swarm.arena.scenario import controller_params
+
+    s = tour_scenario("office", "localize", "low", 1000)
+    params = controller_params(s, 0)
+    params["fingerprint"] = {**params.get("fingerprint", {}), "mode": "localize"}
+    params["topomap"] = mapping_tour()[1]["map"]
+    a, b = ArenaEngine(s), ArenaEngine(s)
+    a.controllers[0].reset(s.seed, 0, params)
+    a.step(300)
+    state = json.loads(json.dumps(a.controllers[0].snapshot()))
+    b.world.restore(a.world.snapshot())
+    b.controllers[0].reset(s.seed, 0, params)
+    b.controllers[0].restore(state)
+    a.step(200)
+    b.step(200)
+    ra, rb = a.controllers[0], b.controllers[0]
+    assert ra.log == rb.log and len(ra.log) > 20
+    assert np.array_equal(ra.belief, rb.belief) and np.array_equal(ra.grid.belief, rb.grid.belief)
 
 
 def test_a_restored_controller_goes_on_exactly_as_the_one_it_was_taken_from():
@@ -337,6 +416,10 @@ def test_a_bad_fingerprint_table_names_the_field(tmp_path):
     r = run_cli("run", str(path), "--controller", "fingerprint", "--max-ticks", "5")
     assert r.returncode == 2
     assert "0 < theta < 1" in r.stderr and "Traceback" not in r.stderr
+    path.write_text((BUNDLED_DIR / "office.toml").read_text() + '\n[fingerprint]\nfilter = "kalman"\n')
+    r = run_cli("run", str(path), "--controller", "fingerprint", "--max-ticks", "5")
+    assert r.returncode == 2
+    assert "[fingerprint].filter: 'kalman'; expected one of grid, links" in r.stderr and "Traceback" not in r.stderr
     with pytest.raises(ScenarioError):
         load_scenario(str(tmp_path / "missing.toml"))
 

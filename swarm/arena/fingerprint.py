@@ -8,11 +8,15 @@ Tapus, Battaglia & Siegwart (2006), section 3, on the `office` floor.
 - map: the ~76 m mapping tour, a fingerprint every 15 cm (~500), the map's
   nodes against the floor's 20 ground-truth places, and the node count as
   theta varies (the paper: 20 nodes);
-- localize: the map of the mapping tour, then the ~255 m localization tour
-  (~1700 fingerprints): the share of fingerprints placed at the right node
-  by matching alone (paper 81%) and by the Markov filter (paper 100%), and
-  the rank of the right node among the matches when matching alone misses
-  (paper: 2nd or 3rd).
+- localize: the map of the mapping tour, then the ~253 m localization tour
+  (~1770 fingerprints, every one on the mapped floor, as the paper's robot
+  stayed on its map): the share of fingerprints placed at the right node
+  by matching alone (paper 81%) and by the Markov filter (paper 100%: ours
+  on the map's odometric grid, and over the links alone beside it), and the
+  rank of the right node among the matches when matching alone misses
+  (paper: 2nd or 3rd); then the same on the `localize-off-map` tour, which
+  also enters the eight rooms the mapping tour did not (our addition: what
+  leaving the map costs).
 
 Both at the sensors' specified noise ("low") and with it doubled ("high").
 Ground truth (the robot's true pose, the place zones) is read by this module
@@ -20,9 +24,9 @@ only, to judge the maps; the controller never sees it.  A node's place is
 the place where most of its fingerprints were taken (for the map against
 the floor's places).  A fingerprint of the second tour is localized right
 when its node holds a mapping fingerprint taken where the nearest one was
-(within TOLERANCE more); the second tour also enters rooms the first did
-not, and fingerprints farther than OFF_MAP from every mapping fingerprint
-are left out of the shares (their count is reported).
+(within TOLERANCE more); fingerprints farther than OFF_MAP from every
+mapping fingerprint (off the mapped floor) are left out of the shares
+(their count is reported).
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ from swarm.scenario import ScenarioError
 NOISES = ("low", "high")
 THETAS = (0.2, 0.35, 0.5, 0.65, 0.8)
 PAPER_NODES, PAPER_MATCH, PAPER_MARKOV = 20, 0.81, 1.00
+LOCALIZE_TOURS = ("localize", "localize-off-map")  # on the mapped floor (the paper's case), and leaving it
 OFF_MAP = 1.0  # a fingerprint taken farther than this from every mapping fingerprint is off the mapped floor
 TOLERANCE = 0.5  # nodes whose mapping fingerprints lie this much farther than the nearest count as right too
 
@@ -68,7 +73,7 @@ def tour_scenario(name: str, route: str, noise: str, seed: int, table: dict | No
     s = load_scenario(name)
     if route not in s.routes:
         raise ScenarioError(name, "routes", f"no route {route!r}; the fingerprint experiments need "
-                            "'mapping' and 'localize' routes")  # fmt: skip
+                            "'mapping', 'localize' and 'localize-off-map' routes")  # fmt: skip
     first = s.routes[route][0]
     nxt = s.routes[route][1] if len(s.routes[route]) > 1 else (first[0] + 1, first[1])
     heading = math.atan2(nxt[1] - first[1], nxt[0] - first[0])
@@ -102,11 +107,12 @@ def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000) -> dict[
             truth.append(before)
             likelihoods.append(np.asarray(c.map.likelihood, np.float64).copy())
             prints.append(c.current)
-    log = np.array(c.log, np.int64).reshape(-1, 4)
+    log = np.array(c.log, np.int64).reshape(-1, 5)
     resolve = np.vectorize(c.map.resolve, otypes=[np.int64])  # a node folded later stands for the one it joined
-    believed, matched = (resolve(log[:, 1]), resolve(log[:, 2])) if len(log) else (log[:, 1], log[:, 2])
+    believed, matched, by_links = (resolve(log[:, k]) if len(log) else log[:, k] for k in (1, 2, 4))
     return {"ticks": engine.tick, "truth": np.array(truth).reshape(-1, 3), "believed": believed,
-            "matched": matched, "size": c.map.size, "likelihoods": likelihoods, "map": c.map_data(),
+            "matched": matched, "believed_links": by_links, "size": c.map.size, "likelihoods": likelihoods,
+            "map": c.map_data(),
             "closures": c.map.closures, "fingerprints": prints, "finished": c.finished,
             "wall_seconds": engine.wall_seconds}  # fmt: skip
 
@@ -155,28 +161,31 @@ def right_nodes(mapped: dict, xy: np.ndarray) -> set[int] | None:
 
 
 def localize_job(job: tuple) -> dict:
-    name, noise, seed = job
+    name, noise, seed, route = job
     s = tour_scenario(name, "mapping", noise, seed)
     mapped = drive_tour(s)
     k = mapped["size"]
-    loc = drive_tour(tour_scenario(name, "localize", noise, seed + 1000), topomap=mapped["map"])
-    by_match, by_markov, ranks, chance, off = [], [], [], [], 0
-    for xy, matched, believed, like in zip(loc["truth"][:, :2], loc["matched"], loc["believed"], loc["likelihoods"],
-                                           strict=True):  # fmt: skip
+    loc = drive_tour(tour_scenario(name, route, noise, seed + 1000), topomap=mapped["map"])
+    by_match, by_markov, by_links, ranks, chance, off = [], [], [], [], [], 0
+    for xy, matched, believed, linked, like in zip(loc["truth"][:, :2], loc["matched"], loc["believed"],
+                                                   loc["believed_links"], loc["likelihoods"], strict=True):  # fmt: skip
         right = right_nodes(mapped, xy)
         if right is None:
             off += 1
             continue
         by_match.append(int(matched) in right)
         by_markov.append(int(believed) in right)
+        by_links.append(int(linked) in right)
         chance.append(len(right) / k)
         if not by_match[-1]:  # where the right node comes among the matches
             order = np.argsort(-like, kind="stable")
             ranks.append(int(np.flatnonzero(np.isin(order, list(right)))[0]) + 1)
     ranks = np.array(ranks, np.int64)
-    return {"scenario": name, "noise": noise, "seed": seed, "map_nodes": k, "fingerprints": len(loc["matched"]),
+    return {"scenario": name, "route": route, "noise": noise, "seed": seed, "map_nodes": k,
+            "fingerprints": len(loc["matched"]),
             "on_map": len(by_match), "off_map": off, "match_correct": round(float(np.mean(by_match)), 4),
-            "markov_correct": round(float(np.mean(by_markov)), 4), "chance": round(float(np.mean(chance)), 4),
+            "markov_correct": round(float(np.mean(by_markov)), 4),
+            "links_markov_correct": round(float(np.mean(by_links)), 4), "chance": round(float(np.mean(chance)), 4),
             "missed_rank2": int((ranks == 2).sum()), "missed_rank3": int((ranks == 3).sum()),
             "missed_rank_over3": int((ranks > 3).sum()), "ticks": loc["ticks"], "finished": loc["finished"],
             "wall_seconds": round(mapped["wall_seconds"] + loc["wall_seconds"], 2)}  # fmt: skip
@@ -259,26 +268,29 @@ def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | Non
         return _calibrate(name, seed, out)
     if which == "fingerprint-map":
         work = [(name, noise, seed + r, theta, "mapping") for noise in NOISES for r in range(reps) for theta in THETAS]
-        work += [(name, noise, seed + r, 0.5, "localize") for noise in NOISES for r in range(reps)]  # loops
+        work += [(name, noise, seed + r, 0.5, route) for route in LOCALIZE_TOURS for noise in NOISES
+                 for r in range(reps)]  # loops  # fmt: skip
         rows = _pool(map_job, work, jobs, which, progress)
-        rows.sort(key=lambda r: (r["route"] != "mapping", NOISES.index(r["noise"]), r["theta"], r["seed"]))
+        rows.sort(key=lambda r: (("mapping", *LOCALIZE_TOURS).index(r["route"]), NOISES.index(r["noise"]), r["theta"],
+                                 r["seed"]))  # fmt: skip
         md = _map_table(rows, name, reps, seed)
         plot_map(rows, name, seed, out / "plot.png")
     elif which == "fingerprint-localize":
-        work = [(name, noise, seed + r) for noise in NOISES for r in range(reps)]
+        work = [(name, noise, seed + r, route) for route in LOCALIZE_TOURS for noise in NOISES for r in range(reps)]
         rows = _pool(localize_job, work, jobs, which, progress)
-        rows.sort(key=lambda r: (NOISES.index(r["noise"]), r["seed"]))
+        rows.sort(key=lambda r: (LOCALIZE_TOURS.index(r["route"]), NOISES.index(r["noise"]), r["seed"]))
         md = _localize_table(rows, name, reps, seed)
         plot_localize(rows, out / "plot.png")
     else:
         raise ValueError(f"unknown fingerprint experiment {which!r}")
     _write_csv(out / "runs.csv", rows)
     (out / "table.md").write_text(md)
-    summary = [{"noise": n, **{k: round(_mean([r for r in rows if r["noise"] == n and
-                                              (which != "fingerprint-map" or (r["theta"] == 0.5
-                                               and r["route"] == "mapping"))], k), 4)
-                               for k in rows[0] if isinstance(rows[0][k], (int, float)) and k != "seed"}}
-               for n in NOISES]  # fmt: skip
+    tours = ("mapping",) if which == "fingerprint-map" else LOCALIZE_TOURS
+    summary = [{"route": t, "noise": n,
+                **{k: round(_mean([r for r in rows if r["noise"] == n and r["route"] == t and
+                                   (which != "fingerprint-map" or r["theta"] == 0.5)], k), 4)
+                   for k in rows[0] if isinstance(rows[0][k], (int, float)) and k != "seed"}}
+               for t in tours for n in NOISES]  # fmt: skip
     _write_csv(out / "summary.csv", summary)
     return {"name": which, "out": str(out), "runs": len(rows), "rows": rows, "summary": summary, "markdown": md}
 
@@ -290,7 +302,7 @@ def _map_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
              f"{tour[0]['places_visited']} of the floor's places.\n",
              "| tour | noise | theta | fingerprints | nodes | paper | places with a node | nodes per place | "
              "purity | loops closed |", "|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
-    for route in ("mapping", "localize"):
+    for route in ("mapping", *LOCALIZE_TOURS):
         for noise in NOISES:
             for theta in THETAS:
                 sel = [r for r in rows if r["route"] == route and r["noise"] == noise and r["theta"] == theta]
@@ -302,8 +314,9 @@ def _map_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
                              f"{sel[0]['places_visited']} | {_mean(sel, 'nodes_per_place'):.2f} | "
                              f"{_mean(sel, 'purity'):.3f} | {_mean(sel, 'closures'):.1f} |")  # fmt: skip
     lines.append("\nPurity: the share of fingerprints whose node's place (where most of its fingerprints were "
-                 "taken) is where they were taken.  The `localize` tour (255 m) enters rooms two and three times: "
-                 "mapped with it, a place seen again should join its node (a loop closed), not add one.  The "
+                 "taken) is where they were taken.  The localization tours (~255 m) enter rooms two and three times "
+                 "(`localize` the mapping tour's eight, `localize-off-map` all sixteen): mapped with one, a place "
+                 "seen again should join its node (a loop closed), not add one.  The "
                  "paper's theta is not given (\"determined experimentally\"); ours is 0.5, the calibrated "
                  "probability's even odds.")  # fmt: skip
     return "\n".join(lines) + "\n"
@@ -312,26 +325,32 @@ def _map_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
 def _localize_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
     lines = [
         f"# Fingerprint localization (Tapus et al. 2006), `{name}`\n",
-        f"Map from the mapping tour, then the localization tour; {reps} runs per noise level "
+        f"Map from the mapping tour, then a localization tour; {reps} runs per tour and noise level "
         f"(seeds {seed}..{seed + reps - 1}).\n",
-        "| noise | map nodes | fingerprints (on the map) | matching alone | paper | Markov filter | paper | "
-        "chance | misses by matching: right node 2nd / 3rd / lower |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| tour | noise | map nodes | fingerprints (on the map) | matching alone | paper | Markov filter | paper | "
+        "links only | chance | misses by matching: right node 2nd / 3rd / lower |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for noise in NOISES:
-        sel = [r for r in rows if r["noise"] == noise]
-        if not sel:
-            continue
-        m, k = _mean(sel, "match_correct"), _mean(sel, "markov_correct")
-        lines.append(f"| {noise} | {_mean(sel, 'map_nodes'):.1f} | {_mean(sel, 'fingerprints'):.0f} "
-                     f"({_mean(sel, 'on_map'):.0f}) | {m:.1%} | {PAPER_MATCH:.0%} ({m - PAPER_MATCH:+.1%}) | {k:.1%} | "
-                     f"{PAPER_MARKOV:.0%} ({k - PAPER_MARKOV:+.1%}) | {_mean(sel, 'chance'):.1%} | "
-                     f"{_mean(sel, 'missed_rank2'):.0f} / {_mean(sel, 'missed_rank3'):.0f} / "
-                     f"{_mean(sel, 'missed_rank_over3'):.0f} |")  # fmt: skip
+    for route in LOCALIZE_TOURS:
+        for noise in NOISES:
+            sel = [r for r in rows if r["noise"] == noise and r["route"] == route]
+            if not sel:
+                continue
+            m, k = _mean(sel, "match_correct"), _mean(sel, "markov_correct")
+            lines.append(f"| {route} | {noise} | {_mean(sel, 'map_nodes'):.1f} | {_mean(sel, 'fingerprints'):.0f} "
+                         f"({_mean(sel, 'on_map'):.0f}) | {m:.1%} | {PAPER_MATCH:.0%} ({m - PAPER_MATCH:+.1%}) | "
+                         f"{k:.1%} | {PAPER_MARKOV:.0%} ({k - PAPER_MARKOV:+.1%}) | "
+                         f"{_mean(sel, 'links_markov_correct'):.1%} | {_mean(sel, 'chance'):.1%} | "
+                         f"{_mean(sel, 'missed_rank2'):.0f} / {_mean(sel, 'missed_rank3'):.0f} / "
+                         f"{_mean(sel, 'missed_rank_over3'):.0f} |")  # fmt: skip
     lines.append(f"\nRight: the node holds a mapping fingerprint taken where the nearest one was (within "
-                 f"{TOLERANCE} m more); fingerprints farther than {OFF_MAP} m from every mapping fingerprint (rooms "
-                 "the first tour did not enter) are left out.  Chance: a node drawn at random.  The paper's floor "
-                 "and tours are not available; ours are in docs/fingerprint.md.")  # fmt: skip
+                 f"{TOLERANCE} m more); fingerprints farther than {OFF_MAP} m from every mapping fingerprint (the "
+                 "rooms the mapping tour did not enter) are left out.  Markov filter: the belief on the map's "
+                 "odometric grid (the controller's default); links only: the same likelihoods through the "
+                 "link-only motion model.  The paper's robot stayed on its map (`localize`); "
+                 "`localize-off-map` also enters the eight rooms the mapping tour did not.  Chance: a node "
+                 "drawn at random.  The paper's floor and tours are not available; ours are in "
+                 "docs/fingerprint.md.")  # fmt: skip
     return "\n".join(lines) + "\n"
 
 
@@ -412,17 +431,21 @@ def plot_localize(rows: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    x = np.arange(len(NOISES))
-    for off, key, label in ((-0.2, "match_correct", "matching alone"), (0.2, "markov_correct", "Markov filter")):
-        ax.bar(x + off, [_mean([r for r in rows if r["noise"] == n], key) for n in NOISES], 0.4, label=label)
+    fig, ax = plt.subplots(figsize=(8, 5.2))
+    groups = [(route, n) for route in LOCALIZE_TOURS for n in NOISES]
+    x = np.arange(len(groups))
+    bars = (("match_correct", "matching alone"), ("links_markov_correct", "Markov, links only"),
+            ("markov_correct", "Markov filter (grid)"))  # fmt: skip
+    for i, (key, label) in enumerate(bars):
+        ax.bar(x + (i - 1) * 0.27, [_mean([r for r in rows if (r["route"], r["noise"]) == g], key) for g in groups],
+               0.27, label=label)  # fmt: skip
     ax.axhline(PAPER_MATCH, color="C0", ls="--", lw=1, label="paper, matching (81%)")
-    ax.axhline(PAPER_MARKOV, color="C1", ls="--", lw=1, label="paper, Markov (100%)")
-    ax.plot(x, [_mean([r for r in rows if r["noise"] == n], "chance") for n in NOISES], "k_", ms=30,
+    ax.axhline(PAPER_MARKOV, color="C2", ls="--", lw=1, label="paper, Markov (100%)")
+    ax.plot(x, [_mean([r for r in rows if (r["route"], r["noise"]) == g], "chance") for g in groups], "k_", ms=30,
             label="chance")  # fmt: skip
-    ax.set(xticks=x, xticklabels=[f"noise {n}" for n in NOISES], ylim=(0, 1.05), ylabel="share at the right place",
-           title="localization on the second tour")  # fmt: skip
-    ax.legend(loc="lower right", fontsize=8)
+    ax.set(xticks=x, xticklabels=[f"{route}\nnoise {n}" for route, n in groups], ylim=(0, 1.05),
+           ylabel="share at the right place", title="localization on the second tour")  # fmt: skip
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3, fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -25,12 +25,14 @@ from agents.controllers.fingerprint.signatures import (
     map_from_data,  # fmt: skip
     map_to_data,
 )
+from agents.controllers.navigation.gridbelief import GridBelief
 from agents.controllers.navigation.mapshare import SharedMap
 from agents.controllers.navigation.topomap import MapParams, TopoMap
 from agents.controllers.tables import params_from_table
 
 DRIVES = ("route", "explore")
 MODES = ("map", "localize")
+FILTERS = ("grid", "links")
 
 
 @dataclass(frozen=True)
@@ -42,15 +44,18 @@ class FingerprintParams:
     keep: int = 30  # fingerprints a node keeps for its mean
     closure: float = 0.5  # belief in a known node that closes a loop
     sharpness: float = 2.0  # the Markov filter weighs nodes by P(match) ** sharpness (docs/fingerprint.md)
+    filter: str = "grid"  # localizing, the belief that decides: on the map's odometric grid, or over links only
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> FingerprintParams:
-        p = params_from_table(cls, table, "fingerprint", ints=("keep",), texts=("drive", "mode"),
+        p = params_from_table(cls, table, "fingerprint", ints=("keep",), texts=("drive", "mode", "filter"),
                               nested=("features", "align"))  # fmt: skip
         if p.drive not in DRIVES:
             raise ValueError(f"[fingerprint].drive: {p.drive!r}; expected one of {', '.join(DRIVES)}")
         if p.mode not in MODES:
             raise ValueError(f"[fingerprint].mode: {p.mode!r}; expected one of {', '.join(MODES)}")
+        if p.filter not in FILTERS:
+            raise ValueError(f"[fingerprint].filter: {p.filter!r}; expected one of {', '.join(FILTERS)}")
         if not (p.spacing > 0 and 0 < p.theta < 1 and p.keep >= 1 and 0 < p.sharpness <= 10):
             raise ValueError("[fingerprint]: spacing > 0, 0 < theta < 1, keep >= 1 and 0 < sharpness <= 10 "
                              "are required")  # fmt: skip
@@ -95,8 +100,10 @@ class FingerprintController:
                     "(swarm experiment fingerprint-localize builds one with a mapping tour first)"
                 )
             self.map = map_from_data(params["topomap"], self.signatures, map_params)
+            self.grid: GridBelief | None = GridBelief(self.map)
         else:
             self.map = TopoMap(self.signatures, map_params)
+            self.grid = None
         if self.p.drive == "route":
             from agents.controllers.carrot import CarrotController
 
@@ -115,7 +122,9 @@ class FingerprintController:
         self.since = math.inf  # metres since the last fingerprint (inf: take one at once)
         self.current: Fingerprint | None = None
         self.believed, self.matched = -1, -1
-        self.log: list[tuple[int, int, int, int]] = []  # (tick, believed node, matched node, nodes in the map)
+        self.belief = np.zeros(0)  # over nodes: the map's own while mapping, the chosen filter's while localizing
+        # (tick, believed node, matched node, nodes in the map, node believed by the links-only filter)
+        self.log: list[tuple[int, int, int, int, int]] = []
 
     @property
     def finished(self) -> bool:
@@ -147,12 +156,18 @@ class FingerprintController:
         if self.p.mode == "map":
             self.believed = self.map.observe(self.current, self.position, moved)
             self.shared.adopt(self.believed)
-            likelihood = self.map.likelihood
+            likelihood, self.belief = self.map.likelihood, self.map.belief
+            by_links = self.believed
         else:
-            likelihood, belief = self.map.localize(self.current, moved)
-            self.believed = int(np.argmax(belief))
+            likelihood, self.belief = self.map.localize(self.current, moved)  # the links-only filter, always run
+            by_links = int(np.argmax(self.belief))
+            if self.grid is not None:
+                on_grid = self.grid.update(likelihood, moved)
+                if self.p.filter == "grid":
+                    self.belief = on_grid
+            self.believed = int(np.argmax(self.belief))
         self.matched = int(np.argmax(likelihood)) if len(likelihood) else self.believed
-        self.log.append((self.tick, self.believed, self.matched, len(self.map.nodes)))
+        self.log.append((self.tick, self.believed, self.matched, len(self.map.nodes), by_links))
 
     def publish(self) -> dict[str, Any] | None:
         """What changed in the map this tick, for the other robots (mapping only)."""
@@ -175,7 +190,9 @@ class FingerprintController:
         return {"tick": self.tick, "position": self.position.tolist(), "last_position": self.last_position.tolist(),
                 "since": self.since, "map": self.map_data(), "log": [list(r) for r in self.log],
                 "driver": _plain(self.driver.snapshot()), "shared": self.shared.to_data(),
-                "params": asdict(self.p)}  # fmt: skip
+                "params": asdict(self.p), "grid": self.grid.to_data() if self.grid is not None else None,
+                "belief": np.asarray(self.belief).tolist(), "believed": self.believed,
+                "matched": self.matched}  # fmt: skip
 
     def restore(self, state: dict[str, Any]) -> None:
         self.tick, self.since = int(state["tick"]), float(state["since"])
@@ -183,6 +200,11 @@ class FingerprintController:
         self.map = map_from_data(state["map"], self.signatures, self.map.params)
         self.shared = SharedMap(self.map, self.agent, fingerprint_data, fingerprint_from_data)
         self.shared.restore(state["shared"])
+        if self.grid is not None:
+            self.grid = GridBelief(self.map)
+            self.grid.restore(state["grid"])
+        self.belief = np.array(state.get("belief", []), np.float64)
+        self.believed, self.matched = int(state.get("believed", -1)), int(state.get("matched", -1))
         self.log = [tuple(row) for row in state["log"]]
         self.driver.restore(state["driver"])
 
@@ -193,7 +215,7 @@ class FingerprintController:
         out["nodes"] = np.array(self.map.size)
         out["folded"] = np.array(sorted(self.map.folded), np.int64)
         out["links"] = np.array(list(self.map.links), np.int64).reshape(-1, 2)
-        out["belief"] = np.asarray(self.map.belief, np.float64)
+        out["belief"] = np.asarray(self.belief if self.p.mode == "localize" else self.map.belief, np.float64)
         if self.current is not None:
             out["fingerprint"] = self.current.codes
         return out
