@@ -338,14 +338,17 @@ def test_the_mapping_tour_takes_about_500_fingerprints_and_maps_every_place_it_p
 
 
 def test_a_room_revisit_counts_as_closed_when_it_joins_the_nodes_made_before():
-    from swarm.arena.fingerprint import room_revisits
+    from swarm.arena.fingerprint import first_use, room_revisits
 
     place = np.array([0, 0, 0, 1, 1, 1, 0, 0, 0, 1])  # room 0, corridor 1, room 0 again
     rooms = np.array([True, False])
-    assert room_revisits(place, np.array([0, 0, 0, 1, 1, 1, 0, 0, 2, 1]), rooms) == (1, 1)
-    assert room_revisits(place, np.array([0, 0, 0, 1, 1, 1, 2, 2, 2, 1]), rooms) == (1, 0)  # a new node: not closed
-    assert room_revisits(place, np.array([0, 0, 0, 1, 1, 1, 0, 0, 0, 1]), ~rooms) == (0, 0)  # a corridor's second
-    # visit here is one fingerprint long: no visit
+
+    def revisits(believed: list[int], where: np.ndarray) -> tuple[int, int]:
+        return room_revisits(place, first_use(np.array(believed)), where)
+
+    assert revisits([0, 0, 0, 1, 1, 1, 0, 0, 2, 1], rooms) == (1, 1)
+    assert revisits([0, 0, 0, 1, 1, 1, 2, 2, 2, 1], rooms) == (1, 0)  # a new node: not closed
+    assert revisits([0, 0, 0, 1, 1, 1, 0, 0, 0, 1], ~rooms) == (0, 0)  # the corridor's second visit is one print
 
 
 def test_localization_on_the_second_tour_beats_matching_alone_and_chance():

@@ -134,26 +134,28 @@ def judge_map(run: dict, zones: list) -> dict[str, Any]:
     live = np.setdiff1d(np.arange(len(labels)), [a for a, _ in run["map"].get("folded", [])])
     per_place = np.bincount(labels[live], minlength=len(zones))
     rooms = np.array([name.startswith("room") for name, _ in zones], np.bool_)
-    revisits, closed = room_revisits(truth, run["believed"], rooms)
+    first = first_use(run["believed"])
+    revisits, closed = room_revisits(truth, first, rooms)
     return {"fingerprints": len(truth), "nodes": run["size"], "places_visited": len(visited),
             "places_with_node": int(sum(per_place[p] > 0 for p in visited)),
             "nodes_per_place": round(run["size"] / max(len(visited), 1), 2), "purity": round(float(pure), 4),
             "links": len(run["map"]["links"]), "closures": run["closures"], "room_revisits": revisits,
             "room_revisits_closed": closed,
-            "corridor_seen_again_on_old_node": round(ground_seen_again(run, truth, ~rooms), 4)}  # fmt: skip
+            "corridor_seen_again_on_old_node": round(ground_seen_again(run["truth"][:, :2], first, truth, ~rooms),
+                                                     4)}  # fmt: skip
 
 
-def _first_use(believed: np.ndarray) -> np.ndarray:
+def first_use(believed: np.ndarray) -> np.ndarray:
     """Per fingerprint, the index of the first fingerprint that joined its node (when the node was made)."""
     first: dict[int, int] = {}
     return np.array([first.setdefault(int(b), i) for i, b in enumerate(believed)], np.int64)
 
 
-def room_revisits(place: np.ndarray, believed: np.ndarray, rooms: np.ndarray, least: int = 3) -> tuple[int, int]:
+def room_revisits(place: np.ndarray, first: np.ndarray, rooms: np.ndarray, least: int = 3) -> tuple[int, int]:
     """Loops closed where the paper counts them, in rooms: (visits to a room seen on an earlier visit,
-    those whose fingerprints mostly joined nodes made before the visit began).  A visit is a run of at
-    least `least` fingerprints in one place."""
-    first, seen, revisits, closed, i = _first_use(believed), set(), 0, 0, 0
+    those whose fingerprints mostly joined nodes made before the visit began; `first`: first_use).
+    A visit is a run of at least `least` fingerprints in one place."""
+    seen, revisits, closed, i = set(), 0, 0, 0
     while i < len(place):
         j = i
         while j < len(place) and place[j] == place[i]:
@@ -167,12 +169,12 @@ def room_revisits(place: np.ndarray, believed: np.ndarray, rooms: np.ndarray, le
     return revisits, closed
 
 
-def ground_seen_again(run: dict, place: np.ndarray, where: np.ndarray, near: float = 0.3, lag: int = 20) -> float:
+def ground_seen_again(xy: np.ndarray, first: np.ndarray, place: np.ndarray, where: np.ndarray, near: float = 0.3,
+                      lag: int = 20) -> float:  # fmt: skip
     """Of the fingerprints taken within `near` of one taken at least `lag` fingerprints (3 m) earlier, in
     the places marked in `where`, the share that joined a node made before that earlier one's time came
     round again (a node older than `lag` fingerprints): the corridor, where a place zone is 8 m long and
     "a visit" means little, seen again is judged by position."""
-    xy, first = run["truth"][:, :2], _first_use(run["believed"])
     again = old = 0
     for i in range(lag + 1, len(xy)):
         if not where[place[i]] or np.hypot(*(xy[: i - lag] - xy[i]).T).min() > near:

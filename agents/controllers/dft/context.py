@@ -48,7 +48,7 @@ class SensedContext:
     def __init__(self, walls: np.ndarray, cell: float, radius: float, bearings, mounts, margin: float,
                  mark_radius: float, memory: int, min_reading: float):  # fmt: skip
         """`mounts`: each sensor's distance from the robot's centre, where its range is measured from."""
-        self.shape, self.cell, self.radius = walls.shape, cell, radius
+        self.shape, self.cell = walls.shape, cell
         self.bearings = np.asarray(bearings, np.float64)
         self.mounts = np.asarray(mounts, np.float64)
         self.memory, self.min_reading = memory, min_reading

@@ -122,7 +122,7 @@ class FingerprintController:
         self.since = math.inf  # metres since the last fingerprint (inf: take one at once)
         self.current: Fingerprint | None = None
         self.believed, self.matched = -1, -1
-        self.belief = np.zeros(0)  # over nodes: the map's own while mapping, the chosen filter's while localizing
+        self.belief = np.zeros(0)  # over nodes, localizing: the chosen filter's (mapping, the map holds its own)
         # (tick, believed node, matched node, nodes in the map, node believed by the links-only filter)
         self.log: list[tuple[int, int, int, int, int]] = []
 
@@ -156,16 +156,12 @@ class FingerprintController:
         if self.p.mode == "map":
             self.believed = self.map.observe(self.current, self.position, moved)
             self.shared.adopt(self.believed)
-            likelihood, self.belief = self.map.likelihood, self.map.belief
-            by_links = self.believed
+            likelihood, by_links = self.map.likelihood, self.believed
         else:
-            likelihood, self.belief = self.map.localize(self.current, moved)  # the links-only filter, always run
-            by_links = int(np.argmax(self.belief))
-            if self.grid is not None:
-                on_grid = self.grid.update(likelihood, moved)
-                if self.p.filter == "grid":
-                    self.belief = on_grid
-            self.believed = int(np.argmax(self.belief))
+            likelihood, over_links = self.map.localize(self.current, moved)  # both filters run, both are logged
+            on_grid = self.grid.update(likelihood, moved)
+            self.belief = on_grid if self.p.filter == "grid" else over_links
+            by_links, self.believed = int(np.argmax(over_links)), int(np.argmax(self.belief))
         self.matched = int(np.argmax(likelihood)) if len(likelihood) else self.believed
         self.log.append((self.tick, self.believed, self.matched, len(self.map.nodes), by_links))
 

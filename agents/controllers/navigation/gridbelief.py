@@ -59,15 +59,17 @@ class GridBelief:
         margin = self.p.reach + self.p.cell
         self.origin = xy.min(axis=0) - margin
         self.shape = tuple(math.ceil(s) for s in (xy.max(axis=0) + margin - self.origin) / self.p.cell)
-        self.node_of = _nearest_owner(self.origin, self.shape, self.p.cell, xy, np.array(owners), self.p.reach)
-        self.mapped = self.node_of >= 0
-        self.cells = np.where(self.mapped, self.node_of, 0)  # node index per cell (0 where off the map: weighed apart)
-        self.belief = np.where(self.mapped, 1.0 / self.mapped.sum(), 0.0)  # global localization: anywhere on the map
+        node_of = _nearest_owner(self.origin, self.shape, self.p.cell, xy, np.array(owners), self.p.reach)
+        self.mapped = node_of >= 0
+        self.cells = np.where(self.mapped, node_of, 0)  # node index per cell (0 where off the map: weighed apart)
+        self.mapped_nodes = node_of[self.mapped]  # the node of each mapped cell, in the order belief[mapped] reads
+        self.uniform = self.mapped / self.mapped.sum()  # the same belief on every mapped cell, none off the map
+        self.belief = self.uniform.copy()  # global localization: anywhere on the map
         self.residual = np.zeros(2)  # motion smaller than a cell, not applied yet
 
     def nodes(self) -> np.ndarray:
         """The belief over the map's nodes (the mass on cells off the map left out, then normalised)."""
-        b = np.bincount(self.cells[self.mapped], weights=self.belief[self.mapped], minlength=len(self.map.nodes))
+        b = np.bincount(self.mapped_nodes, weights=self.belief[self.mapped], minlength=len(self.map.nodes))
         total = b.sum()
         return b / total if total > 0 else np.full(len(b), 1.0 / len(b))
 
@@ -79,10 +81,9 @@ class GridBelief:
         self.residual = total - shift
         b = _shifted(self.belief, int(shift[0]), int(shift[1]))
         a = min(0.25, 0.5 * self.p.slip**2 * moved / self.p.cell**2)  # a 3-tap kernel [a, 1-2a, a] has variance 2a
-        if a > 0:
-            for axis in (0, 1):
-                b = (1 - 2 * a) * b + a * (_shifted(b, 1, 0) + _shifted(b, -1, 0) if axis == 0
-                                           else _shifted(b, 0, 1) + _shifted(b, 0, -1))  # fmt: skip
+        if a > 0:  # along x, then along y
+            b = (1 - 2 * a) * b + a * (_shifted(b, 1, 0) + _shifted(b, -1, 0))
+            b = (1 - 2 * a) * b + a * (_shifted(b, 0, 1) + _shifted(b, 0, -1))
         self.belief = b
 
     def correct(self, likelihood: np.ndarray) -> None:
@@ -92,8 +93,8 @@ class GridBelief:
         w = np.where(self.mapped, weight[self.cells] + p.floor, self.p.off_map)
         b = self.belief * w
         total = b.sum()
-        b = b / total if total > 0 else np.where(self.mapped, 1.0, 0.0) / self.mapped.sum()
-        self.belief = (1 - self.p.spread) * b + np.where(self.mapped, self.p.spread / self.mapped.sum(), 0.0)
+        b = b / total if total > 0 else self.uniform
+        self.belief = (1 - self.p.spread) * b + self.p.spread * self.uniform
 
     def update(self, likelihood: np.ndarray, displacement: np.ndarray) -> np.ndarray:
         """Predict with the odometry since the last observation, correct with this one's
