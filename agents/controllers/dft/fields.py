@@ -145,14 +145,20 @@ def lateral_image(shape: tuple[int, ...], lat: Lateral) -> np.ndarray:
     return img
 
 
-def logistic(u: np.ndarray, beta: float, out: np.ndarray) -> np.ndarray:
-    """f(u) = 1 / (1 + exp(-beta u)), written as 0.5 + 0.5 tanh(beta u / 2) (the same function; numpy's
-    float32 tanh is vectorised, exp through numba is not)."""
-    np.multiply(u, DTYPE(0.5 * beta), out=out)
-    np.tanh(out, out=out)
-    np.multiply(out, DTYPE(0.5), out=out)
-    np.add(out, DTYPE(0.5), out=out)
-    return out
+def _tanh_half(scaled: np.ndarray) -> np.ndarray:
+    """The sigmoid f(u) = 1 / (1 + exp(-beta u)) as 0.5 + 0.5 tanh(x), in place, from x = beta u / 2 (the
+    same function; numpy's float32 tanh is vectorised, exp through numba is not).  The rest is one
+    compiled pass; x * 0.5 is exact, so its numbers are numpy's multiply and add."""
+    np.tanh(scaled, out=scaled)
+    _half_up(scaled.reshape(-1))
+    return scaled
+
+
+@exported("dft_half_up", "void(float32[:])")
+@njit(cache=True)
+def _half_up(x):
+    for c in range(x.size):
+        x[c] = x[c] * np.float32(0.5) + np.float32(0.5)
 
 
 _IH_SCALE = np.float32(1.0 / 65536.0)
@@ -185,21 +191,32 @@ def noise_key(seed, agent, tick, stream):
     return mix64(h ^ (np.uint64(stream) * np.uint64(0xA24BAED4963EE407)))
 
 
-@exported("dft_euler", "void(float32[:, :], float32[:, :], float32[:], float32[:], float32[:], uint64)")
+@exported("dft_euler", "void(float32[:, :], float32[:, :], float32[:], float32[:], float32[:], float32[:], "
+          "float32[:], float32[:, :], uint64)")  # fmt: skip
 @njit(cache=True)
-def _euler(u, inp, taus, hs, amps, key):
-    """u[k] += (-u + h + input + amp * xi) / tau for every field k of a stack (F, n)."""
+def _euler(u, inp, uniform, taus, hs, amps, half_betas, scaled, key):
+    """u[k] += (-u + h + input + amp * xi) / tau for every field k of a stack (F, n), where the input
+    gets its field's uniform part first (and keeps it: `input_of` reports it); `scaled[k]` gets
+    u[k] * beta_k / 2, the argument of the output's tanh (`_tanh_half`).  One pass instead of four."""
     n = u.shape[1]
     for k in range(u.shape[0]):
-        inv, h, amp = np.float32(1.0) / taus[k], hs[k], amps[k]
+        inv, h, amp, uni, hb = np.float32(1.0) / taus[k], hs[k], amps[k], uniform[k], half_betas[k]
         fkey = mix64(key ^ (np.uint64(k + 1) * _GOLDEN))
-        uk, ik = u[k], inp[k]
+        uk, ik, sk = u[k], inp[k], scaled[k]
         if amp != 0:
             for c in range(n):
-                uk[c] += (h - uk[c] + ik[c] + amp * normal_ih(fkey, c)) * inv
+                i = ik[c] + uni
+                ik[c] = i
+                v = uk[c] + (h - uk[c] + i + amp * normal_ih(fkey, c)) * inv
+                uk[c] = v
+                sk[c] = v * hb
         else:
             for c in range(n):
-                uk[c] += (h - uk[c] + ik[c]) * inv
+                i = ik[c] + uni
+                ik[c] = i
+                v = uk[c] + (h - uk[c] + i) * inv
+                uk[c] = v
+                sk[c] = v * hb
 
 
 @exported("dft_mac", "void(complex64[:, :], complex64[:, :], complex64[:, :], int64[:], boolean[:], int64[:], "
@@ -264,13 +281,7 @@ class _Group:
         self.taus = np.array([f.tau for f in fields], DTYPE)
         self.hs = np.array([f.h for f in fields], DTYPE)
         self.amps = np.array([f.noise for f in fields], DTYPE)
-        # fields with the same beta side by side get their outputs in one vectorised call
-        self.beta_runs: list[tuple[int, int, float]] = []
-        for k, f in enumerate(fields):
-            if self.beta_runs and self.beta_runs[-1][2] == f.beta and self.beta_runs[-1][1] == k:
-                self.beta_runs[-1] = (self.beta_runs[-1][0], k + 1, f.beta)
-            else:
-                self.beta_runs.append((k, k + 1, f.beta))
+        self.half_betas = np.array([DTYPE(0.5 * f.beta) for f in fields], DTYPE)
         self.images = np.zeros((len(inputs), self.size), DTYPE)
         self.ext_spec = np.zeros((len(inputs), int(np.prod(half))), CDTYPE)
         self.dirty = np.ones(len(inputs), np.bool_)
@@ -287,8 +298,8 @@ class _Group:
         self._outputs()
 
     def _outputs(self) -> None:
-        for start, stop, beta in self.beta_runs:
-            logistic(self.u[start:stop], beta, self.out[start:stop])
+        np.multiply(self.u, self.half_betas[:, None], out=self.out)
+        _tanh_half(self.out)
 
     def inputs_from_couplings(self) -> None:
         """Every field's input from the current outputs (before any field is updated)."""
@@ -306,9 +317,8 @@ class _Group:
         pocketfft.irfftn(self.acc.reshape(-1, *self.half), self.shape, self.axes, self.inp.reshape(-1, *self.shape))
 
     def update(self, key) -> None:
-        self.inp += self.uniform[:, None]
-        _euler(self.u, self.inp, self.taus, self.hs, self.amps, key)
-        self._outputs()
+        _euler(self.u, self.inp, self.uniform, self.taus, self.hs, self.amps, self.half_betas, self.out, key)
+        _tanh_half(self.out)  # the outputs from the scaled activations _euler left in them
 
 
 class Engine:
