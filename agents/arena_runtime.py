@@ -72,7 +72,9 @@ class ArenaAgentRuntime(AgentRuntime):
     def _send_plans(self, tick: int, agents: list[int]) -> None:
         """A controller's new plan goes to the world once, for the recording."""
         for agent in agents:
-            path = self.brains[self.slot_of[agent]].record().get("path")
+            # route(), not record(): a DFT robot's record stacks MBs of fields, a BG animat's walks its map
+            route = getattr(self.brains[self.slot_of[agent]], "route", None)
+            path = None if route is None else route()
             if path is None or len(path) < 2:
                 continue
             key = (len(path), *np.asarray(path[0]).tolist(), *np.asarray(path[-1]).tolist())

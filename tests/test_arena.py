@@ -361,3 +361,21 @@ def test_an_agent_process_steps_its_controller_without_numba_exactly_as_in_proce
     got, numba_loaded, scipy_loaded = pickle.loads((tmp_path / "given.pkl.out").read_bytes())
     assert got == actions and not numba_loaded
     assert not scipy_loaded  # bg's routes and dft's transforms are compiled or loaded without the package
+
+
+@pytest.mark.parametrize(("controller", "ref", "has_route"), [
+    ("carrot", "zmaze", True), ("fingerprint", "office", True), ("wander", "zmaze", False), ("dft", "zmaze", False),
+])  # fmt: skip
+def test_route_is_the_path_record_shows_and_costs_no_record(controller, ref, has_route):
+    """An agent process asks every robot for its route every tick (to send a new plan to the recording):
+    route() gives record()'s path without building the rest of the record (a DFT robot's fields, a map)."""
+    engine = ArenaEngine(load_scenario(ref).with_overrides(controller=controller, agents=1, max_ticks=100))
+    engine.step(30)
+    brain = engine.controllers[0]
+    route = getattr(brain, "route", None)
+    path = None if route is None else route()
+    if has_route:
+        assert path is not None and len(path) >= 2
+        np.testing.assert_array_equal(path, brain.record()["path"])
+    else:
+        assert path is None and "path" not in brain.record()

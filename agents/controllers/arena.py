@@ -55,6 +55,9 @@ class ArenaController(Protocol):
 
     def record(self) -> dict[str, np.ndarray]: ...
 
+    # Optional: route() -> the path (N x 2 metres) a controller follows, or None.  An agent process asks
+    # for it every tick to send a new plan to the recording, so it must be cheap (record() need not be).
+
 
 def as_action(step_result) -> np.ndarray:
     """A controller's answer as the world's action row: (left, right, act), the

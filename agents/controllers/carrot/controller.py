@@ -95,6 +95,10 @@ class CarrotController:
             self.follower = CarrotFollower(np.asarray(state["path"]), p.k_fic, p.k_look, p.speed, p.window)
             self.follower.index = int(state["index"])
 
+    def route(self) -> np.ndarray | None:
+        """The path it follows (metres), or None before it has one."""
+        return None if self.follower is None else self.follower.path
+
     def record(self) -> dict[str, np.ndarray]:
         f = self.follower
         if f is None:

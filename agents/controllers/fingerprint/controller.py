@@ -204,6 +204,11 @@ class FingerprintController:
         self.log = [tuple(row) for row in state["log"]]
         self.driver.restore(state["driver"])
 
+    def route(self) -> np.ndarray | None:
+        """The route its driver follows (the carrot's), or None when it wanders."""
+        route = getattr(self.driver, "route", None)
+        return None if route is None else route()
+
     def record(self) -> dict[str, np.ndarray]:
         out = {k: v for k, v in self.driver.record().items() if k == "path"}
         out["node"] = np.array(self.believed)
