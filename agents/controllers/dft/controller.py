@@ -91,7 +91,7 @@ class DftController:
         self.noise_level = params.get("noise", "low")
         self.map_noise = MAP_NOISE[self.noise_level]
         self.position_peak = 1.2 if self.noise_level == "high" else 1.0
-        self.engine = Engine(spa_architecture(self.shape, SpaParams()))
+        self.engine = Engine(spa_architecture(self.shape, SpaParams()), keep_inputs=False)
         self.sensed: SensedContext | None = None
         self.shares = None
         self.received = 0  # cells other robots marked that reached this one
