@@ -234,7 +234,7 @@ class _Group:
     """The fields and inputs of one shape, stepped together in the frequency domain."""
 
     def __init__(self, shape: tuple[int, ...], fields: list[Field], inputs: list[Input], couplings: list[Coupling],
-                 keep_inputs: bool = True):  # fmt: skip
+                 keep_inputs: bool):  # fmt: skip
         self.shape, self.fields, self.inputs = shape, fields, inputs
         self.label = "x".join(map(str, shape))
         self.axes = tuple(range(1, len(shape) + 1))
@@ -277,7 +277,6 @@ class _Group:
         # the fields' inputs: their own buffer, or (keep_inputs=False) the outputs' one, which holds nothing
         # between the forward transform and the Euler pass that writes the next outputs over the inputs
         self.inp = np.zeros((n, self.size), DTYPE) if keep_inputs else self.out
-        self.keeps_inputs = keep_inputs
         self.uniform = np.zeros(n, DTYPE)  # reductions from other fields, added to every cell
         self.taus = np.array([f.tau for f in fields], DTYPE)
         self.hs = np.array([f.h for f in fields], DTYPE)
@@ -289,6 +288,10 @@ class _Group:
         self.acc = np.zeros((n, int(np.prod(half))), CDTYPE)
         self.dyn = np.zeros((n, int(np.prod(half))), CDTYPE)  # the fields' outputs, transformed
         self.reset()
+
+    @property
+    def keeps_inputs(self) -> bool:
+        return self.inp is not self.out
 
     def _spectrum(self, stack: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         return pocketfft.rfftn(stack, self.axes, out).astype(CDTYPE, copy=False)
