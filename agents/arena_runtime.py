@@ -32,17 +32,28 @@ class ArenaAgentRuntime(AgentRuntime):
         self.kept = False  # the last answer carried the controllers' memory
 
     def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
+        blob = msg.pop("memory", None)  # a missing agent's place, taken over where it was saved
         brain = make_controller(msg.get("controller", self.controller))
         brain.reset(int(msg["seed"]), agent, msg["params"])
         self.brains[slot] = brain
-        if isinstance(msg.get("memory"), bytes):  # a missing agent's place, taken over where it was saved
-            self.refused_memory += not give_back(brain, msg["memory"])
         heap.give_back()  # what building the controller used and freed (a DFT robot's kernels: ~5 MB)
+        if isinstance(blob, bytes):
+            memory, blob = memory_codec.decode(blob), None  # the blob goes before the rollback state comes
+            self.refused_memory += not restore_or_keep(brain, memory)
+            memory = None
+            heap.give_back()
 
     def _restore(self, msg: arena_proto.ArenaMemory) -> None:
-        for agent, blob in msg.memory:
+        """Each blob is taken out of the message and let go once decoded, before the controller's
+        rollback state is taken: for a DFT robot each of the three is MBs (issue 12's 80 MB)."""
+        handed = msg.memory
+        while handed:
+            agent, blob = handed.pop()
             if (slot := self.slot_of.get(agent)) is not None:
-                self.refused_memory += not give_back(self.brains[slot], blob)
+                memory, blob = memory_codec.decode(blob), None
+                self.refused_memory += not restore_or_keep(self.brains[slot], memory)
+                memory = None
+        heap.give_back()
 
     def _parse(self, data: bytes):
         return arena_proto.parse_obs(data)
@@ -59,10 +70,11 @@ class ArenaAgentRuntime(AgentRuntime):
             agents.append(agent)
             wheels.append(np.zeros(3) if self.null else as_action(self.brains[slot].step(reading)))
         shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
-        if self.kept:  # the memory sent last tick was packed several times over (MBs for a DFT robot), and
-            heap.give_back()  # zenoh has sent and freed its own copy by now: all of it back, not kept in the heap
+        if self.kept:  # the message that carried last tick's memory (MBs for a DFT robot) and zenoh's copy
+            heap.give_back()  # of it are freed by now: all of it back to the system, not kept in the heap
         self.kept = keep = obs.keep and not self.null
-        memory = [(a, memory_codec.encode(b.snapshot())) for a, b in mine] if keep else []
+        # the memory's arrays are written once, straight into the message (the save-tick peak: issue 12)
+        memory = [(a, memory_codec.pieces(b.snapshot())) for a, b in mine] if keep else []
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory)
         self.act_publisher.put(payload)
         if not self.null:
@@ -86,13 +98,17 @@ class ArenaAgentRuntime(AgentRuntime):
 def give_back(brain, blob: bytes) -> bool:
     """Restore a controller from a saved memory.  One that cannot be decoded or
     restored leaves the controller as it was (False: the caller counts it)."""
-    memory = memory_codec.decode(blob)
+    return restore_or_keep(brain, memory_codec.decode(blob))
+
+
+def restore_or_keep(brain, memory) -> bool:
+    """`give_back` of a memory already decoded (a `Rejected` one restores nothing)."""
     if isinstance(memory, proto.Rejected):
         return False
-    had = brain.snapshot()
+    had = memory_codec.encode(brain.snapshot())  # encoded: a snapshot may share the arrays restore() writes
     try:
         brain.restore(memory)
     except (KeyError, IndexError, TypeError, ValueError, AttributeError):
-        brain.restore(had)
+        brain.restore(memory_codec.decode(had))
         return False
     return True

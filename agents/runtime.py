@@ -104,7 +104,8 @@ class AgentRuntime:
             for reply in self.session.get(self.keys.join, payload=request, timeout=2.0):
                 if not reply.ok:
                     continue
-                msg = proto.unpack(reply.ok.payload.to_bytes(), proto.MAX_WELCOME_BYTES)
+                data, reply = reply.ok.payload.to_bytes(), None  # zenoh's copy goes: a welcome may carry MBs
+                msg, data = proto.unpack(data, proto.MAX_WELCOME_BYTES), None
                 if isinstance(msg, proto.Rejected):
                     continue
                 if msg.get("type") == "refused":
@@ -129,12 +130,13 @@ class AgentRuntime:
             latest, last = None, len(batch) - 1
             for i, sample in enumerate(batch):
                 raw = sample.payload.to_bytes()
+                batch[i] = sample = None  # zenoh's copy goes now: memory handed back is MBs (issue 12's 80 MB)
                 if i == last and (fast := self._answer_raw(raw)) is not None:  # a plain observation, answered
                     self._heard = time.monotonic()
                     answered += fast
                     latest = None  # older observations of the batch are superseded
                     break
-                msg = self._parse(raw)
+                msg, raw = self._parse(raw), None  # and the bytes once parsed
                 if isinstance(msg, dict):
                     if msg.get("type") == "stop":
                         return answered

@@ -6,51 +6,123 @@ back bit for bit, so arrays travel as their raw bytes with dtype and shape,
 floats as float64, and map keys keep their type (an int key stays an int).
 Decoding never raises: a broken blob is a `Rejected` reason, and the agent
 runtime counts it (the controller then goes on with what it has).
+
+Why pieces: a DFT robot's memory is MBs of fields, sent at every save tick
+from a process that must stay under 80 MB (issue 12).  `pieces` gives the
+msgpack form as a list of small headers and the arrays' own bytes (views, no
+copy), so the action message that carries it is written once, by one
+`b"".join`, straight from the fields.  The form is msgpack's own, byte for
+byte (tested against `msgpack.packb`), and msgpack decodes it.
 """
 
 from __future__ import annotations
 
+import math
+import struct
 from typing import Any
 
 import msgpack
 import numpy as np
 
-from swarm.protocol import Rejected
+from swarm.protocol import HEADERS, Rejected, bin_header
 
 _ARRAY = 1  # msgpack extension code: [dtype, shape, bytes]
-MAX_MEMORY_BYTES = 256 * 1024 * 1024  # one controller's memory; a DFT robot on large-maze takes ~30 MB
+MAX_MEMORY_BYTES = 256 * 1024 * 1024  # one controller's memory; a DFT robot on large-maze takes ~3.4 MB
+_HEAD = 1024  # bytes enough for an array's dtype and shape
+_FIXEXT = {1: 0xD4, 2: 0xD5, 4: 0xD6, 8: 0xD7, 16: 0xD8}
 
 
-def _default(value: Any) -> Any:
-    if isinstance(value, np.ndarray):
-        a = np.ascontiguousarray(value)
-        if a.dtype.hasobject:
-            return a.tolist()
-        raw = memoryview(a.reshape(-1).view(np.uint8))  # the array's bytes where they are: no copy (fields are MBs)
-        return msgpack.ExtType(_ARRAY, msgpack.packb([a.dtype.str, list(a.shape), raw], use_bin_type=True))
+def _plain(value: Any) -> Any:
+    """msgpack's `default`: what a value without a wire form of its own travels as (arrays aside)."""
     if isinstance(value, np.bool_):
         return bool(value)
     if isinstance(value, np.integer):
         return int(value)
     if isinstance(value, np.floating):
         return float(value)
-    if isinstance(value, tuple | set | frozenset):
+    if isinstance(value, set | frozenset):
         return list(value)
     raise TypeError(f"a controller's memory holds a {type(value).__name__}, which has no wire form")
 
 
-def _ext(code: int, data: bytes) -> Any:
-    if code != _ARRAY:
-        raise ValueError(f"unknown extension {code}")
-    kind, shape, raw = msgpack.unpackb(data, raw=False)
-    dtype = np.dtype(kind)
-    if dtype.hasobject:
-        raise ValueError("object arrays are not memory")
-    return np.frombuffer(raw, dtype=dtype).reshape(shape).copy()
+def _pack(value: Any) -> bytes:
+    return msgpack.packb(value, default=_plain, use_bin_type=True, strict_types=False)
+
+
+def _ext_header(code: int, size: int) -> bytes:
+    if size in _FIXEXT:
+        return struct.pack(">Bb", _FIXEXT[size], code)
+    if size < 1 << 8:
+        return struct.pack(">BBb", 0xC7, size, code)
+    return struct.pack(">BHb", 0xC8, size, code) if size < 1 << 16 else struct.pack(">BIb", 0xC9, size, code)
+
+
+def _array_pieces(value: np.ndarray, out: list) -> None:
+    a = np.ascontiguousarray(value)
+    if a.dtype.hasobject:
+        _walk(a.tolist(), out)
+        return
+    raw = memoryview(a.reshape(-1).view(np.uint8))  # the array's bytes where they are: no copy (fields are MBs)
+    head = HEADERS.pack_array_header(3) + _pack(a.dtype.str) + _pack(list(a.shape)) + bin_header(raw.nbytes)
+    out += [_ext_header(_ARRAY, len(head) + raw.nbytes), head, raw]
+
+
+def _walk(value: Any, out: list) -> None:
+    if isinstance(value, np.ndarray):
+        _array_pieces(value, out)
+    elif isinstance(value, dict):
+        out.append(HEADERS.pack_map_header(len(value)))
+        for key, item in value.items():
+            _walk(key, out)
+            _walk(item, out)
+    elif isinstance(value, list | tuple | set | frozenset):
+        out.append(HEADERS.pack_array_header(len(value)))
+        for item in value:
+            _walk(item, out)
+    else:
+        out.append(_pack(value))
+
+
+def pieces(memory: Any) -> list:
+    """The msgpack form of `memory` as pieces (bytes, and memoryviews of its arrays) to be joined.
+    The views read the arrays when joined: join them before the controller steps again."""
+    out: list = []
+    _walk(memory, out)
+    return out
+
+
+def size(parts: list) -> int:
+    return sum(memoryview(p).nbytes for p in parts)
 
 
 def encode(memory: Any) -> bytes:
-    return msgpack.packb(memory, default=_default, use_bin_type=True, strict_types=False)
+    return b"".join(pieces(memory))
+
+
+def _ext(code: int, data: bytes) -> Any:
+    """An array from its extension: [dtype, shape, bin], its bytes read where they lie (one copy, not two)."""
+    if code != _ARRAY:
+        raise ValueError(f"unknown extension {code}")
+    head = msgpack.Unpacker(raw=False)
+    head.feed(data[:_HEAD])  # dtype and shape come first and are short
+    if head.read_array_header() != 3:
+        raise ValueError("an array is [dtype, shape, bytes]")
+    dtype, shape = np.dtype(head.unpack()), head.unpack()
+    if dtype.hasobject:
+        raise ValueError("object arrays are not memory")
+    at = head.tell()
+    size, at = _bin_size(data, at)
+    if at + size != len(data) or size != dtype.itemsize * math.prod(shape):
+        raise ValueError("an array's bytes do not match its dtype and shape")
+    return np.frombuffer(data, dtype=dtype, offset=at).reshape(shape).copy()
+
+
+def _bin_size(data: bytes, at: int) -> tuple[int, int]:
+    """The size of the bin at `at` and where its bytes begin."""
+    width = {0xC4: 1, 0xC5: 2, 0xC6: 4}.get(data[at])
+    if width is None:
+        raise ValueError("an array's bytes are not a bin")
+    return int.from_bytes(data[at + 1 : at + 1 + width], "big"), at + 1 + width
 
 
 def decode(blob: bytes) -> Any:

@@ -25,6 +25,7 @@ by the world.
 from __future__ import annotations
 
 import math
+import struct
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -90,6 +91,26 @@ class Rejected:
 
 def pack(message: dict) -> bytes:
     return msgpack.packb({"v": VERSION, **message}, use_bin_type=True)
+
+
+HEADERS = msgpack.Packer(use_bin_type=True)  # array and map headers: `HEADERS.pack_array_header(n)`
+
+
+def bin_header(size: int) -> bytes:
+    """msgpack's header of a `size`-byte bin (msgpack-python's Packer has none to call)."""
+    if size < 1 << 8:
+        return struct.pack(">BB", 0xC4, size)
+    return struct.pack(">BH", 0xC5, size) if size < 1 << 16 else struct.pack(">BI", 0xC6, size)
+
+
+def pack_ending_with(message: dict, key: str, tail: list) -> bytes:
+    """`pack({**message, key: value})`, where `value` is given in its msgpack form as pieces
+    (bytes, memoryviews): the message is written once, by one join, with no copy of the pieces
+    before it (a DFT robot's memory is MBs of fields)."""
+    whole = {"v": VERSION, **message}
+    head = [HEADERS.pack_map_header(len(whole) + 1)]
+    head += [msgpack.packb(k, use_bin_type=True) + msgpack.packb(v, use_bin_type=True) for k, v in whole.items()]
+    return b"".join([*head, msgpack.packb(key), *tail])
 
 
 def unpack(data: bytes, limit: int = MAX_MESSAGE_BYTES) -> dict | Rejected:

@@ -25,18 +25,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import msgpack
 import numpy as np
 
 from swarm.protocol import (
     FAMILY_ARENA,
+    HEADERS,
     HandBack,
     Rejected,
+    bin_header,
     check_family,
     family_header,
     first_rejection,
     int_field,
     int_list,
     pack,
+    pack_ending_with,
     unpack,
 )
 
@@ -50,6 +54,7 @@ MAX_PLAN_POINTS = 2000  # 32 KB: a plan message stays under the world's message 
 MAX_SHARED = 4 * 1024 * 1024  # bytes of shared payloads in one message
 Shared = list[tuple[int, str, bytes]]  # (agent, share, payload)
 Memories = list[tuple[int, bytes]]  # (agent, its controller's memory, swarm.memory_codec)
+MemoryPieces = list[tuple[int, list]]  # (agent, its memory as swarm.memory_codec.pieces): sent without a blob
 
 
 @dataclass(frozen=True)
@@ -143,10 +148,11 @@ def observations(tick: int, agents, perceptions: list[dict[str, np.ndarray]], sh
     return pack(m)
 
 
-def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = (), memory: Memories = ()) -> bytes:
+def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = (), memory: Memories | MemoryPieces = ()) -> bytes:
     """(K, 2) wheel speeds, or (K, 3) with a consummatory act each: the acts go
     in their own field, and only when one is not 0 (the message of robots
-    without a metabolism stays as it was)."""
+    without a metabolism stays as it was).  Memory given as pieces is written
+    into the message once (the same bytes as its blob would give)."""
     wheels = np.asarray(wheels, np.float64).reshape(len(agents), -1)
     m = {"type": "act", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
          "wheels": np.ascontiguousarray(wheels[:, :2]).astype("<f8").tobytes()}  # fmt: skip
@@ -155,8 +161,18 @@ def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = (), memory: 
     if shared:
         m["shared"] = _shared_field(shared)
     if memory:
-        m["memory"] = _memory_field(memory)
+        return pack_ending_with(m, "memory", _memory_pieces(memory))
     return pack(m)
+
+
+def _memory_pieces(memory: Memories | MemoryPieces) -> list:
+    """The memory field's msgpack form, [[agent, bin], ...], each bin written from its pieces."""
+    out = [HEADERS.pack_array_header(len(memory))]
+    for agent, blob in memory:
+        parts = [blob] if isinstance(blob, bytes | bytearray) else blob
+        size = sum(memoryview(p).nbytes for p in parts)
+        out += [HEADERS.pack_array_header(2) + msgpack.packb(int(agent)) + bin_header(size), *parts]
+    return out
 
 
 def _decode(entry) -> np.ndarray | Rejected:

@@ -6,7 +6,8 @@ wheel speeds in m/s each tick, or (left, right, act) for a robot with a
 metabolism (world_server.metabolism.ACTS).  It sees only its robot's sensors (the
 perception dict) and what its paper gives the robot beforehand (`params`:
 the map it is given, its goal or route, its body's limits).
-`snapshot()` / `restore()` make a resumed run bit-equal; `record()` returns
+`snapshot()` / `restore()` make a resumed run bit-equal (a snapshot may
+share its arrays with the controller: encode or copy it before the next step); `record()` returns
 what a reviewer should see.  The in-process engine holds N of them; an agent
 process holds K.
 """

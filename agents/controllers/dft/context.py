@@ -139,7 +139,7 @@ class SensedContext:
         self._apply(cells[0], cells[1], int(data["tick"]))
 
     def snapshot(self) -> dict[str, Any]:
-        return {"seen": self.seen.copy(), "marked": self.marked, "cleared": self.cleared}
+        return {"seen": self.seen, "marked": self.marked, "cleared": self.cleared}
 
     def restore(self, state: dict[str, Any]) -> None:
         self.seen[...] = np.asarray(state["seen"], np.int64).reshape(self.shape)

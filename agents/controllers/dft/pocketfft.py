@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import importlib.machinery
 import importlib.util
+import math
 import sysconfig
 from pathlib import Path
 from types import ModuleType
@@ -25,7 +26,7 @@ from types import ModuleType
 import numpy as np
 
 _NAME = "scipy.fft._pocketfft.pypocketfft"
-_BACKWARD, _FORWARD = 0, 2  # pypocketfft's normalisation codes for norm="backward" and norm="forward"
+_NONE, _BACKWARD, _FORWARD = 0, 0, 2  # pypocketfft's normalisation codes: none, norm="backward", "forward"
 
 
 def _load() -> ModuleType | None:
@@ -63,12 +64,26 @@ def irfftn(spectrum: np.ndarray, shape: tuple[int, ...], axes: tuple[int, ...],
            out: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
     """`scipy.fft.irfftn(spectrum, s=shape, axes=axes)` where the spectrum already has the half
     shape of `shape` (its last axis shape[-1] // 2 + 1), as the engine's always does; written into
-    `out` where one is given."""
-    if _pfft is not None:
-        return _pfft.c2r(np.ascontiguousarray(spectrum), axes, shape[-1], False, _FORWARD, out, 1)
-    import scipy.fft
+    `out` where one is given.  The spectrum is used up: written over.
 
-    return _into(scipy.fft.irfftn(spectrum, s=shape, axes=axes), out)
+    Why: over several axes, pocketfft's inverse first transforms all but the last axis into a
+    temporary the size of the spectrum (2.7 MB a step at 16 fields of 210 x 210, held by the
+    allocator or faulted in again each time), then the last axis with the 1/n scale.  Here the
+    first part is done in place and the scale (the same float, 1/n rounded from long double as
+    pocketfft rounds it) multiplies afterwards, as pocketfft multiplies last: the same numbers,
+    bit for bit (tested), no temporary, and faster at 210 x 210."""
+    if _pfft is None:
+        import scipy.fft
+
+        return _into(scipy.fft.irfftn(spectrum, s=shape, axes=axes), out)
+    spectrum = np.ascontiguousarray(spectrum)
+    if len(axes) == 1:
+        return _pfft.c2r(spectrum, axes, shape[-1], False, _FORWARD, out, 1)
+    _pfft.c2c(spectrum, axes[:-1], False, _NONE, spectrum, 1)
+    out = _pfft.c2r(spectrum, axes[-1:], shape[-1], False, _NONE, out, 1)
+    n = math.prod(spectrum.shape[a] for a in axes[:-1]) * shape[-1]
+    out *= out.dtype.type(np.longdouble(1) / np.longdouble(n))
+    return out
 
 
 def _into(result: np.ndarray, out: np.ndarray | None) -> np.ndarray:
