@@ -424,6 +424,23 @@ def test_a_recording_holds_the_metabolism_the_channels_and_the_map(tmp_path):
     assert rows["world/map/0/nodes"] >= 1 and rows["map/0/belief"] >= 1
 
 
+def test_an_animat_put_down_on_a_loaded_map_localizes_itself_before_it_plans():
+    """Experiments 2 and 3 load a map that another animat made: the test's animat must plan from where it
+    is, not from where the mapping animat stopped (that cost a test its first ~30 s, in the wrong way)."""
+    from swarm.arena.bg_experiments import _with
+
+    maker = ArenaEngine(load_scenario("bg-exp1").with_overrides(max_ticks=600))
+    maker.step(600)
+    made = maker.controllers[0].map_data()
+    assert math.hypot(*made["map"]["nodes"][made["map"]["current"]]["position"]) > 1.5  # it stopped away from start
+    engine = ArenaEngine(_with(load_scenario("bg-exp1"), bg={"map": made}, max_ticks=10))
+    nav = engine.controllers[0].nav
+    assert nav.relocalize
+    engine.step(1)
+    assert not nav.relocalize and nav.observations == made["observations"]  # localized, nothing mapped yet
+    assert math.hypot(*nav.map.nodes[nav.map.current].position) < 1.5  # a node near its start (the map's origin)
+
+
 def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):
     from swarm.arena.bg_experiments import run_bg_experiment
 

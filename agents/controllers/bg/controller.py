@@ -118,7 +118,7 @@ class BgController:
         self.nav.move(float(perception["odometry"][0]), heading)
         prox = proximity(resource_pixels(grey, heading))
         if self.p.planning:
-            if self.p.learn_map and self.nav.due():
+            if (self.p.learn_map or self.nav.relocalize) and self.nav.due():
                 self.colony.adopt(self.nav.observe(grey, sonar, heading))
             seen = prox.any(axis=1)
             self.nav.learn(usable, {r: bool(seen[k]) for k, r in enumerate(RESOURCES)}, self.dt)

@@ -200,7 +200,9 @@ class Navigator:
         self.since = self.since + d
 
     def due(self) -> bool:
-        return float(np.hypot(*self.since)) >= self.p.spacing or not self.map.nodes
+        """Time for an observation: every `spacing` metres, on an empty map, and at once when put down on a
+        map (a test's first plan must start from where the animat is, not from where the map was left)."""
+        return self.relocalize or float(np.hypot(*self.since)) >= self.p.spacing or not self.map.nodes
 
     def lost(self) -> None:
         """The animat was put down somewhere on a map it has (a loaded one): the next observation
