@@ -27,7 +27,7 @@ import numpy as np
 from swarm.protocol import HEADERS, Rejected, bin_header
 
 _ARRAY = 1  # msgpack extension code: [dtype, shape, bytes]
-MAX_MEMORY_BYTES = 256 * 1024 * 1024  # one controller's memory; a DFT robot on large-maze takes ~3.4 MB
+MAX_MEMORY_BYTES = 256 * 1024 * 1024  # one controller's memory; a DFT robot on large-maze takes ~3.2 MB
 _HEAD = 1024  # bytes enough for an array's dtype and shape
 _FIXEXT = {1: 0xD4, 2: 0xD5, 4: 0xD6, 8: 0xD7, 16: 0xD8}
 
@@ -89,10 +89,6 @@ def pieces(memory: Any) -> list:
     out: list = []
     _walk(memory, out)
     return out
-
-
-def size(parts: list) -> int:
-    return sum(memoryview(p).nbytes for p in parts)
 
 
 def encode(memory: Any) -> bytes:
