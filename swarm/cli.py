@@ -164,6 +164,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="dft-*: run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)")
     exp.add_argument("--ratios", type=_ratios, metavar="R,R,...",
                      help="bg-tmaze: right / left branch length ratios to run (default 1,1.5,2: tmaze-R scenarios)")
+    exp.add_argument("--maps", type=_positive, metavar="N",
+                     help="bg-choice | bg-forget | bg-fear | bg-tmaze: mapping runs per scenario; test k loads map "
+                          "k mod N (default: one per test; 1: one map for every test)")
     exp.add_argument("--sizes", type=_sizes, metavar="N,N,...",
                      help="bg-colony: colony sizes to run (default 1,2,4,8)")
     exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
@@ -577,12 +580,14 @@ def cmd_experiment(args) -> int:
         from swarm.arena.bg_experiments import run_bg_experiment
 
         result = run_bg_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
-                                   ratios=args.ratios)  # fmt: skip
+                                   ratios=args.ratios, maps=args.maps)  # fmt: skip
         print(result["markdown"])
         print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
         return 0
     if args.ratios:
         raise ScenarioError("command line", "--ratios", "this is for bg-tmaze")
+    if args.maps:
+        raise ScenarioError("command line", "--maps", "this is for bg-choice, bg-forget, bg-fear and bg-tmaze")
     if args.name == "carrot":
         from swarm.arena.experiments import run_carrot_experiment
 

@@ -46,6 +46,15 @@ def test_bg_exp1_resources_cannot_be_seen_from_each_others_vicinity():
     assert _sees(_animat_at("bg-exp1", 1.2, 2.4), 127)  # but each is seen from its own vicinity
 
 
+def test_bg_exp2_blocks_are_told_apart_by_their_greys():
+    """Four blocks of one shape round a cross of corridors: only their greys tell the crossings apart."""
+    s = load_scenario("bg-exp2")
+    greys = [w.colour[0] for w in s.walls if w.name.startswith("block_")]
+    assert len(greys) == 4 and len(set(greys)) == 4
+    assert not set(greys) & {31, 127, 255, 180}  # neither a resource's grey nor the walls'
+    assert min(abs(a - b) for a, b in itertools.combinations(greys, 2)) >= 35  # a unit of grey_scale apart
+
+
 def test_resources_are_usable_within_70_cm_while_present():
     s = load_scenario("bg-exp2")
     ep2 = next(o for o in s.obstacles if o.name == "Ep2")

@@ -2,6 +2,7 @@
 senses, motivations and saliences, its map, and the controller in both
 runtimes.  The GPR loops are in test_bg_gpr.py."""
 
+import csv
 import json
 import math
 
@@ -449,9 +450,32 @@ def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):
     for name in ("runs.csv", "summary.csv", "table.md", "plot.png", "maps.json"):
         assert (tmp_path / name).exists(), name
     text = (tmp_path / "table.md").read_text()
-    assert "| 1.0 |" in text and "paper left" in text
+    assert "| 1.0 |" in text and "paper left" in text and "2 maps" in text
     maps = json.loads((tmp_path / "maps.json").read_text())
-    assert len(maps["tmaze-1"]["map"]["nodes"]) >= 3  # the mapping run made a map every test loaded
+    assert len(maps["tmaze-1"]) == 2 and all(len(m["map"]["nodes"]) >= 3 for m in maps["tmaze-1"])
+    assert maps["tmaze-1"][0]["map"] != maps["tmaze-1"][1]["map"]  # a map per test: mapping runs with seed + k
+    with open(tmp_path / "runs.csv") as f:
+        assert sorted(int(row["map"]) for row in csv.DictReader(f)) == [0, 1]  # test k loaded map k
+
+
+def test_bg_experiment_tests_share_maps_across_conditions():
+    from swarm.arena.bg_experiments import _tests
+
+    maps = {"bg-exp3": [{"id": 0}, {"id": 1}]}
+    jobs = _tests("bg-fear", 4, 10, maps)
+    assert [(j[1], j[3], j[8]) for j in jobs] == [(0.1, 10, 0), (0.1, 11, 1), (0.1, 12, 0), (0.1, 13, 1),
+                                                  (0.5, 10, 0), (0.5, 11, 1), (0.5, 12, 0), (0.5, 13, 1)]
+    assert all(j[9] is maps["bg-exp3"][j[8]] for j in jobs)
+
+
+def test_bg_experiment_maps_option_is_checked():
+    from swarm.arena.bg_experiments import run_bg_experiment
+    from swarm.scenario import ScenarioError
+
+    with pytest.raises(ScenarioError, match="--maps"):
+        run_bg_experiment("bg-tmaze", None, 2, 1, 0, None, maps=3, progress=False)
+    with pytest.raises(ScenarioError, match="--maps"):
+        run_bg_experiment("bg-survival", None, 2, 1, 0, None, maps=1, progress=False)
 
 
 def test_swarm_run_prints_the_animats_metabolism_and_map():

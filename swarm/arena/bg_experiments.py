@@ -14,11 +14,12 @@ the experiments of Girard et al. (2005) with the bg animat.
 - bg-tmaze (exp. 3.2, Table 4): the T-maze with branch ratios 1, 1.5, 2;
   which branch the animat enters first.
 
-Experiments 2 and 3 give the animat "a previously built map": one mapping
-run per experiment (the animat lives `MAPPING_SECONDS` there, hungry, so it
-meets the resources), saved, and loaded by every test.  Every test differs
-from the others only by its seed (sensor noise, exploration draws).
-docs/bg.md says every choice.
+Experiments 2 and 3 give the animat "a previously built map": a mapping run
+(the animat lives `MAPPING_SECONDS` there, hungry, so it meets the
+resources), saved, and loaded by a test.  By default test k of every
+condition loads map k, made with seed + k: the conditions are compared on
+the same maps, and a table is not hostage to one mapping run (`maps=1` is
+one map for every test).  docs/bg.md says every choice.
 """
 
 from __future__ import annotations
@@ -115,10 +116,10 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
 
 def run_test(job: tuple) -> dict:
     """One test of experiments 2 and 3 on a loaded map: (experiment, label, run, seed, scenario, bg, metabolism,
-    absent, map)."""
+    absent, map index, map)."""
     from swarm.arena.engine import ArenaEngine
 
-    experiment, label, run, seed, name, bg, metabolism, absent, map_data = job
+    experiment, label, run, seed, name, bg, metabolism, absent, map_index, map_data = job
     s = load_scenario(name)
     s = _with(s, bg={**bg, "map": map_data}, metabolism=metabolism, seed=seed, absent=absent,
               max_ticks=int(TEST_SECONDS / s.control_period))  # fmt: skip
@@ -131,7 +132,8 @@ def run_test(job: tuple) -> dict:
             first_branch = "left" if x < JUNCTION[0] else "right" if x > JUNCTION[1] else None
     r = engine.summary()["robots"][0]
     seconds = r["ingest_tick"] * s.control_period if r["ingest_tick"] is not None else None
-    return {"experiment": experiment, "condition": label, "run": run, "seed": seed, "chose": r["ingested"] or "none",
+    return {"experiment": experiment, "condition": label, "run": run, "seed": seed, "map": map_index,
+            "chose": r["ingested"] or "none",
             "branch": first_branch or "", "seconds": seconds, "distance": r["distance"],
             "wall_seconds": engine.wall_seconds}  # fmt: skip
 
@@ -252,14 +254,20 @@ def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) ->
 
 
 def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
-                      out: Path | None, ratios: tuple[float, ...] | None = None,
+                      out: Path | None, ratios: tuple[float, ...] | None = None, maps: int | None = None,
                       progress: bool = True) -> dict:  # fmt: skip
+    """Run one experiment; `maps` mapping runs per scenario for experiments 2 and 3 (default: one per test)."""
     expected = SCENARIO[experiment]
     if scenario not in (None, expected) and not (experiment == "bg-tmaze" and scenario.startswith("tmaze")):
         raise ScenarioError("command line", "--scenario", f"{experiment} runs on {expected} (the paper's)")
     reps = REPS[experiment] if reps is None else reps
     if reps < 2:
         raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
+    maps = reps if maps is None else maps
+    if experiment == "bg-survival" and maps != reps:
+        raise ScenarioError("command line", "--maps", "bg-survival has no mapping phase (condition A maps as it lives)")
+    if not 1 <= maps <= reps:
+        raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
     out = Path(out) if out is not None else Path("results") / experiment
     out.mkdir(parents=True, exist_ok=True)
     if experiment == "bg-survival":
@@ -270,11 +278,12 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
         title = f"# Experiment 1 (Girard et al. 2005): survival with and without the map\n\n{reps} runs per " \
                 f"condition, at most 4 h; seed {seed}.\n\n"
     else:
-        work, maps = _tests(experiment, reps, seed, ratios)
-        (out / "maps.json").write_text(json.dumps(maps))
+        made = _maps(experiment, maps, seed, ratios, jobs, progress)
+        (out / "maps.json").write_text(json.dumps(made))
+        work = _tests(experiment, reps, seed, made)
         rows = pool_map(work, run_test, jobs, experiment, progress)
         rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
-        summary, md, title = _test_summary(experiment, rows, reps, seed, maps)
+        summary, md, title = _test_summary(experiment, rows, reps, seed, made)
     write_runs(out, "runs.csv", list(rows[0]), rows, summary)
     _plot(experiment, rows, summary, out / "plot.png")
     text = title + md
@@ -282,42 +291,69 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
     return {"name": experiment, "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
 
 
-def _tests(experiment: str, reps: int, seed: int, ratios) -> tuple[list[tuple], dict[str, dict]]:
-    """The tests' jobs, and the maps they load (built here, once per scenario)."""
-    work, maps = [], {}
+def _mapped(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
+    """The scenarios an experiment maps, each with the resources absent while mapping."""
     if experiment in ("bg-choice", "bg-forget"):
-        mapped_without = ("Ep2",) if experiment == "bg-choice" else ()
-        maps["bg-exp2"] = build_map("bg-exp2", seed, mapped_without)
-        if experiment == "bg-choice":
-            for w in W_PLANS:
-                work += [(experiment, w, k, seed + k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, (),
-                          maps["bg-exp2"]) for k in range(reps)]  # fmt: skip
-        else:
-            work += [(experiment, "Ep2 gone", k, seed + k, "bg-exp2", {}, {}, ("Ep2",), maps["bg-exp2"])
-                     for k in range(reps)]  # fmt: skip
-    elif experiment == "bg-fear":
-        maps["bg-exp3"] = build_map("bg-exp3", seed, ())
-        for ep in FEAR_EP:
-            work += [(experiment, ep, k, seed + k, "bg-exp3", {}, {"potential": ep}, (), maps["bg-exp3"])
-                     for k in range(reps)]  # fmt: skip
-    else:
-        for ratio in ratios or RATIOS:
-            name = f"tmaze-{ratio:g}"
-            maps[name] = build_map(name, seed, ())
-            work += [(experiment, ratio, k, seed + k, name, {}, {}, (), maps[name]) for k in range(reps)]
-    return work, maps
+        return {"bg-exp2": ("Ep2",) if experiment == "bg-choice" else ()}
+    if experiment == "bg-fear":
+        return {"bg-exp3": ()}
+    return {f"tmaze-{ratio:g}": () for ratio in ratios or RATIOS}
+
+
+def _build_map_job(job: tuple) -> dict:
+    name, k, seed, absent = job
+    return {"scenario": name, "index": k, "data": build_map(name, seed, absent)}
+
+
+def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None,
+          progress: bool) -> dict[str, list[dict]]:  # fmt: skip
+    """`count` maps per scenario, map k from a mapping run with seed + k (in parallel)."""
+    work = [(name, k, seed + k, absent) for name, absent in _mapped(experiment, ratios).items() for k in range(count)]
+    made = pool_map(work, _build_map_job, jobs, f"{experiment} mapping", progress)
+    return {name: [m["data"] for m in sorted((m for m in made if m["scenario"] == name), key=lambda m: m["index"])]
+            for name in _mapped(experiment, ratios)}  # fmt: skip
+
+
+def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]]) -> list[tuple]:
+    """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions)."""
+    def job(label, k: int, name: str, bg: dict, metabolism: dict, absent: tuple[str, ...]) -> tuple:
+        m = k % len(maps[name])
+        return (experiment, label, k, seed + k, name, bg, metabolism, absent, m, maps[name][m])
+
+    if experiment == "bg-choice":
+        return [job(w, k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)]
+    if experiment == "bg-forget":
+        return [job("Ep2 gone", k, "bg-exp2", {}, {}, ("Ep2",)) for k in range(reps)]
+    if experiment == "bg-fear":
+        return [job(ep, k, "bg-exp3", {}, {"potential": ep}, ()) for ep in FEAR_EP for k in range(reps)]
+    return [job(float(name.split("-")[1]), k, name, {}, {}, ()) for name in maps for k in range(reps)]
+
+
+def _maps_line(made: list[dict]) -> str:
+    """What the maps of one scenario hold: nodes, mapping time, resources been at, nodes holding each kind."""
+    def spread(values) -> str:
+        lo, mid, hi = min(values), float(np.median(values)), max(values)
+        return f"{lo:.0f}" if lo == hi else f"median {mid:.0f} ({lo:.0f} : {hi:.0f})"
+
+    visited = sorted({v for m in made for v in m["visited"]})
+    kinds = sorted({r for m in made for r in m["assoc"]})
+    holding = {r: spread([sum(w > 0.5 for w in m["assoc"].get(r, [])) for m in made]) for r in kinds}
+    return (f"{len(made)} map{'s' if len(made) > 1 else ''}, {spread([len(m['map']['nodes']) for m in made])} nodes "
+            f"after {spread([m['mapped_seconds'] / 60 for m in made])} min; been at "
+            + ", ".join(f"{v} {sum(v in m['visited'] for m in made)}" for v in visited)
+            + "; nodes holding " + ", ".join(f"{r} {h}" for r, h in holding.items()))  # fmt: skip
 
 
 def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int,
-                  maps: dict) -> tuple[list[dict], str, str]:  # fmt: skip
-    held = "; ".join(f"{name}: {len(m['map']['nodes'])} nodes after {m['mapped_seconds'] / 60:.0f} min, been at "
-                     f"{', '.join(m['visited']) or 'none'}; nodes holding "
-                     + ", ".join(f"{r} {sum(w > 0.5 for w in ws)}" for r, ws in m["assoc"].items())
-                     for name, m in maps.items())  # fmt: skip
-    head = f"{reps} tests per condition; seed {seed}; each on the map of a mapping run ({held}): the animat " \
-           f"lives there (E = Ep = {MAPPING_LEVELS[0]} at the start, a full E lasting 4 h, the saliences of exp. 1) " \
-           f"until it has been at every resource and its map holds every kind, " \
-           f"or {MAPPING_SECONDS / 60:.0f} min.\n\n"
+                  maps: dict[str, list[dict]]) -> tuple[list[dict], str, str]:  # fmt: skip
+    held = "; ".join(f"{name}: {_maps_line(made)}" for name, made in maps.items())
+    one = all(len(made) == 1 for made in maps.values())
+    head = f"{reps} tests per condition; seed {seed}; " + \
+           ("every test on the map of one mapping run" if one else
+            "test k of every condition on the map of mapping run k (seed + k)") + \
+           f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full " \
+           f"E lasting 4 h, the saliences of exp. 1) until it has been at every resource and its map holds every " \
+           f"kind, or {MAPPING_SECONDS / 60:.0f} min.\n\n"
     if experiment == "bg-choice":
         summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
         title = "# Experiment 2.1 (Girard et al. 2005): a new resource, planning against taxon\n\n" + head
