@@ -347,10 +347,11 @@ def _maps_line(made: list[dict]) -> str:
 def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int,
                   maps: dict[str, list[dict]]) -> tuple[list[dict], str, str]:  # fmt: skip
     held = "; ".join(f"{name}: {_maps_line(made)}" for name, made in maps.items())
-    one = all(len(made) == 1 for made in maps.values())
+    n = len(next(iter(maps.values())))
     head = f"{reps} tests per condition; seed {seed}; " + \
-           ("every test on the map of one mapping run" if one else
-            "test k of every condition on the map of mapping run k (seed + k)") + \
+           ("every test on the map of one mapping run" if n == 1 else
+            "test k of every condition on the map of mapping run k (seed + k)" if n == reps else
+            f"test k of every condition on the map of mapping run k mod {n} (seed + k mod {n})") + \
            f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full " \
            f"E lasting 4 h, the saliences of exp. 1) until it has been at every resource and its map holds every " \
            f"kind, or {MAPPING_SECONDS / 60:.0f} min.\n\n"
