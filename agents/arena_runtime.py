@@ -102,9 +102,17 @@ def give_back(brain, blob: bytes) -> bool:
 
 
 def restore_or_keep(brain, memory) -> bool:
-    """`give_back` of a memory already decoded (a `Rejected` one restores nothing)."""
+    """`give_back` of a memory already decoded (a `Rejected` one restores nothing).  A controller whose
+    restore() checks everything before it writes (`atomic_restore`) is trusted to change nothing when it
+    raises; any other is rolled back to a copy of its state taken first."""
     if isinstance(memory, proto.Rejected):
         return False
+    if getattr(brain, "atomic_restore", False):
+        try:
+            brain.restore(memory)
+        except (KeyError, IndexError, TypeError, ValueError, AttributeError):
+            return False
+        return True
     had = memory_codec.encode(brain.snapshot())  # encoded: a snapshot may share the arrays restore() writes
     try:
         brain.restore(memory)

@@ -177,6 +177,50 @@ def test_a_memory_that_does_not_fit_its_controller_is_refused_and_changes_nothin
     assert memory_codec.encode(brain.snapshot()) == before
 
 
+def test_a_dft_robot_takes_its_memory_back_without_a_rollback_copy():
+    """A resume's peak (issue 12): the DFT controller checks a memory whole before writing it, so the agent
+    keeps no copy of the old state to roll back to; the decoded arrays are written in place, not copied."""
+    from agents.arena_runtime import restore_or_keep
+
+    scenario = load_scenario("large-maze").with_overrides(controller="dft", max_ticks=50)
+    engine = ArenaEngine(scenario)
+    engine.step(3)
+    blob = memory_codec.encode(engine.controllers[0].snapshot())
+    twin = make_controller("dft")
+    twin.reset(scenario.seed, 0, controller_params(scenario, 0))
+    memory = memory_codec.decode(blob)
+    tracemalloc.start()
+    assert restore_or_keep(twin, memory)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert len(blob) > 2_000_000 and peak < 0.05 * len(blob)  # the rollback copy alone would be len(blob)
+    assert memory_codec.encode(twin.snapshot()) == blob
+    broken = memory_codec.decode(blob)
+    last = sorted(broken["fields"])[-1]
+    broken["fields"] = {k: v + 1 for k, v in broken["fields"].items() if k != last}  # fails at the last group
+    assert not restore_or_keep(twin, broken)
+    assert memory_codec.encode(twin.snapshot()) == blob  # nothing written
+
+
+def test_a_dft_memory_whose_sensed_context_does_not_fit_changes_nothing():
+    from dataclasses import replace
+
+    from agents.arena_runtime import restore_or_keep
+
+    s = load_scenario("zmaze").with_overrides(controller="dft", max_ticks=50)
+    engine = ArenaEngine(replace(s, controller_params={"dft": {"obstacles": "sensed"}}))
+    engine.step(20)
+    brain = engine.controllers[0]
+    before = memory_codec.encode(brain.snapshot())
+    broken = memory_codec.decode(before)
+    assert broken["context"] is not None
+    broken["tick"] += 5
+    broken["fields"] = {k: v + 1 for k, v in broken["fields"].items()}
+    broken["context"]["marked"] = [1]  # the context is checked last: fields and tick would be written first
+    assert not restore_or_keep(brain, broken)
+    assert memory_codec.encode(brain.snapshot()) == before
+
+
 def test_actions_carry_memory_only_for_their_own_agents():
     wheels = np.zeros((2, 2))
     ok = arena_proto.parse_acts(arena_proto.actions(5, [1, 2], wheels, memory=[(2, b"abc")]))

@@ -142,6 +142,12 @@ class SensedContext:
         return {"seen": self.seen, "marked": self.marked, "cleared": self.cleared}
 
     def restore(self, state: dict[str, Any]) -> None:
-        self.seen[...] = np.asarray(state["seen"], np.int64).reshape(self.shape)
-        self.marked = [tuple(c) for c in state["marked"]]
-        self.cleared = [tuple(c) for c in state["cleared"]]
+        self.put(self.checked(state))
+
+    def checked(self, state: dict[str, Any]) -> tuple[np.ndarray, list[tuple], list[tuple]]:
+        """(seen, marked, cleared) from a state, changing nothing: raises on anything that does not fit."""
+        return (np.asarray(state["seen"], np.int64).reshape(self.shape), [tuple(c) for c in state["marked"]],
+                [tuple(c) for c in state["cleared"]])  # fmt: skip
+
+    def put(self, parts: tuple[np.ndarray, list[tuple], list[tuple]]) -> None:
+        self.seen[...], self.marked, self.cleared = parts

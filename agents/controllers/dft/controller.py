@@ -191,12 +191,20 @@ class DftController:
         return {"tick": self.tick, "fields": self.engine.state(), "params": asdict(self.p), "received": self.received,
                 "context": None if self.sensed is None else self.sensed.snapshot()}  # fmt: skip
 
+    # restore() checks the whole state before it writes any of it: a memory that does not fit changes
+    # nothing, so the agent needs no rollback copy of the old state (MBs: agents/arena_runtime.py)
+    atomic_restore = True
+
     def restore(self, state: dict[str, Any]) -> None:
-        self.tick = int(state["tick"])
-        self.engine.restore(state["fields"])
-        self.received = int(state.get("received", 0))
+        tick, received = int(state["tick"]), int(state.get("received", 0))
+        fields = self.engine.checked(state["fields"])
+        context = None
         if self.sensed is not None and state.get("context") is not None:
-            self.sensed.restore(state["context"])
+            context = self.sensed.checked(state["context"])
+        self.tick, self.received = tick, received
+        self.engine.put(fields)
+        if context is not None:
+            self.sensed.put(context)
         self.known = -1
 
     def record(self) -> dict[str, np.ndarray]:

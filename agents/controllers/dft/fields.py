@@ -417,8 +417,19 @@ class Engine:
         return out
 
     def restore(self, state: dict[str, np.ndarray]) -> None:
-        for g, grp in enumerate(self.groups):
-            grp.u[...] = np.asarray(state[f"u{g}"], DTYPE).reshape(grp.u.shape)
-            grp.images[...] = np.asarray(state[f"img{g}"], DTYPE).reshape(grp.images.shape)
+        self.put(self.checked(state))
+
+    def checked(self, state: dict[str, np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Every group's (u, images) from a state, in the engine's shapes and dtype, changing nothing: raises
+        on any missing or misshapen array.  Views where the state's arrays already fit (no MB-sized copies)."""
+        return [(np.asarray(state[f"u{g}"], DTYPE).reshape(grp.u.shape),
+                 np.asarray(state[f"img{g}"], DTYPE).reshape(grp.images.shape))
+                for g, grp in enumerate(self.groups)]  # fmt: skip
+
+    def put(self, arrays: list[tuple[np.ndarray, np.ndarray]]) -> None:
+        """Write what `checked` gave (it cannot fail half-way)."""
+        for grp, (u, images) in zip(self.groups, arrays, strict=True):
+            grp.u[...] = u
+            grp.images[...] = images
             grp.dirty[:] = True
             grp._outputs()
