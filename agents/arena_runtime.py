@@ -107,16 +107,11 @@ def restore_or_keep(brain, memory) -> bool:
     raises; any other is rolled back to a copy of its state taken first."""
     if isinstance(memory, proto.Rejected):
         return False
-    if getattr(brain, "atomic_restore", False):
-        try:
-            brain.restore(memory)
-        except (KeyError, IndexError, TypeError, ValueError, AttributeError):
-            return False
-        return True
-    had = memory_codec.encode(brain.snapshot())  # encoded: a snapshot may share the arrays restore() writes
-    try:
+    had = None if getattr(brain, "atomic_restore", False) else memory_codec.encode(brain.snapshot())
+    try:  # `had` encoded: a snapshot may share the arrays restore() writes
         brain.restore(memory)
     except (KeyError, IndexError, TypeError, ValueError, AttributeError):
-        brain.restore(memory_codec.decode(had))
+        if had is not None:
+            brain.restore(memory_codec.decode(had))
         return False
     return True

@@ -308,10 +308,11 @@ def _build_map_job(job: tuple) -> dict:
 def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None,
           progress: bool) -> dict[str, list[dict]]:  # fmt: skip
     """`count` maps per scenario, map k from a mapping run with seed + k (in parallel)."""
-    work = [(name, k, seed + k, absent) for name, absent in _mapped(experiment, ratios).items() for k in range(count)]
-    made = pool_map(work, _build_map_job, jobs, f"{experiment} mapping", progress)
-    return {name: [m["data"] for m in sorted((m for m in made if m["scenario"] == name), key=lambda m: m["index"])]
-            for name in _mapped(experiment, ratios)}  # fmt: skip
+    mapped = _mapped(experiment, ratios)
+    work = [(name, k, seed + k, absent) for name, absent in mapped.items() for k in range(count)]
+    made = {(m["scenario"], m["index"]): m["data"]
+            for m in pool_map(work, _build_map_job, jobs, f"{experiment} mapping", progress)}  # fmt: skip
+    return {name: [made[name, k] for k in range(count)] for name in mapped}
 
 
 def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]]) -> list[tuple]:

@@ -141,9 +141,6 @@ class SensedContext:
     def snapshot(self) -> dict[str, Any]:
         return {"seen": self.seen, "marked": self.marked, "cleared": self.cleared}
 
-    def restore(self, state: dict[str, Any]) -> None:
-        self.put(self.checked(state))
-
     def checked(self, state: dict[str, Any]) -> tuple[np.ndarray, list[tuple], list[tuple]]:
         """(seen, marked, cleared) from a state, changing nothing: raises on anything that does not fit."""
         return (np.asarray(state["seen"], np.int64).reshape(self.shape), [tuple(c) for c in state["marked"]],

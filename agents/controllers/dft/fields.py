@@ -416,9 +416,6 @@ class Engine:
         out |= {f"img{g}": grp.images for g, grp in enumerate(self.groups)}
         return out
 
-    def restore(self, state: dict[str, np.ndarray]) -> None:
-        self.put(self.checked(state))
-
     def checked(self, state: dict[str, np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
         """Every group's (u, images) from a state, in the engine's shapes and dtype, changing nothing: raises
         on any missing or misshapen array.  Views where the state's arrays already fit (no MB-sized copies)."""
