@@ -38,19 +38,19 @@ class ArenaAgentRuntime(AgentRuntime):
         self.brains[slot] = brain
         heap.give_back()  # what building the controller used and freed (a DFT robot's kernels: ~5 MB)
         if isinstance(blob, bytes):
-            memory, blob = memory_codec.decode(blob), None  # the blob goes before the rollback state comes
+            memory, blob = _decoded(brain, blob), None  # the blob goes before the rollback state comes
             self.refused_memory += not restore_or_keep(brain, memory)
             memory = None
             heap.give_back()
 
     def _restore(self, msg: arena_proto.ArenaMemory) -> None:
-        """Each blob is taken out of the message and let go once decoded, before the controller's
-        rollback state is taken: for a DFT robot each of the three is MBs (issue 12's 80 MB)."""
+        """Each blob (a view of the message: swarm/protocol_arena.py) is let go once decoded, before
+        any rollback state is taken: for a DFT robot each is MBs (issue 12's 80 MB)."""
         handed = msg.memory
         while handed:
             agent, blob = handed.pop()
             if (slot := self.slot_of.get(agent)) is not None:
-                memory, blob = memory_codec.decode(blob), None
+                memory, blob = _decoded(self.brains[slot], blob), None
                 self.refused_memory += not restore_or_keep(self.brains[slot], memory)
                 memory = None
         heap.give_back()
@@ -98,7 +98,12 @@ class ArenaAgentRuntime(AgentRuntime):
 def give_back(brain, blob: bytes) -> bool:
     """Restore a controller from a saved memory.  One that cannot be decoded or
     restored leaves the controller as it was (False: the caller counts it)."""
-    return restore_or_keep(brain, memory_codec.decode(blob))
+    return restore_or_keep(brain, _decoded(brain, blob))
+
+
+def _decoded(brain, blob: bytes | memoryview):
+    """The memory in `blob`; its arrays are views of it for a controller that copies what it restores."""
+    return memory_codec.decode(blob, views=getattr(brain, "restore_copies", False))
 
 
 def restore_or_keep(brain, memory) -> bool:

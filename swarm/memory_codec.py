@@ -24,11 +24,11 @@ from typing import Any
 import msgpack
 import numpy as np
 
+from swarm import msgpack_views
 from swarm.protocol import HEADERS, Rejected, bin_header
 
 _ARRAY = 1  # msgpack extension code: [dtype, shape, bytes]
 MAX_MEMORY_BYTES = 256 * 1024 * 1024  # one controller's memory; a DFT robot on large-maze takes ~3.2 MB
-_HEAD = 1024  # bytes enough for an array's dtype and shape
 _FIXEXT = {1: 0xD4, 2: 0xD5, 4: 0xD6, 8: 0xD7, 16: 0xD8}
 
 
@@ -95,36 +95,36 @@ def encode(memory: Any) -> bytes:
     return b"".join(pieces(memory))
 
 
-def _ext(code: int, data: bytes) -> Any:
-    """An array from its extension: [dtype, shape, bin], its bytes read where they lie (one copy, not two)."""
+def _array(code: int, data: bytes | memoryview) -> np.ndarray:
+    """An array from its extension, [dtype, shape, bin]: a read-only view of `data`, checked."""
     if code != _ARRAY:
         raise ValueError(f"unknown extension {code}")
-    head = msgpack.Unpacker(raw=False)
-    head.feed(data[:_HEAD])  # dtype and shape come first and are short
-    if head.read_array_header() != 3:
+    parts = msgpack_views.unpack(data)
+    if not (isinstance(parts, list) and len(parts) == 3 and isinstance(parts[0], str)
+            and isinstance(parts[1], list) and isinstance(parts[2], memoryview)):  # fmt: skip
         raise ValueError("an array is [dtype, shape, bytes]")
-    dtype, shape = np.dtype(head.unpack()), head.unpack()
+    dtype, shape, raw = np.dtype(parts[0]), parts[1], parts[2]
     if dtype.hasobject:
         raise ValueError("object arrays are not memory")
-    at = head.tell()
-    size, at = _bin_size(data, at)
-    if at + size != len(data) or size != dtype.itemsize * math.prod(shape):
+    if not all(type(n) is int and n >= 0 for n in shape) or raw.nbytes != dtype.itemsize * math.prod(shape):
         raise ValueError("an array's bytes do not match its dtype and shape")
-    return np.frombuffer(data, dtype=dtype, offset=at).reshape(shape).copy()
+    return np.frombuffer(raw, dtype=dtype).reshape(shape)
 
 
-def _bin_size(data: bytes, at: int) -> tuple[int, int]:
-    """The size of the bin at `at` and where its bytes begin."""
-    width = {0xC4: 1, 0xC5: 2, 0xC6: 4}.get(data[at])
-    if width is None:
-        raise ValueError("an array's bytes are not a bin")
-    return int.from_bytes(data[at + 1 : at + 1 + width], "big"), at + 1 + width
+def _ext(code: int, data: bytes) -> np.ndarray:
+    """msgpack's ext hook: the array copied once out of the extension's bytes (they are msgpack's copy)."""
+    return _array(code, data).copy()
 
 
-def decode(blob: bytes) -> Any:
-    if not isinstance(blob, bytes | bytearray) or len(blob) > MAX_MEMORY_BYTES:
+def decode(blob: bytes | memoryview, views: bool = False) -> Any:
+    """The memory in `blob`, or a `Rejected` reason.  With `views`, its arrays (and any bins) are read-only
+    views of `blob`, not copies: for a controller whose restore() copies what it is given (`restore_copies`,
+    agents/controllers/arena.py), so a DFT robot's fields are never held twice while they are handed back."""
+    if not isinstance(blob, bytes | bytearray | memoryview) or len(blob) > MAX_MEMORY_BYTES:
         return Rejected("memory: expected at most 256 MB of bytes")
     try:
+        if views:
+            return msgpack_views.unpack(blob, _array)
         return msgpack.unpackb(blob, raw=False, strict_map_key=False, ext_hook=_ext)
     except Exception as err:  # a broken blob is a reason, never a traceback
         return Rejected(f"memory: {type(err).__name__}")

@@ -33,6 +33,7 @@ import msgpack
 import numpy as np
 
 from agents.controllers.layout import ACT_LEN, MEM_LEN, PERC_F_LEN, PERC_LEN, new_memory
+from swarm import msgpack_views
 
 VERSION = 2
 FAMILY_GRID = "grid"
@@ -113,11 +114,13 @@ def pack_ending_with(message: dict, key: str, tail: list) -> bytes:
     return b"".join([*head, msgpack.packb(key), *tail])
 
 
-def unpack(data: bytes, limit: int = MAX_MESSAGE_BYTES) -> dict | Rejected:
+def unpack(data: bytes, limit: int = MAX_MESSAGE_BYTES, views: bool = False) -> dict | Rejected:
+    """A message's map, or why not.  With `views` its bins are views of `data`, not copies
+    (swarm/msgpack_views.py): for a message that carries MBs, such as memories handed back."""
     if len(data) > limit:
         return Rejected("too large")
     try:
-        message = msgpack.unpackb(data, raw=False, strict_map_key=True)
+        message = msgpack_views.unpack(data) if views else msgpack.unpackb(data, raw=False, strict_map_key=True)
     except Exception:
         return Rejected("not msgpack")
     if not isinstance(message, dict):

@@ -53,7 +53,7 @@ MAX_PLAN_POINTS = 2000  # 32 KB: a plan message stays under the world's message 
 
 MAX_SHARED = 4 * 1024 * 1024  # bytes of shared payloads in one message
 Shared = list[tuple[int, str, bytes]]  # (agent, share, payload)
-Memories = list[tuple[int, bytes]]  # (agent, its controller's memory, swarm.memory_codec)
+Memories = list[tuple[int, bytes | memoryview]]  # (agent, its controller's memory, swarm.memory_codec)
 MemoryPieces = list[tuple[int, list]]  # (agent, its memory as swarm.memory_codec.pieces): sent without a blob
 
 
@@ -95,12 +95,16 @@ def parse_memory(raw, agents: np.ndarray | None = None) -> Memories | Rejected:
     named = None if agents is None else set(agents.tolist())
     out = []
     for item in raw:
-        if not (isinstance(item, list) and len(item) == 2 and type(item[0]) is int and isinstance(item[1], bytes)):
+        if not (isinstance(item, list) and len(item) == 2 and type(item[0]) is int
+                and isinstance(item[1], bytes | memoryview)):  # a view where the message was read with views
             return Rejected("memory: expected [agent, bytes]")
         if named is not None and item[0] not in named:
             return Rejected("memory: names an agent the message does not act for")
         out.append((item[0], item[1]))
     return out
+
+
+_MEMORY_HEAD = pack({"type": "memory", "family": FAMILY_ARENA})[1:]  # how memory_message's map begins
 
 
 def memory_message(memory: Memories) -> bytes:
@@ -188,8 +192,10 @@ def _decode(entry) -> np.ndarray | Rejected:
 
 
 def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
-    """A batch of readings, or the raw dict of a `stop` message."""
-    m = unpack(data, MAX_OBS_BYTES)
+    """A batch of readings, the memories a resumed world hands back, or the raw dict of a `stop` message.
+    A memory message as `memory_message` writes it is read with its blobs as views of `data`: a DFT
+    robot's is MBs, and the agent must not hold it twice (issue 12's 80 MB)."""
+    m = unpack(data, MAX_OBS_BYTES, views=data[1 : len(_MEMORY_HEAD) + 1] == _MEMORY_HEAD)
     if isinstance(m, Rejected) or m.get("type") in ("stop", "wake"):
         return m
     if m.get("type") == "memory":

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from agents.arena_runtime import give_back
 from agents.controllers.arena import make_controller
-from swarm import memory_codec
+from swarm import memory_codec, msgpack_views
 from swarm import protocol_arena as arena_proto
 from swarm.arena.engine import ArenaEngine
 from swarm.arena.scenario import controller_params
@@ -298,3 +298,132 @@ def test_freed_heap_memory_goes_back_to_the_system():
     if glibc != "True":
         pytest.skip("not glibc: nothing to give back this way")
     assert trimmed == "True" and float(now) < float(before) - 30, out.stdout
+
+
+def _no_views(value):
+    """A value read by msgpack_views with its bins as bytes, as msgpack reads them."""
+    if isinstance(value, memoryview):
+        return bytes(value)
+    if isinstance(value, list):
+        return [_no_views(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _no_views(v) for k, v in value.items()}
+    return value
+
+
+_SIZES = [0, 1, 15, 16, 31, 32, 255, 256, 65_535, 65_536]
+_KEYS = st.text(max_size=5) | st.integers(-3, 3) | st.binary(max_size=3)
+_PLAIN = st.recursive(
+    st.none() | st.booleans() | st.integers(-(2**63), 2**64 - 1) | st.floats(allow_nan=False, width=32) | st.text()
+    | st.binary() | st.sampled_from(_SIZES).map(lambda n: "é" * n) | st.sampled_from(_SIZES).map(bytes),
+    lambda inner: st.lists(inner) | st.dictionaries(_KEYS, inner),
+    max_leaves=40,
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(_PLAIN, st.booleans())
+def test_msgpack_views_reads_what_msgpack_reads_with_bins_as_views_of_the_message(value, single):
+    data = msgpack.packb(value, use_bin_type=True, use_single_float=single)
+    got = msgpack_views.unpack(data)
+    assert _no_views(got) == msgpack.unpackb(data, raw=False, strict_map_key=False)
+
+
+def test_msgpack_views_reads_every_header_size_and_leaves_bins_where_they_lie():
+    for n in _SIZES:
+        value = {"s": "x" * n, "b": b"y" * n, "a": [0] * n, "m": {i: None for i in range(n)}, -n: 2**64 - 1 - n}
+        data = msgpack.packb(value, use_bin_type=True)
+        got = msgpack_views.unpack(data)
+        assert _no_views(got) == value
+        assert isinstance(got["b"], memoryview) and got["b"].obj is data and got["b"].readonly  # no copy
+
+
+def _same_as_msgpack(data: bytes) -> None:
+    def theirs(code, raw):
+        return ("ext", code, raw)
+
+    try:
+        want = msgpack.packb(msgpack.unpackb(data, raw=False, strict_map_key=False, ext_hook=theirs))
+    except Exception:
+        want = "refused"
+    try:
+        got = msgpack.packb(_no_views(msgpack_views.unpack(data, lambda code, raw: ("ext", code, bytes(raw)))))
+    except ValueError as err:
+        got = "refused" if want == "refused" or "too deep" not in str(err) else want  # msgpack nests to 1024
+    assert got == want, data.hex()
+
+
+@settings(max_examples=500, deadline=None)
+@given(st.binary(max_size=120))
+def test_msgpack_views_refuses_what_msgpack_refuses_with_a_value_error(data):
+    """Random bytes (NaNs compared by their packed form): read alike, or refused by both, never another error."""
+    _same_as_msgpack(data)
+
+
+@settings(max_examples=200, deadline=None)
+@given(_PLAIN, st.data())
+def test_msgpack_views_refuses_a_truncated_or_overlong_message(value, data):
+    packed = msgpack.packb(value, use_bin_type=True)
+    cut = data.draw(st.integers(0, len(packed) - 1))
+    _same_as_msgpack(packed[:cut])
+    _same_as_msgpack(packed + b"\xc0")
+    deep = b"\x91" * (msgpack_views.MAX_DEPTH + 1) + b"\xc0"
+    with pytest.raises(ValueError, match="too deep"):
+        msgpack_views.unpack(deep)
+
+
+@settings(max_examples=100, deadline=None)
+@given(_MEMORIES)
+def test_a_memory_decoded_with_views_equals_the_one_decoded_with_copies(memory):
+    blob = memory_codec.encode(memory)
+    copied, viewed = memory_codec.decode(blob), memory_codec.decode(blob, views=True)
+    assert memory_codec.encode(_no_views(viewed)) == memory_codec.encode(copied) == blob
+    arrays = [v for v in _leaves(viewed) if isinstance(v, np.ndarray)]
+    assert all(not a.flags.writeable and not a.flags.owndata for a in arrays)  # views of the blob, not copies
+
+
+def _leaves(value):
+    if isinstance(value, list):
+        return [x for v in value for x in _leaves(v)]
+    if isinstance(value, dict):
+        return [x for v in value.values() for x in _leaves(v)]
+    return [value]
+
+
+def test_broken_array_extensions_are_refused_with_views_as_with_copies():
+    good = memory_codec.encode({"a": np.arange(4.0)})
+    cases = [
+        msgpack.packb({"a": msgpack.ExtType(1, msgpack.packb(["<f8", [5], bytes(32)]))}),  # bytes short of the shape
+        msgpack.packb({"a": msgpack.ExtType(1, msgpack.packb(["<f8", [-4], bytes(32)]))}),
+        msgpack.packb({"a": msgpack.ExtType(1, msgpack.packb(["|O", [1], bytes(8)]))}),
+        msgpack.packb({"a": msgpack.ExtType(1, msgpack.packb(["<f8", [4], "x" * 32]))}),
+        msgpack.packb({"a": msgpack.ExtType(2, b"")}),
+        good[:-1],
+    ]
+    for blob in cases:
+        assert isinstance(memory_codec.decode(blob), Rejected) and isinstance(memory_codec.decode(blob, True), Rejected)
+
+
+def test_a_dft_memory_handed_back_is_read_where_it_lies_in_the_message():
+    """A resume's peak (issue 12): the memory message is parsed with its blob as a view, the blob decoded
+    with its fields as views, and the controller copies them into its own arrays: no MB-sized copy on the way."""
+    from agents.arena_runtime import ArenaAgentRuntime
+
+    scenario = load_scenario("large-maze").with_overrides(controller="dft", max_ticks=50)
+    engine = ArenaEngine(scenario)
+    engine.step(3)
+    blob = memory_codec.encode(engine.controllers[0].snapshot())
+    message = arena_proto.memory_message([(0, blob)])
+    runtime = ArenaAgentRuntime.__new__(ArenaAgentRuntime)  # its restore path alone, without a session
+    runtime.brains, runtime.slot_of, runtime.refused_memory = [make_controller("dft")], {0: 0}, 0
+    runtime.brains[0].reset(scenario.seed, 0, controller_params(scenario, 0))
+    tracemalloc.start()
+    handed = arena_proto.parse_obs(message)
+    assert isinstance(handed, arena_proto.ArenaMemory) and isinstance(handed.memory[0][1], memoryview)
+    runtime._restore(handed)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert len(blob) > 2_000_000 and peak < 0.05 * len(blob) and runtime.refused_memory == 0  # a copy: len(blob)
+    assert memory_codec.encode(runtime.brains[0].snapshot()) == blob
+    reordered = pack({"memory": [[0, blob]], "type": "memory", "family": "arena"})  # not as memory_message writes
+    assert arena_proto.parse_obs(reordered).memory == [(0, blob)]  # read with copies: still the same memory

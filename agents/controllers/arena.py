@@ -58,6 +58,8 @@ class ArenaController(Protocol):
 
     # Optional: atomic_restore = True when restore() checks the whole state before it writes any of it, so
     # that one raising has changed nothing (the agent then keeps no rollback copy of the old state).
+    # Optional: restore_copies = True when restore() copies the arrays it is given into its own and keeps
+    # none of them: it is then given read-only views of the message that carried its memory, not copies.
     # Optional: route() -> the path (N x 2 metres) a controller follows, or None.  An agent process asks
     # for it every tick to send a new plan to the recording, so it must be cheap (record() need not be).
 

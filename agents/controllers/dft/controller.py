@@ -194,6 +194,7 @@ class DftController:
     # restore() checks the whole state before it writes any of it: a memory that does not fit changes
     # nothing, so the agent needs no rollback copy of the old state (MBs: agents/arena_runtime.py)
     atomic_restore = True
+    restore_copies = True  # put() writes the fields into the engine's arrays: it may be given views
 
     def restore(self, state: dict[str, Any]) -> None:
         tick, received = int(state["tick"]), int(state.get("received", 0))
