@@ -468,6 +468,16 @@ def test_bg_experiment_tests_share_maps_across_conditions():
     assert all(j[9] is maps["bg-exp3"][j[8]] for j in jobs)
 
 
+def test_a_choice_table_says_how_many_of_neither_died():
+    from swarm.arena.bg_experiments import PAPER_FEAR, _choice_summary
+
+    rows = [{"condition": 0.1, "chose": c, "died": d} for c, d in [("Ep1", False), ("none", True), ("none", False)]]
+    rows += [{"condition": 0.5, "chose": "Ep2", "died": False}]
+    summary, md = _choice_summary(rows, PAPER_FEAR, "Ep at start", ("Ep1", "Ep2"), fisher=True)
+    assert "| 0.1 | 1 | 0 | 2 (1 died) | 13 | 7 |" in md and "| 0.5 | 0 | 1 | 0 | 2 | 18 |" in md
+    assert [s.get("neither_died") for s in summary[:2]] == [1, 0] and "Died: E ran out" in md
+
+
 def test_bg_experiment_maps_option_is_checked():
     from swarm.arena.bg_experiments import run_bg_experiment
     from swarm.scenario import ScenarioError

@@ -133,7 +133,7 @@ def run_test(job: tuple) -> dict:
     r = engine.summary()["robots"][0]
     seconds = r["ingest_tick"] * s.control_period if r["ingest_tick"] is not None else None
     return {"experiment": experiment, "condition": label, "run": run, "seed": seed, "map": map_index,
-            "chose": r["ingested"] or "none",
+            "chose": r["ingested"] or "none", "died": not r["alive"],
             "branch": first_branch or "", "seconds": seconds, "distance": r["distance"],
             "wall_seconds": engine.wall_seconds}  # fmt: skip
 
@@ -174,12 +174,15 @@ def _choice_summary(rows: list[dict], paper: dict, header: str, options: tuple[s
         n1 = sum(r[field] == options[0] for r in sel)
         n2 = sum(r[field] == options[1] for r in sel)
         other = len(sel) - n1 - n2
+        died = sum(bool(r.get("died")) for r in sel if r[field] not in options)  # the dangerous area's drain
         table.append([n1, n2])
         summary.append({"condition": cond, "runs": len(sel), options[0]: n1, options[1]: n2, "neither": other,
-                        f"paper_{options[0]}": p1, f"paper_{options[1]}": p2})  # fmt: skip
-        lines.append(f"| {cond} | {n1} | {n2} | {other} | {p1} | {p2} |")
+                        "neither_died": died, f"paper_{options[0]}": p1, f"paper_{options[1]}": p2})  # fmt: skip
+        lines.append(f"| {cond} | {n1} | {n2} | {other}{f' ({died} died)' if died else ''} | {p1} | {p2} |")
     md = (f"| {header} | {options[0]} | {options[1]} | neither | paper {options[0]} | paper {options[1]} |\n"
           "|---|---|---|---|---|---|\n" + "\n".join(lines) + "\n")  # fmt: skip
+    if any(s["neither_died"] for s in summary):
+        md += "\nDied: E ran out before any reload (the dangerous area drains E: docs/bg.md, Metabolism).\n"
     if fisher:
         from scipy.stats import fisher_exact
 
@@ -238,7 +241,8 @@ def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) ->
         ax.set_xlabel("seconds to reload at Ep1")
     else:
         rows_ = [r for r in summary if isinstance(r.get("runs"), int)]
-        keys = [k for k in rows_[0] if k not in ("condition", "runs", "neither") and not k.startswith("paper")]
+        keys = [k for k in rows_[0] if k not in ("condition", "runs", "neither", "neither_died")
+                and not k.startswith("paper")]  # fmt: skip
         x = np.arange(len(rows_))
         for k, key in enumerate(keys):
             ax.bar(x + (k - 0.5) * 0.35, [r[key] for r in rows_], 0.35, label=f"ours: {key}")
