@@ -40,8 +40,8 @@ def _no_ext(code: int, data: memoryview) -> Any:
 def unpack(data: bytes | memoryview, ext_hook: ExtHook = _no_ext) -> Any:
     """The one value `data` holds; raises ValueError on a malformed, truncated or overlong message.
     Bins in the result are views of `data`: it stays alive as long as they do."""
-    view = memoryview(data)
-    reader = _Reader(view if view.format == "B" else view.cast("B"), ext_hook)
+    view = memoryview(data).cast("B")  # bytes, whatever the buffer's item format
+    reader = _Reader(view, ext_hook)
     try:
         value = reader.value(0)
     except (TypeError, struct.error) as err:  # a key that cannot be a key (a list), a short number
@@ -65,7 +65,7 @@ class _Reader:
         return struct.unpack(fmt, self.take(size))[0]
 
     def value(self, depth: int, key: bool = False) -> Any:
-        code = self.number(">B", 1)
+        code = self.take(1)[0]
         if code <= 0x7F:
             return code
         if code >= 0xE0:
