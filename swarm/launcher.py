@@ -236,6 +236,7 @@ def _follow(session, keys: proto.Keys, children: _Children, agents: int, progres
     states: queue.Queue = queue.Queue()
     sub = session.declare_subscriber(keys.state, states.put)
     bar = tqdm(desc="done", unit="", disable=not progress, leave=False)
+    next_look = 0.0  # when to look at the agents' processes again (failures, peak memory)
     try:
         while world.poll() is None:
             try:
@@ -246,7 +247,8 @@ def _follow(session, keys: proto.Keys, children: _Children, agents: int, progres
                 continue
             if isinstance(msg, proto.Rejected):
                 continue
-            if msg.get("tick", 0) % 50 == 1:
+            if time.monotonic() >= next_look and msg.get("tick", 0) > 0:  # the world ticks ten times this a second
+                next_look = time.monotonic() + 1.0
                 if (failed := children.failed_agent()) is not None:
                     raise children.failure(failed)
                 for p in procs[1:]:

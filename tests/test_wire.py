@@ -8,7 +8,7 @@ from agents.controllers.layout import A_MARK, A_MOVE, ACT_LEN, MARK, MARK_NONE, 
 from swarm import protocol as proto
 from swarm.scenario import load_scenario
 from world_server.grid import GridWorld
-from world_server.grid_wire import REFUSALS, accept_rows, observe_rows
+from world_server.grid_wire import REFUSALS, accept_message, accept_rows, observe_rows
 
 ACTIVE, FREE = 2, 0
 
@@ -151,3 +151,66 @@ def test_the_compiled_envelope_leaves_every_other_message_to_the_parser():
     nan = proto.observations(4, np.zeros((5, proto.OBS_INTS), np.int64), np.full((5, 5), np.nan))
     size, _, _, mems, _ = _answer(nan, kind, params)
     assert size == -1 and (mems == new_memory(5)).all()  # a plain observation that is malformed: nobody stepped
+
+
+def _accept_world():
+    n = 4
+    return {"slots": np.array([ACTIVE, ACTIVE, FREE, ACTIVE], np.int64), "group_ids": np.array([0, 1, -1, 0], np.int64),
+            "acted": np.zeros(n, bool), "acts": np.zeros((n, ACT_LEN), np.int64), "mark_due": np.zeros(n, bool),
+            "memory": np.zeros((n, 8), np.int64)}  # fmt: skip
+
+
+def _mixed_rows():
+    """Good rows and one of every refusal: unknown agents, another process's, a second action, out of range."""
+    stay = np.zeros(ACT_LEN, np.int64)
+    stay[A_MOVE] = 4
+    wild = stay.copy()
+    wild[A_MOVE] = 99
+    return proto.action_rows([0, 1, 2, 99, -1, 3, 0, 3], [stay, stay, stay, stay, stay, wild, stay, stay],
+                             [0, 0, 0, 0, 0, 0, 0, 1], np.arange(64).reshape(8, 8))  # fmt: skip
+
+
+def _accept(message, first, last, w):
+    refused = np.full(len(REFUSALS), 7, np.int64)
+    got = accept_message(np.frombuffer(message, np.uint8), first, last, w["slots"], w["group_ids"], 0, True,
+                         w["acted"], w["acts"], w["mark_due"], w["memory"], refused)  # fmt: skip
+    return got, refused
+
+
+def test_the_world_accepts_a_plain_action_message_in_one_call_as_the_parser_does():
+    """grid_wire.accept_message on pack_actions' bytes equals parse_acts then accept_rows (every width of the tick)."""
+    rows = _mixed_rows()
+    for tick in (0, 127, 128, 300, 70_000, 2**33):
+        message = proto.pack_actions(tick, rows)
+        ours, ref = _accept_world(), _accept_world()
+        got, refused = _accept(message, tick, tick, ours)
+        parsed = proto.parse_acts(message)
+        expected = accept_rows(parsed.rows, ref["slots"], ref["group_ids"], 0, True, ref["acted"], ref["acts"],
+                               ref["mark_due"], ref["memory"])  # fmt: skip
+        assert got == expected.sum() == 6 and refused.tolist() == expected.tolist()
+        for name in ours:
+            np.testing.assert_array_equal(ours[name], ref[name], err_msg=name)
+        assert ours["mark_due"].tolist() == [False, False, False, True]
+
+
+def test_the_world_leaves_every_other_action_message_to_the_parser_and_changes_nothing():
+    good = proto.pack_actions(300, _mixed_rows())
+    others = [b"", b"\x85", proto.pack({"type": "act", "tick": 300, "family": "grid", "rows": b""}),  # another order
+              good + b"\x00", proto.pack({"type": "wake"}),
+              proto.pack({"v": proto.VERSION, "type": "act", "family": "arena", "tick": 300, "rows": b""})]  # fmt: skip
+    others += [good[:k] for k in range(0, len(good), 5)]  # every truncation: never a read past the end
+    lying = bytearray(good)
+    lying[lying.index(b"rows") + 5] = 0xFF  # a bin length past the end
+    odd = bytearray(proto.pack_actions(300, _mixed_rows()[:1]))
+    odd[odd.index(b"rows") + 5] -= 8  # rows not a whole number of rows
+    others += [bytes(lying), bytes(odd[:-8])]
+    for message in others:
+        w = _accept_world()
+        assert _accept(message, 300, 300, w)[0] == proto.NOT_PLAIN, message[:40]
+        assert not (w["acted"].any() or w["acts"].any() or w["memory"].any() or w["mark_due"].any())
+    for first, last in ((301, 301), (299, 299), (301, 303)):  # not for this tick (lock-step, or real time's window)
+        w = _accept_world()
+        assert _accept(good, first, last, w)[0] == proto.NOT_PLAIN and not w["acted"].any()
+    assert _accept(good, 298, 300, _accept_world())[0] == 6  # real time: one of the last three ticks
+    big = proto.pack_actions(300, np.zeros((proto.MAX_MESSAGE_BYTES // (8 * proto.ACT_ROW) + 1, proto.ACT_ROW), int))
+    assert _accept(big, 300, 300, _accept_world())[0] == proto.NOT_PLAIN  # too large: the parser refuses it

@@ -28,7 +28,8 @@ from agents.controllers.layout import (
     STAY,
     TRAIL_ERASE,
 )  # fmt: skip
-from swarm.protocol import ACT_ROW, OBS_INTS, R_ACT, R_AGENT, R_MARKED, R_MEM
+from swarm.protocol import ACT_ROW, MAX_MESSAGE_BYTES, NOT_PLAIN, OBS_INTS, R_ACT, R_AGENT, R_MARKED, R_MEM
+from swarm.wire_bytes import ACT_HEAD, ROWS_KEY, key, read_bin, read_int, words
 from world_server.grid import perceive
 
 ACTIVE = 2  # world_server.server.ACTIVE (a slot whose agent is in the run)
@@ -72,6 +73,12 @@ def accept_rows(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, 
     those that pass; returns the refusals counted by reason (REFUSALS).  A
     refused row changes nothing."""
     refused = np.zeros(len(REFUSALS), dtype=np.int64)
+    _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused)
+    return refused
+
+
+@njit(cache=True)
+def _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused):
     n = len(slots)
     for i in range(rows.shape[0]):
         row = rows[i]
@@ -92,7 +99,40 @@ def accept_rows(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, 
                 memory[a, k] = row[R_MEM + k]
             acted[a] = True
             mark_due[a] = row[R_MARKED] == 1
-    return refused
+
+
+@njit(cache=True)
+def accept_message(buf, first_tick, last_tick, slots, group_ids, group, lockstep, acted, acts, mark_due, memory,
+                   refused):  # fmt: skip
+    """An action message from process `group`, read where its bytes lie (laid
+    out as `swarm.protocol.pack_actions` packs it) and applied as `accept_rows`
+    applies its rows, in one call.  Returns how many rows were refused (counted
+    by reason in `refused`), or NOT_PLAIN, having applied nothing: a tick
+    outside first_tick .. last_tick, any other layout, anything malformed,
+    which the Python path then counts and says why it refuses."""
+    header = ACT_HEAD
+    n = len(buf)
+    if n < len(header) or n > MAX_MESSAGE_BYTES:
+        return NOT_PLAIN
+    for k in range(len(header)):
+        if buf[k] != header[k]:
+            return NOT_PLAIN
+    tick, at = read_int(buf, len(header))
+    if at < 0:
+        return NOT_PLAIN
+    at = key(buf, at, ROWS_KEY[1:])  # the key without its fixstr tag
+    if at < 0:
+        return NOT_PLAIN
+    rows_at, rows_len = read_bin(buf, at)
+    if rows_at < 0 or rows_at + rows_len != n or rows_len % (ACT_ROW * 8):
+        return NOT_PLAIN
+    if not first_tick <= tick <= last_tick:
+        return NOT_PLAIN
+    count = rows_len // (ACT_ROW * 8)
+    rows = words(buf, rows_at, count * ACT_ROW).view(np.int64).reshape((count, ACT_ROW))
+    refused[:] = 0
+    _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused)
+    return refused.sum()
 
 
 def warm_up(world) -> None:
@@ -103,3 +143,6 @@ def warm_up(world) -> None:
     n = len(world.pos)
     accept_rows(np.zeros((0, ACT_ROW), np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64), 0, True,
                 np.zeros(n, bool), world.acts, np.zeros(n, bool), np.zeros((n, MEM_LEN), np.int64))  # fmt: skip
+    accept_message(np.zeros(0, np.uint8), 0, 0, np.zeros(n, np.int64), np.zeros(n, np.int64), 0, True,
+                   np.zeros(n, bool), world.acts, np.zeros(n, bool), np.zeros((n, MEM_LEN), np.int64),
+                   np.zeros(len(REFUSALS), np.int64))  # fmt: skip

@@ -35,6 +35,7 @@ from swarm.scenario import ScenarioError
 # JOINING: welcomed, but its observation subscriber may not be routed yet; it is
 # ACTIVE once its liveliness token arrives (declared after the subscriber).
 FREE, JOINING, ACTIVE, LOST = 0, 1, 2, 3
+STATE_PERIOD = 0.1  # seconds between progress messages on the state key (at most one per tick)
 
 
 @dataclass
@@ -121,6 +122,7 @@ class WorldServer:
             *self._declare_shared(put),
         ]
         self._state_publisher = self.session.declare_publisher(k.state)
+        self._next_state = 0.0  # when progress goes out on the state key next
 
     # ----------------------------------------------------- hooks of a world kind
 
@@ -337,12 +339,17 @@ class WorldServer:
             return True
         return False
 
-    def _current(self, tick: int) -> bool:
-        """Lock-step: only this tick.  Real time: this tick or the two before
-        (an agent may answer a slightly old observation)."""
+    def _window(self) -> tuple[int, int]:
+        """The ticks an action may be for now.  Lock-step: only this tick.  Real
+        time: this tick or the two before (an agent may answer a slightly old
+        observation)."""
         if self.mode == "lockstep":
-            return tick == self.tick
-        return self.tick - 2 <= tick <= self.tick
+            return self.tick, self.tick
+        return self.tick - 2, self.tick
+
+    def _current(self, tick: int) -> bool:
+        first, last = self._window()
+        return first <= tick <= last
 
     def _drain(self, timeout: float) -> bool:
         """Handle queued events; wait up to `timeout` for the first one."""
@@ -424,7 +431,9 @@ class WorldServer:
         if self.recorder is not None:
             self.recorder.capture(tick, present=present, tick_ms=self.tick_seconds[-1] * 1000,
                                   rejected=self.stats.rejected_total)  # fmt: skip
-        self._state_publisher.put(proto.pack({"type": "state", **self.progress()}))
+        if (now := time.monotonic()) >= self._next_state:  # progress for people: ten times a second is plenty
+            self._next_state = now + STATE_PERIOD
+            self._state_publisher.put(proto.pack({"type": "state", **self.progress()}))
 
     def _groups(self, agents: np.ndarray) -> dict[str, np.ndarray]:
         """The active agents by agent process, worked out again only when

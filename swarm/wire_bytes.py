@@ -1,0 +1,93 @@
+"""Compiled reading and writing of the grid's msgpack messages where their
+bytes lie: both ends' one-call envelopes (the agent's answer,
+`agents/controllers/envelope.py`, and the world's acceptance of actions,
+`world_server/grid_wire.py`) read and write the same fixed layout that
+`swarm.protocol` packs.  Every read is bounds-checked: a short or lying
+buffer gives -1, never a read past its end.
+"""
+
+import numpy as np
+from numba import njit
+
+from swarm.protocol import FAMILY_GRID, VERSION
+
+# The fixed bytes of both messages (msgpack: fixmap of 5, fixstr keys, in the order swarm.protocol packs them).
+OBS_HEAD = np.frombuffer(b"\x85\xa1v" + bytes([VERSION]) + b"\xa4type\xa3obs\xa4tick", np.uint8).copy()
+ACT_HEAD = np.frombuffer(b"\x85\xa1v" + bytes([VERSION]) + b"\xa4type\xa3act\xa6family\xa4" + FAMILY_GRID.encode()
+                          + b"\xa4tick", np.uint8).copy()  # fmt: skip
+INTS_KEY = np.frombuffer(b"ints", np.uint8).copy()
+PF_KEY = np.frombuffer(b"pf", np.uint8).copy()
+ROWS_KEY = np.frombuffer(b"\xa4rows", np.uint8).copy()
+
+
+@njit(cache=True)
+def tagged(buf, at, first_tag, widths):
+    """(value, next offset) of a tag byte in first_tag .. first_tag + widths - 1 at `at`,
+    followed by a big-endian unsigned value of 1, 2, 4 or 8 bytes (msgpack's uint and
+    bin headers), or (-1, -1) when the tag is another or the bytes run out."""
+    n = len(buf)
+    if at >= n or not first_tag <= buf[at] < first_tag + widths:
+        return -1, -1
+    size = 1 << (buf[at] - first_tag)
+    if at + 1 + size > n:
+        return -1, -1
+    v = np.uint64(0)
+    for k in range(size):
+        v = (v << np.uint64(8)) | np.uint64(buf[at + 1 + k])
+    if v > np.uint64(2**62):
+        return -1, -1
+    return np.int64(v), at + 1 + size
+
+
+@njit(cache=True)
+def read_int(buf, at):
+    """(value, next offset) of a non-negative msgpack integer at `at`, or (-1, -1)."""
+    if at < len(buf) and buf[at] <= 0x7F:
+        return np.int64(buf[at]), at + 1
+    return tagged(buf, at, 0xCC, 4)  # uint 8, 16, 32, 64
+
+
+@njit(cache=True)
+def read_bin(buf, at):
+    """(start, length) of a msgpack bin at `at`, or (-1, -1)."""
+    length, start = tagged(buf, at, 0xC4, 3)  # bin 8, 16, 32
+    if start < 0 or start + length > len(buf):
+        return -1, -1
+    return start, length
+
+
+@njit(cache=True)
+def words(buf, at, count):
+    """`count` little-endian 64-bit words from `at`, at any alignment."""
+    out = np.empty(count, np.uint64)
+    for j in range(count):
+        v = np.uint64(0)
+        for k in range(8):
+            v |= np.uint64(buf[at + 8 * j + k]) << np.uint64(8 * k)
+        out[j] = v
+    return out
+
+
+@njit(cache=True)
+def key(buf, at, key):
+    """The offset after fixstr `key` at `at`, or -1."""
+    m = len(key)
+    if at + 1 + m > len(buf) or buf[at] != 0xA0 | m:
+        return -1
+    for k in range(m):
+        if buf[at + 1 + k] != key[k]:
+            return -1
+    return at + 1 + m
+
+
+@njit(cache=True)
+def write_tagged(out, at, v, first_tag, widths):
+    """`v` after the tag of its narrowest width (1, 2, 4, then 8 bytes, big-endian); returns the next offset."""
+    w = 0
+    while w < widths - 1 and v >= 1 << (8 << w):
+        w += 1
+    size = 1 << w
+    out[at] = first_tag + w
+    for k in range(size):
+        out[at + size - k] = (v >> (8 * k)) & 0xFF
+    return at + 1 + size
