@@ -36,7 +36,8 @@ class GridServer(WorldServer):
         self.mark_due = np.zeros(n, dtype=bool)  # its action announced a mark write
         self.mark_got = np.zeros(n, dtype=bool)  # that mark write arrived
         self.memory = new_memory(n)  # every controller's memory after its last step (saved: exact resume)
-        self.refused = np.zeros(len(REFUSALS), dtype=np.int64)  # an action message's refusals, by reason
+        self.refused = np.zeros(len(REFUSALS), dtype=np.int64)  # action rows refused since the last count, by reason
+        self.accepted = 0  # action rows accepted this tick
         self.state_file = persist.state_path(self.state_dir, self.keys.run) if self.state_dir else None
 
     def _declare_shared(self, put) -> list:
@@ -120,6 +121,7 @@ class GridServer(WorldServer):
 
     def _begin_tick(self) -> None:
         w = self.world
+        self.accepted = 0
         self.mark_due[:] = False
         self.mark_got[:] = False
         w.acts[:, A_MOVE] = STAY
@@ -150,31 +152,35 @@ class GridServer(WorldServer):
         self.bytes_in += len(raw)
         group = str(sample.key_expr).rsplit("/", 1)[1]
         first, last = self._window()
-        refused = accept_message(np.frombuffer(raw, np.uint8), first, last, self.slots, self.group_ids,
-                                 self.group_index.get(group, -1), self.mode == "lockstep", self.acted,
-                                 self.world.acts, self.mark_due, self.memory, self.refused)  # fmt: skip
-        if refused == proto.NOT_PLAIN:
-            self._parsed_act(raw, group)
-        elif refused:
-            self._count_refusals(self.refused)
+        accepted = accept_message(np.frombuffer(raw, np.uint8), first, last, self.slots, self.group_ids,
+                                  self.group_index.get(group, -1), self.mode == "lockstep", self.acted,
+                                  self.world.acts, self.mark_due, self.memory, self.refused)  # fmt: skip
+        if accepted == proto.NOT_PLAIN:
+            accepted = self._parsed_act(raw, group)
+        self.accepted += accepted
 
-    def _parsed_act(self, raw: bytes, group: str) -> None:
+    def _parsed_act(self, raw: bytes, group: str) -> int:
         msg = proto.parse_acts(raw)
         if isinstance(msg, proto.Rejected):
             self.stats.reject(f"act: {msg.reason}")
-            return
+            return 0
         if not self._current(msg.tick):
             self.stats.late_actions += len(msg.rows)
             self.stats.reject("act: not for this tick", len(msg.rows))
-            return
-        self._count_refusals(accept_rows(msg.rows, self.slots, self.group_ids, self.group_index.get(group, -1),
-                                         self.mode == "lockstep", self.acted, self.world.acts, self.mark_due,
-                                         self.memory))  # fmt: skip
+            return 0
+        refused = accept_rows(msg.rows, self.slots, self.group_ids, self.group_index.get(group, -1),
+                              self.mode == "lockstep", self.acted, self.world.acts, self.mark_due,
+                              self.memory)  # fmt: skip
+        self.refused += refused
+        return len(msg.rows) - int(refused.sum())
 
-    def _count_refusals(self, refused: np.ndarray) -> None:
-        for reason, count in zip(REFUSALS, refused.tolist(), strict=True):
-            if count:
-                self.stats.reject(reason, count)
+    def _count_refusals(self) -> None:
+        """The refused rows since the last count, into the run's rejections (once a tick, not per message)."""
+        if self.refused.any():
+            for reason, count in zip(REFUSALS, self.refused.tolist(), strict=True):
+                if count:
+                    self.stats.reject(reason, count)
+            self.refused[:] = 0
 
     def _on_mark(self, sample) -> None:
         received = self._receive(sample, proto.parse_marks, "mark")
@@ -207,6 +213,15 @@ class GridServer(WorldServer):
                               "width": int(grid.shape[1]), "marks": grid.ravel().tolist(),
                               "trails": self.world.trails.ravel().tolist()})  # fmt: skip
         self._reply(query, f"{self.keys.prefix}/marks/grid", payload)
+
+    def may_all_have_answered(self, agents: np.ndarray) -> bool:
+        return self.accepted >= len(agents)
+
+    def barrier_passed(self) -> None:
+        self._count_refusals()
+
+    def _finish(self) -> None:
+        self._count_refusals()  # what came after the last tick's barrier
 
     def answered(self, agents: np.ndarray) -> np.ndarray:
         if self.mode == "realtime":

@@ -79,7 +79,9 @@ def accept_rows(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, 
 
 @njit(cache=True)
 def _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused):
+    """Rows accepted; each refusal added to its reason's count in `refused`."""
     n = len(slots)
+    accepted = 0
     for i in range(rows.shape[0]):
         row = rows[i]
         a = row[R_AGENT]
@@ -99,6 +101,8 @@ def _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memo
                 memory[a, k] = row[R_MEM + k]
             acted[a] = True
             mark_due[a] = row[R_MARKED] == 1
+            accepted += 1
+    return accepted
 
 
 @njit(cache=True)
@@ -106,10 +110,11 @@ def accept_message(buf, first_tick, last_tick, slots, group_ids, group, lockstep
                    refused):  # fmt: skip
     """An action message from process `group`, read where its bytes lie (laid
     out as `swarm.protocol.pack_actions` packs it) and applied as `accept_rows`
-    applies its rows, in one call.  Returns how many rows were refused (counted
-    by reason in `refused`), or NOT_PLAIN, having applied nothing: a tick
-    outside first_tick .. last_tick, any other layout, anything malformed,
-    which the Python path then counts and says why it refuses."""
+    applies its rows, in one call.  Returns how many rows were accepted (each
+    refused one is added to its reason's count in `refused`, which the caller
+    reads once a tick), or NOT_PLAIN, having applied nothing: a tick outside
+    first_tick .. last_tick, any other layout, anything malformed, which the
+    Python path then counts and says why it refuses."""
     header = ACT_HEAD
     n = len(buf)
     if n < len(header) or n > MAX_MESSAGE_BYTES:
@@ -130,9 +135,7 @@ def accept_message(buf, first_tick, last_tick, slots, group_ids, group, lockstep
         return NOT_PLAIN
     count = rows_len // (ACT_ROW * 8)
     rows = words(buf, rows_at, count * ACT_ROW).view(np.int64).reshape((count, ACT_ROW))
-    refused[:] = 0
-    _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused)
-    return refused.sum()
+    return _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused)
 
 
 def warm_up(world) -> None:
