@@ -91,3 +91,31 @@ def write_tagged(out, at, v, first_tag, widths):
     for k in range(size):
         out[at + size - k] = (v >> (8 * k)) & 0xFF
     return at + 1 + size
+
+
+@njit(cache=True)
+def write_uint(out, at, v):
+    """A non-negative integer as msgpack packs it (a positive fixint, else uint 8, 16, 32 or 64)."""
+    if v <= 0x7F:
+        out[at] = v
+        return at + 1
+    return write_tagged(out, at, v, 0xCC, 4)
+
+
+@njit(cache=True)
+def write_raw(out, at, raw):
+    """The bytes of `raw` (uint8) at `at`; returns the next offset."""
+    for k in range(len(raw)):
+        out[at + k] = raw[k]
+    return at + len(raw)
+
+
+@njit(cache=True)
+def write_words(out, at, bits, first, count):
+    """`count` 64-bit words of `bits` (uint64) from `first`, little-endian; returns the next offset."""
+    for j in range(first, first + count):
+        v = bits[j]
+        for k in range(8):
+            out[at] = (v >> np.uint64(8 * k)) & np.uint64(0xFF)
+            at += 1
+    return at

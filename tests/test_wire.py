@@ -8,7 +8,15 @@ from agents.controllers.layout import A_MARK, A_MOVE, ACT_LEN, MARK, MARK_NONE, 
 from swarm import protocol as proto
 from swarm.scenario import load_scenario
 from world_server.grid import GridWorld
-from world_server.grid_wire import REFUSALS, accept_message, accept_rows, observe_rows
+from world_server.grid_wire import (
+    OBS_OVERHEAD,
+    REFUSALS,
+    accept_message,
+    accept_messages,
+    accept_rows,
+    observe_rows,
+    write_observations,
+)
 
 ACTIVE, FREE = 2, 0
 
@@ -214,3 +222,48 @@ def test_the_world_leaves_every_other_action_message_to_the_parser_and_changes_n
     assert _accept(good, 298, 300, _accept_world())[0] == 2  # real time: one of the last three ticks
     big = proto.pack_actions(300, np.zeros((proto.MAX_MESSAGE_BYTES // (8 * proto.ACT_ROW) + 1, proto.ACT_ROW), int))
     assert _accept(big, 300, 300, _accept_world())[0] == proto.NOT_PLAIN  # too large: the parser refuses it
+
+
+def test_the_world_writes_every_observation_message_byte_for_byte_in_one_call():
+    """grid_wire.write_observations equals swarm.protocol.observations per process: every width of the tick,
+    blocks of one to 40 rows (bin 8 and bin 16), read back by the agent's parser."""
+    rng = np.random.default_rng(3)
+    sizes = [1, 3, 40, 2]
+    ints = rng.integers(-(2**40), 2**40, size=(sum(sizes), proto.OBS_INTS))
+    pf = rng.normal(size=(sum(sizes), 5))
+    bounds = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    for tick in (0, 127, 128, 300, 70_000, 2**33):
+        out = np.empty(len(sizes) * OBS_OVERHEAD + ints.nbytes + pf.nbytes, np.uint8)
+        offsets = np.empty(len(sizes) + 1, np.int64)
+        end = write_observations(tick, ints, pf, bounds, out, offsets)
+        assert offsets[0] == 0 and offsets[-1] == end <= len(out)
+        for g in range(len(sizes)):
+            a, b = bounds[g], bounds[g + 1]
+            assert out[offsets[g]:offsets[g + 1]].tobytes() == proto.observations(tick, ints[a:b], pf[a:b])
+
+
+def test_the_world_applies_the_messages_of_a_tick_in_one_call_as_one_by_one():
+    """grid_wire.accept_messages over messages laid end to end equals accept_message on each in order, other
+    messages (a late tick, another layout) left to the parser (NOT_PLAIN) and nothing of them applied."""
+    stay = np.zeros(ACT_LEN, np.int64)
+    stay[A_MOVE] = 4
+    first = proto.pack_actions(300, proto.action_rows([0], [stay], [0], np.ones((1, 8), np.int64)))
+    again = proto.pack_actions(300, proto.action_rows([0, 3], [stay, stay], [0, 1], np.full((2, 8), 5)))
+    late = proto.pack_actions(299, proto.action_rows([1], [stay], [0], np.ones((1, 8), np.int64)))
+    foreign = proto.pack_actions(300, proto.action_rows([1], [stay], [0], np.ones((1, 8), np.int64)))
+    messages, groups = [first, late, b"\x85", again, foreign], [0, 1, 0, 0, 1]
+    ours, ref = _accept_world(), _accept_world()
+    refused, ref_refused = np.zeros(len(REFUSALS), np.int64), np.zeros(len(REFUSALS), np.int64)
+    status = np.zeros(len(messages), np.int64)
+    starts = np.concatenate([[0], np.cumsum([len(m) for m in messages])]).astype(np.int64)
+    total = accept_messages(np.frombuffer(b"".join(messages), np.uint8), starts, np.array(groups, np.int64), 300, 300,
+                            ours["slots"], ours["group_ids"], True, ours["acted"], ours["acts"], ours["mark_due"],
+                            ours["memory"], refused, status)  # fmt: skip
+    expected = [accept_message(np.frombuffer(m, np.uint8), 300, 300, ref["slots"], ref["group_ids"], g, True,
+                               ref["acted"], ref["acts"], ref["mark_due"], ref["memory"], ref_refused)
+                for m, g in zip(messages, groups, strict=True)]  # fmt: skip
+    assert status.tolist() == expected == [1, proto.NOT_PLAIN, proto.NOT_PLAIN, 1, 1] and total == 3
+    assert refused.tolist() == ref_refused.tolist() == [0, 0, 1, 0]  # agent 0's second action
+    for name in ours:
+        np.testing.assert_array_equal(ours[name], ref[name], err_msg=name)
+    assert ours["acted"].tolist() == [True, True, False, True] and ours["memory"][1].tolist() == [1] * 8

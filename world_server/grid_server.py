@@ -20,7 +20,14 @@ from swarm import protocol as proto
 from swarm.engine import UNTIL, is_done
 from world_server import grid_wire, persist
 from world_server.grid import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, L_OBST, GridWorld, write_mark
-from world_server.grid_wire import REFUSALS, accept_message, accept_rows, observe_rows
+from world_server.grid_wire import (
+    OBS_OVERHEAD,
+    REFUSALS,
+    accept_messages,
+    accept_rows,
+    observe_rows,
+    write_observations,
+)
 from world_server.server import ACTIVE, JOINING, WorldServer
 
 
@@ -38,6 +45,8 @@ class GridServer(WorldServer):
         self.memory = new_memory(n)  # every controller's memory after its last step (saved: exact resume)
         self.refused = np.zeros(len(REFUSALS), dtype=np.int64)  # action rows refused since the last count, by reason
         self.accepted = 0  # action rows accepted this tick
+        self.arrived: list[tuple[bytes, str]] = []  # action messages not applied yet: (bytes, process)
+        self.expected = 0  # action messages still to come before the tick applies them
         self.state_file = persist.state_path(self.state_dir, self.keys.run) if self.state_dir else None
 
     def _declare_shared(self, put) -> list:
@@ -129,35 +138,48 @@ class GridServer(WorldServer):
         w.acts[:, A_TRAIL_OP:A_MODE] = 0  # the mode stays as last reported
 
     def _observations(self, tick: int, groups: dict[str, np.ndarray]):
-        """Every active agent perceived in one compiled pass, in group order,
-        each process's rows sent as one block."""
+        """Every active agent perceived in one compiled pass, in group order, and
+        every process's message written in one more (`grid_wire.write_observations`)."""
         w = self.world
         agents = np.concatenate(list(groups.values())) if groups else np.zeros(0, np.int64)
         ints = np.zeros((len(agents), proto.OBS_INTS), dtype=np.int64)
         pf = np.zeros((len(agents), PERC_F_LEN), dtype=np.float64)
         observe_rows(w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked, agents,
                      ints, pf, self.null)  # fmt: skip
-        start = 0
-        for group, members in groups.items():
-            end = start + len(members)
-            yield group, proto.observations(tick, ints[start:end], pf[start:end])
-            start = end
+        bounds = np.zeros(len(groups) + 1, np.int64)
+        np.cumsum([len(members) for members in groups.values()], out=bounds[1:])
+        out = np.empty(len(groups) * OBS_OVERHEAD + ints.nbytes + pf.nbytes, np.uint8)
+        offsets = np.empty(len(groups) + 1, np.int64)
+        data = out[:write_observations(tick, ints, pf, bounds, out, offsets)].tobytes()
+        self.expected = len(groups)
+        at = offsets.tolist()
+        return [(group, data[at[g]:at[g + 1]]) for g, group in enumerate(groups)]
 
     def _on_act(self, sample) -> None:
-        """A plain action message of this tick is read and applied where its
-        bytes lie, in one compiled call (`grid_wire.accept_message`: a hundred
-        of these a tick at one agent per process); anything else goes through
-        the parser, which counts it and says why it is refused."""
+        """An action message waits, as it came, until the tick's messages are
+        all in (or a mark write or the barrier's end needs them applied): then
+        one compiled call reads and applies every plain one where its bytes
+        lie (`grid_wire.accept_messages`), and the parser takes the rest,
+        counts them and says why it refuses them."""
         raw = sample.payload.to_bytes()
         self.bytes_in += len(raw)
-        group = str(sample.key_expr).rsplit("/", 1)[1]
+        self.arrived.append((raw, str(sample.key_expr).rsplit("/", 1)[1]))
+        self.expected -= 1
+
+    def _apply_arrived(self) -> None:
+        arrived, self.arrived = self.arrived, []
+        if not arrived:
+            return
+        starts = np.zeros(len(arrived) + 1, np.int64)
+        np.cumsum([len(raw) for raw, _ in arrived], out=starts[1:])
+        groups = np.array([self.group_index.get(group, -1) for _, group in arrived], np.int64)
+        status = np.empty(len(arrived), np.int64)
         first, last = self._window()
-        accepted = accept_message(np.frombuffer(raw, np.uint8), first, last, self.slots, self.group_ids,
-                                  self.group_index.get(group, -1), self.mode == "lockstep", self.acted,
-                                  self.world.acts, self.mark_due, self.memory, self.refused)  # fmt: skip
-        if accepted == proto.NOT_PLAIN:
-            accepted = self._parsed_act(raw, group)
-        self.accepted += accepted
+        self.accepted += accept_messages(np.frombuffer(b"".join(raw for raw, _ in arrived), np.uint8), starts, groups,
+                                         first, last, self.slots, self.group_ids, self.mode == "lockstep", self.acted,
+                                         self.world.acts, self.mark_due, self.memory, self.refused, status)  # fmt: skip
+        for m in np.flatnonzero(status == proto.NOT_PLAIN).tolist():
+            self.accepted += self._parsed_act(*arrived[m])
 
     def _parsed_act(self, raw: bytes, group: str) -> int:
         msg = proto.parse_acts(raw)
@@ -183,6 +205,7 @@ class GridServer(WorldServer):
             self.refused[:] = 0
 
     def _on_mark(self, sample) -> None:
+        self._apply_arrived()  # a mark write is checked against its agent's action
         received = self._receive(sample, proto.parse_marks, "mark")
         if received is None:
             return
@@ -215,13 +238,18 @@ class GridServer(WorldServer):
         self._reply(query, f"{self.keys.prefix}/marks/grid", payload)
 
     def may_all_have_answered(self, agents: np.ndarray) -> bool:
+        if self.expected > 0:
+            return False  # a process's message is still to come (from then on each is applied as it comes)
+        self._apply_arrived()
         return self.accepted >= len(agents)
 
     def barrier_passed(self) -> None:
+        self._apply_arrived()
         self._count_refusals()
 
     def _finish(self) -> None:
-        self._count_refusals()  # what came after the last tick's barrier
+        self._apply_arrived()  # what came after the last tick's barrier
+        self._count_refusals()
 
     def answered(self, agents: np.ndarray) -> np.ndarray:
         if self.mode == "realtime":

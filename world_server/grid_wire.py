@@ -29,7 +29,21 @@ from agents.controllers.layout import (
     TRAIL_ERASE,
 )  # fmt: skip
 from swarm.protocol import ACT_ROW, MAX_MESSAGE_BYTES, NOT_PLAIN, OBS_INTS, R_ACT, R_AGENT, R_MARKED, R_MEM
-from swarm.wire_bytes import ACT_HEAD, ROWS_KEY, key, read_bin, read_int, words
+from swarm.wire_bytes import (
+    ACT_HEAD,
+    INTS_KEY,
+    OBS_HEAD,
+    PF_KEY,
+    ROWS_KEY,
+    key,
+    read_bin,
+    read_int,
+    words,
+    write_raw,
+    write_tagged,
+    write_uint,
+    write_words,
+)
 from world_server.grid import perceive
 
 ACTIVE = 2  # world_server.server.ACTIVE (a slot whose agent is in the run)
@@ -52,6 +66,36 @@ def observe_rows(layers, pher, pher_on, base_r, base_c, pos, payload, blocked, a
         ints[i, 1] = r * width + c
         if not null:
             perceive(layers, pher, pher_on, base_r, base_c, r, c, payload[a], blocked[a], ints[i, 2:], pf[i])
+
+
+OBS_OVERHEAD = 64  # bytes of an observation message besides its blocks (at most)
+
+
+@njit(cache=True)
+def write_observations(tick, ints, pf, bounds, out, offsets):
+    """Every agent process's observation message, byte for byte as
+    `swarm.protocol.observations` packs it, one after another in `out`:
+    process g's rows are bounds[g] .. bounds[g + 1] of `ints` and `pf` (both
+    C-contiguous), its message out[offsets[g]:offsets[g + 1]].  Returns the
+    end.  `out` holds OBS_OVERHEAD bytes a process besides the blocks."""
+    ibits, fbits = ints.reshape(-1).view(np.uint64), pf.reshape(-1).view(np.uint64)
+    ni, nf = ints.shape[1], pf.shape[1]
+    at = 0
+    for g in range(len(bounds) - 1):
+        offsets[g] = at
+        first, rows = bounds[g], bounds[g + 1] - bounds[g]
+        at = write_raw(out, at, OBS_HEAD)
+        at = write_uint(out, at, tick)
+        out[at] = 0xA0 | len(INTS_KEY)  # fixstr
+        at = write_raw(out, at + 1, INTS_KEY)
+        at = write_tagged(out, at, rows * ni * 8, 0xC4, 3)  # bin 8, 16, 32
+        at = write_words(out, at, ibits, first * ni, rows * ni)
+        out[at] = 0xA0 | len(PF_KEY)
+        at = write_raw(out, at + 1, PF_KEY)
+        at = write_tagged(out, at, rows * nf * 8, 0xC4, 3)
+        at = write_words(out, at, fbits, first * nf, rows * nf)
+    offsets[len(bounds) - 1] = at
+    return at
 
 
 @njit(cache=True, inline="always")
@@ -138,14 +182,31 @@ def accept_message(buf, first_tick, last_tick, slots, group_ids, group, lockstep
     return _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused)
 
 
+@njit(cache=True)
+def accept_messages(buf, starts, groups, first_tick, last_tick, slots, group_ids, lockstep, acted, acts, mark_due,
+                    memory, refused, status):  # fmt: skip
+    """`accept_message` for each message of buf[starts[m]:starts[m + 1]] from
+    process `groups[m]`, in order: one call for all that came since the last,
+    so the world does not enter compiled code once per message.  status[m]:
+    its rows accepted, or NOT_PLAIN.  Returns the rows accepted."""
+    total = 0
+    for m in range(len(groups)):
+        status[m] = accept_message(buf[starts[m]:starts[m + 1]], first_tick, last_tick, slots, group_ids, groups[m],
+                                   lockstep, acted, acts, mark_due, memory, refused)  # fmt: skip
+        if status[m] != NOT_PLAIN:
+            total += status[m]
+    return total
+
+
 def warm_up(world) -> None:
-    """Load both kernels now (no agents, no rows), so the first tick does not compile."""
+    """Load every kernel now (no agents, no rows), so the first tick does not compile."""
     none, ints, pf = np.zeros(0, np.int64), np.zeros((0, OBS_INTS), np.int64), np.zeros((0, PERC_F_LEN))
     observe_rows(world.layers, world.pher, world.pheromone_on, world.base[0], world.base[1], world.pos,
                  world.payload, world.blocked, none, ints, pf, False)  # fmt: skip
     n = len(world.pos)
     accept_rows(np.zeros((0, ACT_ROW), np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64), 0, True,
                 np.zeros(n, bool), world.acts, np.zeros(n, bool), np.zeros((n, MEM_LEN), np.int64))  # fmt: skip
-    accept_message(np.zeros(0, np.uint8), 0, 0, np.zeros(n, np.int64), np.zeros(n, np.int64), 0, True,
-                   np.zeros(n, bool), world.acts, np.zeros(n, bool), np.zeros((n, MEM_LEN), np.int64),
-                   np.zeros(len(REFUSALS), np.int64))  # fmt: skip
+    accept_messages(np.zeros(0, np.uint8), np.zeros(1, np.int64), none, 0, 0, np.zeros(n, np.int64),
+                    np.zeros(n, np.int64), True, np.zeros(n, bool), world.acts, np.zeros(n, bool),
+                    np.zeros((n, MEM_LEN), np.int64), np.zeros(len(REFUSALS), np.int64), none)  # fmt: skip
+    write_observations(0, ints, pf, np.zeros(1, np.int64), np.zeros(0, np.uint8), np.zeros(1, np.int64))

@@ -27,7 +27,10 @@ from swarm.wire_bytes import (
     read_bin,
     read_int,
     words,
+    write_raw,
     write_tagged,
+    write_uint,
+    write_words,
 )
 
 
@@ -73,24 +76,9 @@ def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info
     size = got * ACT_ROW * 8
     if len(out) < ENVELOPE + size:
         return -1
-    at = 0
-    for k in range(len(act_header)):
-        out[at] = act_header[k]
-        at += 1
-    if tick <= 0x7F:  # positive fixint
-        out[at] = tick
-        at += 1
-    else:
-        at = write_tagged(out, at, tick, 0xCC, 4)  # uint 8, 16, 32, 64
-    for k in range(len(rows_key)):
-        out[at] = rows_key[k]
-        at += 1
+    at = write_raw(out, 0, act_header)
+    at = write_uint(out, at, tick)
+    at = write_raw(out, at, rows_key)
     at = write_tagged(out, at, size, 0xC4, 3)  # bin 8, 16, 32
-    for i in range(got):
-        for c in range(ACT_ROW):
-            v = np.uint64(rows[i, c])
-            for k in range(8):
-                out[at] = (v >> np.uint64(8 * k)) & np.uint64(0xFF)
-                at += 1
-    return at
+    return write_words(out, at, rows.reshape(-1).view(np.uint64), 0, got * ACT_ROW)
 
