@@ -17,7 +17,7 @@ ACT_HEAD = np.frombuffer(b"\x85\xa1v" + bytes([VERSION]) + b"\xa4type\xa3act\xa6
                           + b"\xa4tick", np.uint8).copy()  # fmt: skip
 INTS_KEY = np.frombuffer(b"ints", np.uint8).copy()
 PF_KEY = np.frombuffer(b"pf", np.uint8).copy()
-ROWS_KEY = np.frombuffer(b"\xa4rows", np.uint8).copy()
+ROWS_KEY = np.frombuffer(b"rows", np.uint8).copy()
 
 
 @njit(cache=True)
@@ -78,6 +78,25 @@ def key(buf, at, key):
         if buf[at + 1 + k] != key[k]:
             return -1
     return at + 1 + m
+
+
+@njit(cache=True)
+def read_head(buf, header):
+    """(tick, next offset) of a message that begins with `header` (the fixed
+    bytes up to its tick key) and a tick, or (-1, -1)."""
+    if len(buf) < len(header):
+        return -1, -1
+    for k in range(len(header)):
+        if buf[k] != header[k]:
+            return -1, -1
+    return read_int(buf, len(header))
+
+
+@njit(cache=True)
+def write_key(out, at, name):
+    """`name` as a fixstr map key; returns the next offset."""
+    out[at] = 0xA0 | len(name)
+    return write_raw(out, at + 1, name)
 
 
 @njit(cache=True)

@@ -37,8 +37,9 @@ from swarm.wire_bytes import (
     ROWS_KEY,
     key,
     read_bin,
-    read_int,
+    read_head,
     words,
+    write_key,
     write_raw,
     write_tagged,
     write_uint,
@@ -86,12 +87,10 @@ def write_observations(tick, ints, pf, bounds, out, offsets):
         first, rows = bounds[g], bounds[g + 1] - bounds[g]
         at = write_raw(out, at, OBS_HEAD)
         at = write_uint(out, at, tick)
-        out[at] = 0xA0 | len(INTS_KEY)  # fixstr
-        at = write_raw(out, at + 1, INTS_KEY)
+        at = write_key(out, at, INTS_KEY)
         at = write_tagged(out, at, rows * ni * 8, 0xC4, 3)  # bin 8, 16, 32
         at = write_words(out, at, ibits, first * ni, rows * ni)
-        out[at] = 0xA0 | len(PF_KEY)
-        at = write_raw(out, at + 1, PF_KEY)
+        at = write_key(out, at, PF_KEY)
         at = write_tagged(out, at, rows * nf * 8, 0xC4, 3)
         at = write_words(out, at, fbits, first * nf, rows * nf)
     offsets[len(bounds) - 1] = at
@@ -159,17 +158,13 @@ def accept_message(buf, first_tick, last_tick, slots, group_ids, group, lockstep
     reads once a tick), or NOT_PLAIN, having applied nothing: a tick outside
     first_tick .. last_tick, any other layout, anything malformed, which the
     Python path then counts and says why it refuses."""
-    header = ACT_HEAD
     n = len(buf)
-    if n < len(header) or n > MAX_MESSAGE_BYTES:
+    if n > MAX_MESSAGE_BYTES:
         return NOT_PLAIN
-    for k in range(len(header)):
-        if buf[k] != header[k]:
-            return NOT_PLAIN
-    tick, at = read_int(buf, len(header))
+    tick, at = read_head(buf, ACT_HEAD)
     if at < 0:
         return NOT_PLAIN
-    at = key(buf, at, ROWS_KEY[1:])  # the key without its fixstr tag
+    at = key(buf, at, ROWS_KEY)
     if at < 0:
         return NOT_PLAIN
     rows_at, rows_len = read_bin(buf, at)

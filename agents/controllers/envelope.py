@@ -25,8 +25,9 @@ from swarm.wire_bytes import (
     ROWS_KEY,
     key,
     read_bin,
-    read_int,
+    read_head,
     words,
+    write_key,
     write_raw,
     write_tagged,
     write_uint,
@@ -40,14 +41,8 @@ def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info
     returns their length, -1 for an observation whose blocks are malformed (not
     answered, as `answer_rows` says), or NOT_PLAIN.  `info`: rows written,
     whether any row put a mark write, the tick."""
-    header, act_header, rows_key = OBS_HEAD, ACT_HEAD, ROWS_KEY
     n = len(buf)
-    if n < len(header):
-        return NOT_PLAIN
-    for k in range(len(header)):
-        if buf[k] != header[k]:
-            return NOT_PLAIN
-    tick, at = read_int(buf, len(header))
+    tick, at = read_head(buf, OBS_HEAD)
     if at < 0:
         return NOT_PLAIN
     at = key(buf, at, INTS_KEY)
@@ -76,9 +71,9 @@ def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info
     size = got * ACT_ROW * 8
     if len(out) < ENVELOPE + size:
         return -1
-    at = write_raw(out, 0, act_header)
+    at = write_raw(out, 0, ACT_HEAD)
     at = write_uint(out, at, tick)
-    at = write_raw(out, at, rows_key)
+    at = write_key(out, at, ROWS_KEY)
     at = write_tagged(out, at, size, 0xC4, 3)  # bin 8, 16, 32
     return write_words(out, at, rows.reshape(-1).view(np.uint64), 0, got * ACT_ROW)
 
