@@ -3,6 +3,7 @@ senses, motivations and saliences, its map, and the controller in both
 runtimes.  The GPR loops are in test_bg_gpr.py."""
 
 import csv
+import dataclasses
 import json
 import math
 
@@ -347,6 +348,55 @@ def test_the_map_learns_where_food_is_forgets_it_when_gone_and_plans_to_it():
     assert nav.assoc["Ep"][3] < 0.1
 
 
+def _corridor(nav: Navigator, legs: list[tuple[float, int]]) -> None:
+    """Drive `legs` (heading, steps of 0.3 m), observing a new look of its own at each step."""
+    k = 0
+    for heading, steps in legs:
+        for _ in range(steps):
+            nav.move(0.3 if k else 0.0, heading)
+            nav.observe(np.full(36, 20 + 25 * k, np.uint8), np.full(8, 0.5 + 2.0 * k), 0.0)
+            k += 1
+
+
+@pytest.mark.parametrize("pursuit, heading", [(0.5, 0.0), (0.0, math.radians(45))])
+def test_with_pursuit_the_plan_points_at_the_next_place_on_the_way_not_across_a_corner(pursuit, heading):
+    """An L-shaped way: four places eastwards, then three northwards, food at the end.  From the second
+    place, with `pursuit` the plan points east at the corner's place (0.6 m on); the sum of the route's
+    first metre (the default) points north-east, through the corner."""
+    nav = Navigator(NavParams(pursuit=pursuit), seed=0, agent=0, resources=("DA", "Ep", "E"))
+    _corridor(nav, [(0.0, 4), (math.pi / 2, 3)])
+    nav.map.belief = np.eye(nav.map.size)[6]
+    for _ in range(40):
+        nav.learn({"Ep": True}, {"Ep": True}, 0.25)
+    nav.map.current, nav.at = 1, nav.map.nodes[1].position.copy()  # seen back at the second place
+    towards = nav.plan("Ep")
+    assert towards.max() > 0.5 and abs(ANGLES[int(np.argmax(towards))] - heading) <= math.radians(10)
+
+
+@pytest.mark.parametrize("radius, reached", [(1.0, [False, False, True, True, True, True]), (None, [True] * 6)])
+def test_a_loop_closes_only_onto_a_place_within_the_closure_radius(radius, reached):
+    """bg-exp1's two rooms mirror each other across the middle wall: with loops closing onto nodes up to 2 m
+    away by odometry (the default) they close through the wall.  At 1 m a node 1.25 m away is out of reach."""
+    params = NavParams() if radius is None else NavParams(closure_radius=radius)
+    nav = Navigator(params, seed=0, agent=0, resources=("DA", "Ep", "E"))
+    _corridor(nav, [(math.pi / 2, 6)])  # places at y = 0, 0.3, ..., 1.5 (x = 0)
+    assert nav.map.size == 6
+    assert nav.map._within_reach(np.array([0.0, 1.55])).tolist() == reached  # 1.55, 1.25, 0.95 ... m away
+
+
+@pytest.mark.parametrize("anchor", [0.2, 0.0])
+def test_with_anchor_recognizing_a_place_pulls_drifted_odometry_part_of_the_way_to_it(anchor):
+    nav = Navigator(NavParams(anchor=anchor), seed=0, agent=0, resources=("DA", "Ep", "E"))
+    _corridor(nav, [(0.0, 3)])  # places at x = 0, 0.3, 0.6
+    nav.xy = np.array([0.6, 0.5])  # odometry has drifted 0.5 m north of the last place
+    nav.since = np.array([0.0, 0.3])
+    node = nav.observe(np.full(36, 20 + 25 * 2, np.uint8), np.full(8, 0.5 + 2.0 * 2), 0.0)  # the last place again
+    position = nav.map.nodes[node].position
+    assert node == 2 and position[1] > 0.0  # the node's mean took the drifted observation in ...
+    assert nav.xy[1] == pytest.approx(0.5 + anchor * (position[1] - 0.5))  # ... and odometry moved to it (or not)
+    assert np.array_equal(nav.at, nav.xy)
+
+
 def test_a_saved_map_loads_back_exactly_and_a_bad_one_is_one_line():
     nav = _nav()
     for k in range(3):
@@ -375,6 +425,22 @@ def test_the_animat_reloads_at_food_it_sees_and_then_goes_on():
     r = engine.summary()["robots"][0]
     assert r["reloads"]["ReloadEp"] > 10 and r["potential"] > 0.6 and r["ingested"] == "food"
     assert r["distance"] > 0.1 and engine.summary()["rejected_actions"] == 0
+
+
+@pytest.mark.parametrize("usable_threshold, reloads", [(0.5, True), (None, False)])
+def test_beside_food_a_moderate_need_tops_up_where_it_works(usable_threshold, reloads):
+    """Ep 0.65 beside an ingesting zone: ReloadEp's channel is released to about 0.9, just under the 0.9 an act
+    needs.  With `usable_threshold` 0.5 the act starts where its zone is usable: the animat tops up.  With the
+    default (0.9 there too) it does not (in bg-exp1 such an animat stood by Ep for 1000 s, starving for E)."""
+    s = arena(FOOD.format(extra="energy = 1.0\npotential = 0.65\n", x=1.2, y=0.5), w=3.0, h=2.0, robot="animat",
+              noise="low", max_ticks=600)  # fmt: skip
+    params = dict(s.controller_params)
+    if usable_threshold is not None:
+        params["bg"] = {**params.get("bg", {}), "usable_threshold": usable_threshold}
+    engine = ArenaEngine(dataclasses.replace(s.with_overrides(start=(1.2, 0.5, math.pi)), controller_params=params))
+    engine.step(400)
+    r = engine.summary()["robots"][0]
+    assert (r["reloads"]["ReloadEp"] > 10 and r["potential"] > 0.8) == reloads, r["reloads"]
 
 
 def test_snapshot_and_restore_continue_bit_for_bit():

@@ -39,7 +39,8 @@ class BgParams:
     w_plan: float = 0.65
     w_taxon: float = 0.55
     fear: float = 0.2  # F, m(DA)
-    dorsal_threshold: float = 0.9  # disinhibition an act needs to start (it goes on while above 0: docs/bg.md)
+    dorsal_threshold: float = 0.9  # disinhibition an act needs to start (it goes on while above 0: docs/bg.md) ...
+    usable_threshold: float = 0.9  # ... and where it works (A(res)); lower, an act nearly selected there starts
     ventral_threshold: float = -0.6  # ... a direction channel needs to join the vector sum (EP/SNr below 1.6 x rest)
     too_close: float = 0.45  # m from the centre: the sonar reflex takes over
     reflex_hold: float = 2.0  # s the reflex drives straight on once the front is clear
@@ -133,7 +134,8 @@ class BgController:
                                                  self.p.w_plan if self.p.planning else 0.0, self.p.w_taxon)  # fmt: skip
         self.bg.run(s_dorsal, s_ventral, self.dt)
         d, v = self.bg.disinhibition()
-        chosen = select_dorsal(d, self.p.dorsal_threshold, self.acting)
+        works = np.array([usable["E"], usable["Ep"]])  # DORSAL_ACTS' zones
+        chosen = select_dorsal(d, np.where(works, self.p.usable_threshold, self.p.dorsal_threshold), self.acting)
         self.acting = chosen
         direction, strength = select_ventral(v, self.p.ventral_threshold)
         reflex = self.reflex(sonar, self.dt) if chosen < 0 else None

@@ -210,12 +210,13 @@ class BasalGanglia:
         self.a_v[...] = state["a_v"]
 
 
-def select_dorsal(disinhibition: np.ndarray, threshold: float, incumbent: int = -1) -> int:
-    """Winner-takes-all: the most disinhibited channel if it is released beyond `threshold` -- or, for the
-    channel selected last (`incumbent`), released at all (below its resting output): an act goes on until
-    its channel is inhibited again, as the thalamo-cortical loop's persistence means it to.  Else -1."""
+def select_dorsal(disinhibition: np.ndarray, threshold: float | np.ndarray, incumbent: int = -1) -> int:
+    """Winner-takes-all: the most disinhibited channel if it is released beyond `threshold` (one for every
+    channel, or one per channel) -- or, for the channel selected last (`incumbent`), released at all (below
+    its resting output): an act goes on until its channel is inhibited again, as the thalamo-cortical
+    loop's persistence means it to.  Else -1."""
     k = int(np.argmax(disinhibition))
-    floor = 0.0 if k == incumbent else threshold
+    floor = 0.0 if k == incumbent else float(np.broadcast_to(threshold, disinhibition.shape)[k])
     return k if disinhibition[k] > floor else -1
 
 

@@ -20,8 +20,14 @@ system:
 - P(res): shortest routes over the links from every node that holds res,
   weighted by what it holds and by exp(-distance / `reach`), give the
   proximity of res from the current node; its direction is that of the
-  route's first `lookahead` metres (summed link displacements), spread over
-  the 36 directions by a von Mises bump;
+  route's first `lookahead` metres (summed link displacements) or, with
+  `pursuit`, from where the last observation was made to the first node of
+  the route that far away (the next place on the way: no corner cut through
+  a wall's end); spread over the 36 directions by a von Mises bump;
+- odometry (compass-turned) drifts, some 1.5 m over 80 minutes of bg-exp1:
+  with `anchor`, each time the animat recognizes a place (joins or closes a
+  loop onto a node it had), its odometric position is pulled that share of
+  the way to the node's, so the map and the animat stay in one frame;
 - BKA: P towards the known nodes (made `known_age` observations ago or more);
 - Expl: the directions in which the sonars see room and the map has no node
   near yet, plus a slowly turning random preference (random exploration
@@ -54,7 +60,8 @@ class NavParams:
     theta: float = 0.6  # largest dissimilarity (1 - P(match)) that joins the current node (docs/bg.md: calibration)
     closure_match: float = 0.45  # P(match) with which a known node the belief points at closes a loop
     extent: float = 1.0  # m: a node stretches no farther from where it was first seen (Filliat's maps are dense)
-    closure_radius: float = 2.0  # m: a loop closes only onto a node this near by odometry (alike places elsewhere)
+    closure_radius: float = 2.0  # m: a loop closes only onto a node this near by odometry (alike places elsewhere;
+    # bg-exp1's two rooms mirror each other, and at 2 m loops close through its middle wall: 1 m, docs/bg.md)
     merge_match: float = 0.6  # P(match) with which another animat's node is one of ours (within closure_radius)
     grey_scale: float = 35.0  # grey levels of one unit of dissimilarity
     sonar_scale: float = 1.0  # metres of one unit of dissimilarity
@@ -63,7 +70,9 @@ class NavParams:
     gain: float = 1.0  # Hebbian gain while a resource is usable, 1/s: a few seconds there and the node holds it
     forget: float = 0.02  # ... and while it is not even in sight, 1/s: half forgotten in about 35 s there
     reach: float = 15.0  # m: P falls by e over this route length (docs/bg.md)
-    lookahead: float = 1.0  # m of route whose direction P points along
+    anchor: float = 0.0  # share of the way odometry is pulled to a recognized node's position (docs/bg.md)
+    lookahead: float = 1.0  # m of route whose direction P points along ...
+    pursuit: float = 0.0  # ... or, when > 0, m: P points at the first route node this far from the last observation
     width: float = 4.0  # von Mises concentration of a direction's bump over the 36 channels
     known_age: int = 20  # observations after its creation from which coming back to a node means a known area
     near: float = 0.0  # m: link a new node to nodes observed this close (0: only to nodes driven between:
@@ -178,6 +187,7 @@ class Navigator:
         self.assoc: dict[str, np.ndarray] = {r: np.zeros(0) for r in resources}
         self.xy = np.zeros(2)  # odometric position (compass-turned odometry)
         self.since = np.zeros(2)  # displacement since the last observation
+        self.at = np.zeros(2)  # odometric position of the last observation (where routes start from)
         self.D = 0.0
         self.created = 0
         self.relocalize = False
@@ -218,6 +228,7 @@ class Navigator:
             node = int(np.argmax(belief))
             self.map.current, self.map.belief = node, np.eye(len(self.map.nodes))[node]
             self.xy, self.since, self.relocalize = self.map.nodes[node].position.copy(), np.zeros(2), False
+            self.at = self.xy.copy()
             return node
         before, folded = len(self.map.nodes), len(self.map.folded)
         node = self.map.observe(observation, self.xy, self.since, self.p.extent)
@@ -225,7 +236,7 @@ class Navigator:
             for young, known in list(self.map.folded.items())[folded:]:
                 for w in self.assoc.values():
                     w[known], w[young] = max(w[known], w[young]), 0.0
-        self.since = np.zeros(2)
+        self.since, self.at = np.zeros(2), self.xy.copy()
         self.observations += 1
         self.born += [self.observations] * (len(self.map.nodes) - before)
         if len(self.map.nodes) > before:
@@ -233,8 +244,12 @@ class Navigator:
             self.D += self.p.d_rise * (1.0 - self.D)
             for r in self.resources:
                 self.assoc[r] = np.concatenate([self.assoc[r], np.zeros(len(self.map.nodes) - len(self.assoc[r]))])
-        elif self.observations - self.born[node] >= self.p.known_age:
-            self.D *= self.p.d_fall
+        else:  # a known place: odometry is pulled part of the way to where the map has it (drift stays bounded)
+            if self.observations - self.born[node] >= self.p.known_age:
+                self.D *= self.p.d_fall
+            if self.p.anchor > 0.0:
+                self.xy = self.xy + self.p.anchor * (self.map.nodes[node].position - self.xy)
+                self.at = self.xy.copy()
         return node
 
     def grow(self) -> None:
@@ -291,18 +306,36 @@ class Navigator:
                                      np.concatenate([lengths, -self.p.reach * np.log(strength[sources])]))  # fmt: skip
         out = np.zeros(DIRECTIONS)
         if np.isfinite(dist[here]):
-            value = math.exp(-dist[here] / self.p.reach)
-            offset, node, travelled = np.zeros(2), here, 0.0
-            while pred[node] != k and pred[node] >= 0 and travelled < self.p.lookahead:
-                nxt = int(pred[node])
-                d = self._displacement(node, nxt)
-                offset, travelled, node = offset + d, travelled + float(np.hypot(*d)), nxt
-            if travelled > 0.0:  # else here is where it is: the last stretch is the taxon's
-                out = bump(math.atan2(offset[1], offset[0]), value, self.p.width)
+            offset = self._next_place(pred, k) if self.p.pursuit > 0.0 else self._first_metre(pred, k)
+            if offset is not None:  # else here is where it is: the last stretch is the taxon's
+                out = bump(math.atan2(offset[1], offset[0]), math.exp(-dist[here] / self.p.reach), self.p.width)
         if len(self._towards) > 64:
             self._towards.clear()
         self._towards[key] = out
         return out
+
+    def _first_metre(self, pred: np.ndarray, source: int) -> np.ndarray | None:
+        """The route's link displacements summed over its first `lookahead` metres (None: no way to go).
+        Round a wall's end this cuts the corner (docs/bg.md, stop 32): see `_next_place`."""
+        offset, node, travelled = np.zeros(2), self.map.current, 0.0
+        while pred[node] != source and pred[node] >= 0 and travelled < self.p.lookahead:
+            nxt = int(pred[node])
+            d = self._displacement(node, nxt)
+            offset, travelled, node = offset + d, travelled + float(np.hypot(*d)), nxt
+        return offset if travelled > 0.0 else None
+
+    def _next_place(self, pred: np.ndarray, source: int) -> np.ndarray | None:
+        """From where the last observation was made (the route starts there too) to the first node of the
+        route at least `pursuit` away: the next place the animat has been to on the way.  That place stays
+        put between observations, so the vector is cached with the route and a restored animat, whose cache
+        is empty, works out the same one."""
+        node, offset = self.map.current, None
+        while pred[node] != source and pred[node] >= 0:
+            node = int(pred[node])
+            offset = self.map.nodes[node].position - self.at
+            if math.hypot(offset[0], offset[1]) >= self.p.pursuit:
+                break
+        return offset
 
     def _displacement(self, a: int, b: int) -> np.ndarray:
         key = (min(a, b), max(a, b))
@@ -369,8 +402,9 @@ class Navigator:
         """The map, what its nodes hold and the odometric frame, as plain data (to save and load)."""
         return {"map": topomap_to_data(self.map, lambda sig: np.asarray(sig).tolist()),
                 "assoc": {r: w.tolist() for r, w in self.assoc.items()}, "xy": self.xy.tolist(),
-                "since": self.since.tolist(), "D": self.D, "created": self.created, "born": self.born,
-                "observations": self.observations, "relocalize": self.relocalize, "news": self.news}  # fmt: skip
+                "since": self.since.tolist(), "at": self.at.tolist(), "D": self.D, "created": self.created,
+                "born": self.born, "observations": self.observations, "relocalize": self.relocalize,
+                "news": self.news}  # fmt: skip
 
     def from_data(self, data: dict[str, Any]) -> None:
         try:
@@ -382,6 +416,7 @@ class Navigator:
                 raise ValueError("one resource weight per node expected")
             self.assoc = assoc
             self.xy, self.since = np.array(data["xy"], np.float64), np.array(data["since"], np.float64)
+            self.at = np.array(data.get("at", self.xy - self.since), np.float64)  # maps saved before stop 32 lack it
             self.D, self.created = float(data["D"]), int(data["created"])
             self.born, self.observations = [int(b) for b in data["born"]], int(data["observations"])
             self._known_key = ()
