@@ -72,6 +72,32 @@ def _ratios(text: str) -> tuple[float, ...]:
     return values
 
 
+def _bg_setting(text: str) -> tuple[str, object]:
+    """KEY=VALUE, the value a TOML literal (0.5, true, "fear"); navigation.KEY names a [bg.navigation] field."""
+    import tomllib
+
+    key, sep, value = text.partition("=")
+    try:
+        parsed = tomllib.loads(f"v = {value}")["v"] if sep and key else None
+    except tomllib.TOMLDecodeError:
+        parsed = None
+    if parsed is None or isinstance(parsed, (dict, list)):
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE (e.g. usable_threshold=0.5, navigation.anchor=0.2), "
+                                         f"got {text}")  # fmt: skip
+    return key.strip(), parsed
+
+
+def _bg_table(settings: list[tuple[str, object]] | None) -> dict:
+    """--bg settings as a [bg] table (navigation.KEY into its [bg.navigation] table)."""
+    table: dict = {}
+    for key, value in settings or ():
+        if key.startswith("navigation."):
+            table.setdefault("navigation", {})[key.removeprefix("navigation.")] = value
+        else:
+            table[key] = value
+    return table
+
+
 def _sizes(text: str) -> tuple[int, ...]:
     from swarm.arena.bg_colony import NEST
 
@@ -167,6 +193,9 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--maps", type=_positive, metavar="N",
                      help="bg-choice | bg-forget | bg-fear | bg-tmaze: mapping runs per scenario; test k loads map "
                           "k mod N (default: one per test; 1: one map for every test)")
+    exp.add_argument("--bg", type=_bg_setting, action="append", metavar="KEY=VALUE",
+                     help="bg-*: change a [bg] setting in every run, mapping runs included (repeatable; e.g. "
+                          "usable_threshold=0.5, navigation.pursuit=0.5: docs/bg.md)")
     exp.add_argument("--sizes", type=_sizes, metavar="N,N,...",
                      help="bg-colony: colony sizes to run (default 1,2,4,8)")
     exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
@@ -537,6 +566,8 @@ def cmd_report(args) -> int:
 
 
 def cmd_experiment(args) -> int:
+    if args.bg and args.name not in BG_EXPERIMENTS[:-1]:
+        raise ScenarioError("command line", "--bg", "this is for the bg-* experiments but bg-colony")
     if args.name == "fingerprint-together":
         if args.scenario:
             raise ScenarioError("command line", "--scenario", "fingerprint-together surveys office")
@@ -580,7 +611,7 @@ def cmd_experiment(args) -> int:
         from swarm.arena.bg_experiments import run_bg_experiment
 
         result = run_bg_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
-                                   ratios=args.ratios, maps=args.maps)  # fmt: skip
+                                   ratios=args.ratios, maps=args.maps, bg=_bg_table(args.bg))  # fmt: skip
         print(result["markdown"])
         print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
         return 0

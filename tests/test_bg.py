@@ -554,6 +554,25 @@ def test_bg_experiment_maps_option_is_checked():
         run_bg_experiment("bg-survival", None, 2, 1, 0, None, maps=1, progress=False)
 
 
+def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
+    import argparse
+
+    from swarm.arena.bg_experiments import _tests, _with, run_bg_experiment
+    from swarm.cli import _bg_setting, _bg_table
+
+    table = _bg_table([_bg_setting("usable_threshold=0.5"), _bg_setting("navigation.anchor=0.2")])
+    assert table == {"usable_threshold": 0.5, "navigation": {"anchor": 0.2}}
+    with pytest.raises(argparse.ArgumentTypeError, match="KEY=VALUE"):
+        _bg_setting("anchor")
+    engine = ArenaEngine(_with(load_scenario("bg-exp1"), bg={**table, "planning": False}))
+    animat = engine.controllers[0]
+    assert animat.p.usable_threshold == 0.5 and animat.nav.p.anchor == 0.2 and not animat.p.planning
+    jobs = _tests("bg-choice", 2, 0, {"bg-exp2": [{}]}, table)  # a test's own [bg] fields kept beside them
+    assert all(job[5] == {**table, "w_plan": job[1], "w_taxon": 0.55} for job in jobs)
+    with pytest.raises(ScenarioError, match=r"--bg.*bogus"):
+        run_bg_experiment("bg-survival", None, 2, 1, 0, None, progress=False, bg={"bogus": 1})
+
+
 def test_swarm_run_prints_the_animats_metabolism_and_map():
     import subprocess
     import sys

@@ -57,9 +57,10 @@ JUNCTION = (3.1, 4.3)  # T-maze: the stem's walls (x): beyond the first, the lef
 
 def _with(s, bg: dict[str, Any] | None = None, metabolism: dict[str, Any] | None = None,
           seed: int | None = None, absent: tuple[str, ...] = (), max_ticks: int | None = None):  # fmt: skip
-    """A scenario changed for one run: [bg] fields, metabolism fields, resources taken away."""
+    """A scenario changed for one run: [bg] fields (and [bg.navigation] ones), metabolism fields, resources
+    taken away."""
     params = dict(s.controller_params)
-    params["bg"] = {**params.get("bg", {}), **(bg or {})}
+    params["bg"] = _merged(params.get("bg", {}), bg or {})
     obstacles = tuple(dataclasses.replace(o, appear=10**9) if o.name in absent else o for o in s.obstacles)
     m = dataclasses.replace(s.metabolism, **(metabolism or {}))
     out = dataclasses.replace(s, controller_params=params, obstacles=obstacles, metabolism=m,
@@ -68,15 +69,23 @@ def _with(s, bg: dict[str, Any] | None = None, metabolism: dict[str, Any] | None
     return out
 
 
+def _merged(table: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
+    """A [bg] table with `changes` over it; their navigation fields go into its [bg.navigation] table."""
+    out = {**table, **changes}
+    if "navigation" in changes:
+        out["navigation"] = {**table.get("navigation", {}), **changes["navigation"]}
+    return out
+
+
 # ------------------------------------------------------------------ runs
 
 
 def run_survival(job: tuple) -> dict:
-    """One animat in bg-exp1 until it dies or 4 h pass: (condition, run, seed)."""
+    """One animat in bg-exp1 until it dies or 4 h pass: (condition, run, seed, [bg] changes)."""
     from swarm.arena.engine import ArenaEngine
 
-    condition, run, seed = job
-    s = _with(load_scenario("bg-exp1"), bg={"planning": condition == "A"}, seed=seed)
+    condition, run, seed, changes = job
+    s = _with(load_scenario("bg-exp1"), bg=_merged(changes, {"planning": condition == "A"}), seed=seed)
     summary = ArenaEngine(s).run()
     r = summary["robots"][0]
     return {"condition": condition, "run": run, "seed": seed, "survival_seconds": r["survival_seconds"],
@@ -95,7 +104,7 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
     ticks = int(MAPPING_SECONDS / s.control_period)
     levels = {"energy": MAPPING_LEVELS[0], "potential": MAPPING_LEVELS[1], "lifetime": MAPPING_LIFETIME,
               "danger_rate": 0.0}  # mapping is learning the floor, not surviving it
-    bg = {"saliences": "survival", **(bg or {})}  # mapping explores as in exp. 1 (exp. 3's saliences barely explore)
+    bg = _merged(bg or {}, {"saliences": "survival"})  # mapping explores as in exp. 1 (exp. 3's barely explore)
     s = _with(s, bg=bg, metabolism={**levels, "stop_at": "death"}, seed=seed, absent=absent, max_ticks=ticks)
     kinds = {"ingesting": "Ep", "digesting": "E", "dangerous": "DA"}
     present = [o for o in s.obstacles if o.zone is not None and o.name not in absent]
@@ -259,8 +268,17 @@ def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) ->
 
 def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
                       out: Path | None, ratios: tuple[float, ...] | None = None, maps: int | None = None,
-                      progress: bool = True) -> dict:  # fmt: skip
-    """Run one experiment; `maps` mapping runs per scenario for experiments 2 and 3 (default: one per test)."""
+                      progress: bool = True, bg: dict[str, Any] | None = None) -> dict:  # fmt: skip
+    """Run one experiment; `maps` mapping runs per scenario for experiments 2 and 3 (default: one per test);
+    `bg` changes the [bg] table of every run (mapping runs included)."""
+    from agents.controllers.bg.controller import check_table
+
+    changes = dict(bg or {})
+    try:
+        base = load_scenario("tmaze-1" if experiment == "bg-tmaze" else SCENARIO[experiment])
+        check_table(_merged(base.controller_params.get("bg", {}), changes))
+    except ValueError as e:
+        raise ScenarioError("command line", "--bg", str(e)) from None
     expected = SCENARIO[experiment]
     if scenario not in (None, expected) and not (experiment == "bg-tmaze" and scenario.startswith("tmaze")):
         raise ScenarioError("command line", "--scenario", f"{experiment} runs on {expected} (the paper's)")
@@ -275,21 +293,23 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
     out = Path(out) if out is not None else Path("results") / experiment
     out.mkdir(parents=True, exist_ok=True)
     if experiment == "bg-survival":
-        work = [(c, k, seed + k) for c in ("A", "B") for k in range(reps)]
+        work = [(c, k, seed + k, changes) for c in ("A", "B") for k in range(reps)]
         rows = pool_map(work, run_survival, jobs, experiment, progress)
         rows.sort(key=lambda r: (r["condition"], r["run"]))
         summary, md = _survival_summary(rows)
         title = f"# Experiment 1 (Girard et al. 2005): survival with and without the map\n\n{reps} runs per " \
                 f"condition, at most 4 h; seed {seed}.\n\n"
     else:
-        made = _maps(experiment, maps, seed, ratios, jobs, progress)
+        made = _maps(experiment, maps, seed, ratios, jobs, progress, changes)
         (out / "maps.json").write_text(json.dumps(made))
-        work = _tests(experiment, reps, seed, made)
+        work = _tests(experiment, reps, seed, made, changes)
         rows = pool_map(work, run_test, jobs, experiment, progress)
         rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
         summary, md, title = _test_summary(experiment, rows, reps, seed, made)
     write_runs(out, "runs.csv", list(rows[0]), rows, summary)
     _plot(experiment, rows, summary, out / "plot.png")
+    if changes:
+        title += f"[bg] changed in every run: {json.dumps(changes)}.\n\n"
     text = title + md
     (out / "table.md").write_text(text)
     return {"name": experiment, "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
@@ -305,25 +325,27 @@ def _mapped(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
 
 
 def _build_map_job(job: tuple) -> dict:
-    name, k, seed, absent = job
-    return {"scenario": name, "index": k, "data": build_map(name, seed, absent)}
+    name, k, seed, absent, changes = job
+    return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes)}
 
 
 def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None,
-          progress: bool) -> dict[str, list[dict]]:  # fmt: skip
+          progress: bool, changes: dict[str, Any] | None = None) -> dict[str, list[dict]]:  # fmt: skip
     """`count` maps per scenario, map k from a mapping run with seed + k (in parallel)."""
     mapped = _mapped(experiment, ratios)
-    work = [(name, k, seed + k, absent) for name, absent in mapped.items() for k in range(count)]
+    work = [(name, k, seed + k, absent, changes or {}) for name, absent in mapped.items() for k in range(count)]
     made = {(m["scenario"], m["index"]): m["data"]
             for m in pool_map(work, _build_map_job, jobs, f"{experiment} mapping", progress)}  # fmt: skip
     return {name: [made[name, k] for k in range(count)] for name in mapped}
 
 
-def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]]) -> list[tuple]:
+def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
+           changes: dict[str, Any] | None = None) -> list[tuple]:  # fmt: skip
     """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions)."""
     def job(label, k: int, name: str, bg: dict, metabolism: dict, absent: tuple[str, ...]) -> tuple:
         m = k % len(maps[name])
-        return (experiment, label, k, seed + k, name, bg, metabolism, absent, m, maps[name][m])
+        return (experiment, label, k, seed + k, name, _merged(changes or {}, bg), metabolism, absent, m,
+                maps[name][m])
 
     if experiment == "bg-choice":
         return [job(w, k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)]
