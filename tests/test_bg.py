@@ -571,6 +571,8 @@ def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     assert all(job[5] == {**table, "w_plan": job[1], "w_taxon": 0.55} for job in jobs)
     with pytest.raises(ScenarioError, match=r"--bg.*bogus"):
         run_bg_experiment("bg-survival", None, 2, 1, 0, None, progress=False, bg={"bogus": 1})
+    with pytest.raises(ScenarioError, match=r"--bg: \[bg.navigation\] anchor: expected a number, got true"):
+        run_bg_experiment("bg-tmaze", None, 2, 1, 0, None, progress=False, bg={"navigation": {"anchor": True}})
 
 
 def test_swarm_run_prints_the_animats_metabolism_and_map():

@@ -17,4 +17,7 @@ def params_from_table(cls, table: dict[str, Any] | None, section: str, ints=(), 
     if unknown := sorted(set(table) - known):
         raise ValueError(f"[{section}]: unknown field {unknown[0]!r}; expected one of "
                          f"{', '.join(sorted(known | set(nested)))}")  # fmt: skip
+    for k, v in table.items():
+        if k not in texts and isinstance(v, bool):  # float(True) is 1.0: a switch given for a number is a slip
+            raise ValueError(f"[{section}] {k}: expected a number, got {str(v).lower()}")
     return cls(**{k: (v if k in texts else int(v) if k in ints else float(v)) for k, v in table.items()})
