@@ -244,7 +244,7 @@ class Navigator:
             self.D += self.p.d_rise * (1.0 - self.D)
             for r in self.resources:
                 self.assoc[r] = np.concatenate([self.assoc[r], np.zeros(len(self.map.nodes) - len(self.assoc[r]))])
-        else:  # a known place: odometry is pulled part of the way to where the map has it (drift stays bounded)
+        else:  # a known place (with `anchor`, odometry is pulled part of the way to where the map has it)
             if self.observations - self.born[node] >= self.p.known_age:
                 self.D *= self.p.d_fall
             if self.p.anchor > 0.0:
