@@ -2,8 +2,13 @@
 
 The launcher only starts, watches and stops processes; it follows the run on
 the world's `state` key for the progress bar.  Every child runs in its own
-session so that Ctrl-C reaches it only through us, and every child is ended
-(SIGTERM, then SIGKILL) before we return: no orphans, no hang.
+process group so that Ctrl-C reaches it only through us, and every child is
+ended (SIGTERM, then SIGKILL) before we return: no orphans, no hang.
+
+A process group, not a session: Linux's autogroup scheduler (on by default)
+gives every session one equal share of the CPU, so a world in its own session
+got as much CPU, with all its threads, as one single-threaded agent process:
+at 100 agent processes on 2 cores lock-step ran some 20 % slower.
 """
 
 from __future__ import annotations
@@ -175,7 +180,7 @@ class _Children:
     def start(self, name: str, cmd: list[str]) -> subprocess.Popen:
         log = self.folder / f"child-{len(self.procs)}.err"
         with open(log, "wb") as err:
-            p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err, start_new_session=True)
+            p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err, process_group=0)
         self.procs.append(p)
         self.names[p.pid] = name
         return p

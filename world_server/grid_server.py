@@ -46,6 +46,8 @@ class GridServer(WorldServer):
         self.refused = np.zeros(len(REFUSALS), dtype=np.int64)  # action rows refused since the last count, by reason
         self.accepted = 0  # action rows accepted this tick
         self.arrived: list[tuple[bytes, str]] = []  # action messages not applied yet: (bytes, process)
+        self.arrived_end = [0]  # where each of them ends in their bytes joined (0, then one entry per message)
+        self._laid_out: tuple | None = None  # (the groups, their agents in order, where each group's rows start)
         self.expected = 0  # action messages still to come before the tick applies them
         self.state_file = persist.state_path(self.state_dir, self.keys.run) if self.state_dir else None
 
@@ -141,19 +143,27 @@ class GridServer(WorldServer):
         """Every active agent perceived in one compiled pass, in group order, and
         every process's message written in one more (`grid_wire.write_observations`)."""
         w = self.world
-        agents = np.concatenate(list(groups.values())) if groups else np.zeros(0, np.int64)
+        agents, bounds = self._layout(groups)
         ints = np.zeros((len(agents), proto.OBS_INTS), dtype=np.int64)
         pf = np.zeros((len(agents), PERC_F_LEN), dtype=np.float64)
         observe_rows(w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked, agents,
                      ints, pf, self.null)  # fmt: skip
-        bounds = np.zeros(len(groups) + 1, np.int64)
-        np.cumsum([len(members) for members in groups.values()], out=bounds[1:])
         out = np.empty(len(groups) * OBS_OVERHEAD + ints.nbytes + pf.nbytes, np.uint8)
         offsets = np.empty(len(groups) + 1, np.int64)
         data = out[:write_observations(tick, ints, pf, bounds, out, offsets)].tobytes()
         self.expected = len(groups)
         at = offsets.tolist()
         return [(group, data[at[g]:at[g + 1]]) for g, group in enumerate(groups)]
+
+    def _layout(self, groups: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """The agents in group order and where each group's rows start: worked
+        out again only when the groups have (`_groups` keeps the same dict until then)."""
+        if self._laid_out is None or self._laid_out[0] is not groups:
+            agents = np.concatenate(list(groups.values())) if groups else np.zeros(0, np.int64)
+            bounds = np.zeros(len(groups) + 1, np.int64)
+            np.cumsum([len(members) for members in groups.values()], out=bounds[1:])
+            self._laid_out = (groups, agents, bounds)
+        return self._laid_out[1], self._laid_out[2]
 
     def _on_act(self, sample) -> None:
         """An action message waits, as it came, until the tick's messages are
@@ -164,14 +174,14 @@ class GridServer(WorldServer):
         raw = sample.payload.to_bytes()
         self.bytes_in += len(raw)
         self.arrived.append((raw, str(sample.key_expr).rsplit("/", 1)[1]))
+        self.arrived_end.append(self.arrived_end[-1] + len(raw))
         self.expected -= 1
 
     def _apply_arrived(self) -> None:
         arrived, self.arrived = self.arrived, []
         if not arrived:
             return
-        starts = np.zeros(len(arrived) + 1, np.int64)
-        np.cumsum([len(raw) for raw, _ in arrived], out=starts[1:])
+        starts, self.arrived_end = np.array(self.arrived_end, np.int64), [0]
         groups = np.array([self.group_index.get(group, -1) for _, group in arrived], np.int64)
         status = np.empty(len(arrived), np.int64)
         first, last = self._window()

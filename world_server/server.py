@@ -367,12 +367,10 @@ class WorldServer:
         except queue.Empty:
             return False
         self._handle(kind, item)
-        while True:
-            try:
-                kind, item = self.events.get_nowait()
-            except queue.Empty:
-                return True
-            self._handle(kind, item)
+        events = self.events
+        while not events.empty():  # we are its only reader: not empty, so get_nowait cannot fail
+            self._handle(*events.get_nowait())
+        return True
 
     # ------------------------------------------------------------------ ticks
 
@@ -421,15 +419,14 @@ class WorldServer:
         self.barrier_passed()
         answered = self.answered(active)
         self.agent_steps += int(answered.sum())
-        for a, ok in zip(active, answered, strict=True):
-            if ok:
-                self.misses[a] = 0
-            elif self.slots[a] == ACTIVE:
+        self.misses[active[answered]] = 0
+        for a in active[~answered].tolist():  # a Python loop over the few that missed, not over everyone
+            if self.slots[a] == ACTIVE:
                 self.misses[a] += 1
                 self.stats.missed_ticks += 1
-                self._missed(int(a))
+                self._missed(a)
                 if self.misses[a] >= self.max_misses:
-                    self._lose(int(a))
+                    self._lose(a)
         if not self.null:
             self._resolve(tick)
         self.tick += 1
