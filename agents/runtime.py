@@ -149,9 +149,10 @@ class AgentRuntime:
         newest observation is answered.  Returns (stop, agent-steps answered)."""
         latest, last = None, len(batch) - 1
         for i, item in enumerate(batch):
-            raw = item if isinstance(item, bytes) else item.payload.to_bytes()
+            tried = isinstance(item, bytes)  # bytes: `run`'s short way already found them not plain
+            raw = item if tried else item.payload.to_bytes()
             batch[i] = item = None  # zenoh's copy goes now: memory handed back is MBs (issue 12's 80 MB)
-            if i == last and (fast := self._answer_raw(raw)) is not None:  # a plain observation, answered
+            if i == last and not tried and (fast := self._answer_raw(raw)) is not None:  # a plain observation
                 self._heard = time.monotonic()
                 return False, fast  # older observations of the batch are superseded
             msg, raw = self._parse(raw), None  # and the bytes once parsed

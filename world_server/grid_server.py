@@ -46,7 +46,6 @@ class GridServer(WorldServer):
         self.refused = np.zeros(len(REFUSALS), dtype=np.int64)  # action rows refused since the last count, by reason
         self.accepted = 0  # action rows accepted this tick
         self.arrived: list[tuple[bytes, str]] = []  # action messages not applied yet: (bytes, process)
-        self.arrived_end = [0]  # where each of them ends in their bytes joined (0, then one entry per message)
         self._laid_out: tuple | None = None  # (the groups, their agents in order, where each group's rows start)
         self.expected = 0  # action messages still to come before the tick applies them
         self.state_file = persist.state_path(self.state_dir, self.keys.run) if self.state_dir else None
@@ -174,14 +173,14 @@ class GridServer(WorldServer):
         raw = sample.payload.to_bytes()
         self.bytes_in += len(raw)
         self.arrived.append((raw, str(sample.key_expr).rsplit("/", 1)[1]))
-        self.arrived_end.append(self.arrived_end[-1] + len(raw))
         self.expected -= 1
 
     def _apply_arrived(self) -> None:
         arrived, self.arrived = self.arrived, []
         if not arrived:
             return
-        starts, self.arrived_end = np.array(self.arrived_end, np.int64), [0]
+        starts = np.zeros(len(arrived) + 1, np.int64)
+        np.cumsum(np.fromiter((len(raw) for raw, _ in arrived), np.int64, len(arrived)), out=starts[1:])
         groups = np.array([self.group_index.get(group, -1) for _, group in arrived], np.int64)
         status = np.empty(len(arrived), np.int64)
         first, last = self._window()
