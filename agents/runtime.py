@@ -18,7 +18,7 @@ import numpy as np
 
 from agents.controllers import aot
 from agents.controllers.arena import ARENA_CONTROLLERS
-from agents.controllers.layout import A_MARK, controller_kind, new_memory
+from agents.controllers.layout import controller_kind, new_memory
 from swarm import protocol as proto
 from swarm.bus import DEFAULT_ENDPOINT, open_client
 from swarm.errors import RunError
@@ -247,19 +247,16 @@ class GridAgentRuntime(AgentRuntime):
 
     def _answer_raw(self, raw: bytes) -> int | None:
         """Step every agent of ours in the observation and send the action
-        message, envelope and all from one compiled call (`envelope`); a mark
-        write that lowers a mark also goes out on the marks key space."""
+        message, envelope and all from one compiled call (`envelope`); mark
+        writes ride the action rows."""
         size = self.answer_message(self.kind, np.frombuffer(raw, np.uint8), self.mem, self.slot_table, self.rows,
                                    self.params, self.seed, self.null, self.out, self.info)  # fmt: skip
         if size == proto.NOT_PLAIN:
             return None
         if size < 0:
             return 0  # a malformed observation: not answered (the world counts the miss)
-        n, marked, _ = self.info.tolist()
-        if marked:
-            self._send_marks(proto.obs_blocks(raw), self.rows[:n])
         self.act_publisher.put(self.out[:size].tobytes())
-        return n
+        return self.info.item(0)
 
     def _restore(self, memory: proto.Memory) -> None:
         for agent, *words in memory.rows.tolist():
@@ -273,19 +270,8 @@ class GridAgentRuntime(AgentRuntime):
                              self.slot_table, self.rows, self.params, self.seed, obs.tick, self.null)  # fmt: skip
         if n < 0:
             return 0  # a malformed observation: not answered (the world counts the miss)
-        rows = self.rows[:n]
-        if rows[:, proto.R_MARKED].any():
-            self._send_marks(obs, rows)
-        self.act_publisher.put(proto.pack_actions(obs.tick, rows))
+        self.act_publisher.put(proto.pack_actions(obs.tick, self.rows[:n]))
         return n
-
-    def _send_marks(self, obs: proto.ObsBlocks, rows: np.ndarray) -> None:
-        ints = np.frombuffer(obs.ints, "<i8").reshape(-1, proto.OBS_INTS)
-        cell_of = dict(zip(ints[:, 0].tolist(), ints[:, 1].tolist(), strict=True))
-        marked = rows[rows[:, proto.R_MARKED] == 1]
-        agents = marked[:, proto.R_AGENT].tolist()
-        self.session.put(self.keys.mark(self.group), proto.mark_writes(
-            obs.tick, agents, [cell_of[a] for a in agents], marked[:, proto.R_ACT + A_MARK].tolist()))  # fmt: skip
 
 
 def make_runtime(run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,

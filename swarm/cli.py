@@ -212,6 +212,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "bg: the animat's GPR loops, sensing, navigation and step, as real-time factors")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument("--quick", action="store_true", help="shorter measurement")
+    bench.add_argument("--pairs", type=_positive, default=3,
+                       help="distributed: floor/run pairs measured in turn per size; the share is their median "
+                       "(default 3)")  # fmt: skip
 
     world = sub.add_parser(
         "world",
@@ -673,7 +676,7 @@ def cmd_bench(args) -> int:
         from swarm.bench_distributed import bench_distributed, format_distributed_bench
 
         result = bench_distributed(sizes=(10, 50) if args.quick else (10, 50, 100, 200),
-                                   packed=200 if args.quick else 1000)  # fmt: skip
+                                   packed=200 if args.quick else 1000, pairs=args.pairs)  # fmt: skip
         print(json.dumps(result) if args.json else format_distributed_bench(result))
         return 0
     from swarm.bench import bench_engine, format_engine_bench

@@ -168,10 +168,11 @@ def observations(tick: int, ints: np.ndarray, pf: np.ndarray) -> bytes:
 
 def pack_actions(tick: int, rows: np.ndarray) -> bytes:
     """The actions of one agent process for one tick: `rows` (K x ACT_ROW, int64)
-    hold per agent its id, action, whether it put a mark write for this tick on
-    the marks key space (zenoh does not order puts on different keys, so the
-    world waits for both) and its controller memory after the step (the world
-    keeps it, so a restarted world resumes every controller exactly)."""
+    hold per agent its id, action (its mark write included: the world checks
+    it against UPDATE-VALUE on the agent's cell and applies it with the tick),
+    whether that write lowers the mark it perceived, and its controller memory
+    after the step (the world keeps it, so a restarted world resumes every
+    controller exactly)."""
     return pack({"type": "act", "family": FAMILY_GRID, "tick": tick, "rows": rows.astype("<i8", copy=False).tobytes()})
 
 
@@ -194,12 +195,6 @@ def memory_message(agents: np.ndarray, memory: np.ndarray) -> bytes:
     controller memory each of its agents had at the saved tick."""
     rows = np.column_stack([np.asarray(agents, dtype=np.int64), memory]).astype("<i8")
     return pack({"type": "memory", "rows": rows.tobytes()})
-
-
-def mark_writes(tick: int, agents: list[int], cells: list[int], values: list[int]) -> bytes:
-    """UPDATE-VALUE writes of one agent process for one tick, merged by min."""
-    return pack({"type": "mark", "family": FAMILY_GRID, "tick": tick, "agents": list(agents), "cells": list(cells),
-                 "values": list(values)})  # fmt: skip
 
 
 def stop_message(reason: str) -> bytes:
@@ -244,14 +239,6 @@ class Memory(HandBack):
 class Acts:
     tick: int
     rows: np.ndarray  # (K, ACT_ROW): agent, action, marked, memory (validated by the world, row by row)
-
-
-@dataclass(frozen=True)
-class Marks:
-    tick: int
-    agents: np.ndarray
-    cells: np.ndarray
-    values: np.ndarray
 
 
 def int_list(m: dict, key: str, high: int = INT64_MAX) -> np.ndarray | Rejected:
@@ -347,21 +334,6 @@ def parse_acts(data: bytes) -> Acts | Rejected:
     if not isinstance(raw, bytes) or len(raw) % (ACT_ROW * 8):
         return Rejected(f"rows: expected rows of {ACT_ROW} binary integers")
     return Acts(tick, np.frombuffer(raw, dtype="<i8").reshape(-1, ACT_ROW))
-
-
-def parse_marks(data: bytes) -> Marks | Rejected:
-    m = unpack(data)
-    if isinstance(m, Rejected):
-        return m
-    if m.get("type") != "mark" or m.get("family") not in FAMILIES:
-        return Rejected("not a mark write")
-    tick = int_field(m, "tick")
-    agents, cells, values = int_list(m, "agents"), int_list(m, "cells"), int_list(m, "values", 2**62)
-    if bad := first_rejection(tick, agents, cells, values):
-        return bad
-    if not len(agents) == len(cells) == len(values):
-        return Rejected("agents, cells, values: one each per write")
-    return Marks(tick, agents, cells, values)
 
 
 def parse_join(data: bytes) -> dict | Rejected:

@@ -61,17 +61,21 @@ def test_every_bad_row_is_refused_by_reason_and_changes_nothing():
     slots = np.array([ACTIVE, ACTIVE, FREE, ACTIVE], np.int64)
     group_ids = np.array([0, 1, -1, 0], np.int64)
     acts = np.zeros((n, ACT_LEN), np.int64)
-    acted, mark_due, memory = np.zeros(n, bool), np.zeros(n, bool), np.zeros((n, 8), np.int64)
+    acted, memory = np.zeros(n, bool), np.zeros((n, 8), np.int64)
+    mark_floor = np.array([0, 0, 0, 5], np.int64)  # agent 3 may write no mark below 5 on its cell
     stay = np.zeros(ACT_LEN, np.int64)
-    stay[A_MOVE] = 4
+    stay[A_MOVE], stay[A_MARK] = 4, MARK_NONE
     wild = stay.copy()
     wild[A_MOVE] = 99
-    rows = proto.action_rows([0, 1, 2, 99, -1, 3, 0], [stay, stay, stay, stay, stay, wild, stay],
-                             [0, 0, 0, 0, 0, 0, 0], np.arange(56).reshape(7, 8))  # fmt: skip
-    refused = accept_rows(rows, slots, group_ids, 0, True, acted, acts, mark_due, memory)
+    low = stay.copy()
+    low[A_MARK] = 4
+    rows = proto.action_rows([0, 1, 2, 99, -1, 3, 3, 0], [stay, stay, stay, stay, stay, wild, low, stay],
+                             [0, 0, 0, 0, 0, 0, 1, 0], np.arange(64).reshape(8, 8))  # fmt: skip
+    refused = accept_rows(rows, slots, group_ids, 0, True, acted, acts, mark_floor, memory)
     counts = dict(zip(REFUSALS, refused.tolist(), strict=True))
     assert counts == {"act: unknown agent": 3, "act: names an agent of another process": 1,
-                      "act: second action in one tick": 1, "act: out-of-range action": 1}  # fmt: skip
+                      "act: second action in one tick": 1, "act: out-of-range action": 1,
+                      "act: a mark lower than UPDATE-VALUE allows": 1}  # fmt: skip
     assert acted.tolist() == [True, False, False, False]
     assert acts[0, A_MOVE] == 4 and acts[0, A_MARK] == MARK_NONE and not acts[1:].any()
     np.testing.assert_array_equal(memory[0], np.arange(8))  # the first row of agent 0, not the refused second
@@ -164,7 +168,7 @@ def test_the_compiled_envelope_leaves_every_other_message_to_the_parser():
 def _accept_world():
     n = 4
     return {"slots": np.array([ACTIVE, ACTIVE, FREE, ACTIVE], np.int64), "group_ids": np.array([0, 1, -1, 0], np.int64),
-            "acted": np.zeros(n, bool), "acts": np.zeros((n, ACT_LEN), np.int64), "mark_due": np.zeros(n, bool),
+            "acted": np.zeros(n, bool), "acts": np.zeros((n, ACT_LEN), np.int64), "mark_floor": np.zeros(n, np.int64),
             "memory": np.zeros((n, 8), np.int64)}  # fmt: skip
 
 
@@ -181,7 +185,7 @@ def _mixed_rows():
 def _accept(message, first, last, w):
     refused = np.full(len(REFUSALS), 7, np.int64)
     got = accept_message(np.frombuffer(message, np.uint8), first, last, w["slots"], w["group_ids"], 0, True,
-                         w["acted"], w["acts"], w["mark_due"], w["memory"], refused)  # fmt: skip
+                         w["acted"], w["acts"], w["mark_floor"], w["memory"], refused)  # fmt: skip
     return got, refused
 
 
@@ -194,11 +198,11 @@ def test_the_world_accepts_a_plain_action_message_in_one_call_as_the_parser_does
         got, refused = _accept(message, tick, tick, ours)
         parsed = proto.parse_acts(message)
         expected = accept_rows(parsed.rows, ref["slots"], ref["group_ids"], 0, True, ref["acted"], ref["acts"],
-                               ref["mark_due"], ref["memory"])  # fmt: skip
+                               ref["mark_floor"], ref["memory"])  # fmt: skip
         assert got == 2 and expected.sum() == 6 and (refused - 7).tolist() == expected.tolist()  # refusals added up
         for name in ours:
             np.testing.assert_array_equal(ours[name], ref[name], err_msg=name)
-        assert ours["mark_due"].tolist() == [False, False, False, True]
+        assert ours["acts"][:, A_MARK].tolist() == [0, 0, 0, 0]  # the rows' mark writes (0), kept to be applied
 
 
 def test_the_world_leaves_every_other_action_message_to_the_parser_and_changes_nothing():
@@ -215,7 +219,7 @@ def test_the_world_leaves_every_other_action_message_to_the_parser_and_changes_n
     for message in others:
         w = _accept_world()
         assert _accept(message, 300, 300, w)[0] == proto.NOT_PLAIN, message[:40]
-        assert not (w["acted"].any() or w["acts"].any() or w["memory"].any() or w["mark_due"].any())
+        assert not (w["acted"].any() or w["acts"].any() or w["memory"].any())
     for first, last in ((301, 301), (299, 299), (301, 303)):  # not for this tick (lock-step, or real time's window)
         w = _accept_world()
         assert _accept(good, first, last, w)[0] == proto.NOT_PLAIN and not w["acted"].any()
@@ -257,13 +261,28 @@ def test_the_world_applies_the_messages_of_a_tick_in_one_call_as_one_by_one():
     status = np.zeros(len(messages), np.int64)
     starts = np.concatenate([[0], np.cumsum([len(m) for m in messages])]).astype(np.int64)
     total = accept_messages(np.frombuffer(b"".join(messages), np.uint8), starts, np.array(groups, np.int64), 300, 300,
-                            ours["slots"], ours["group_ids"], True, ours["acted"], ours["acts"], ours["mark_due"],
+                            ours["slots"], ours["group_ids"], True, ours["acted"], ours["acts"], ours["mark_floor"],
                             ours["memory"], refused, status)  # fmt: skip
     expected = [accept_message(np.frombuffer(m, np.uint8), 300, 300, ref["slots"], ref["group_ids"], g, True,
-                               ref["acted"], ref["acts"], ref["mark_due"], ref["memory"], ref_refused)
+                               ref["acted"], ref["acts"], ref["mark_floor"], ref["memory"], ref_refused)
                 for m, g in zip(messages, groups, strict=True)]  # fmt: skip
     assert status.tolist() == expected == [1, proto.NOT_PLAIN, proto.NOT_PLAIN, 1, 1] and total == 3
-    assert refused.tolist() == ref_refused.tolist() == [0, 0, 1, 0]  # agent 0's second action
+    assert refused.tolist() == ref_refused.tolist() == [0, 0, 1, 0, 0]  # agent 0's second action
     for name in ours:
         np.testing.assert_array_equal(ours[name], ref[name], err_msg=name)
     assert ours["acted"].tolist() == [True, True, False, True] and ours["memory"][1].tolist() == [1] * 8
+
+
+def test_the_mark_floor_is_update_value_on_the_agents_cell():
+    """grid_wire.mark_floors: a cell's mark, or one more than its lowest free neighbour's (obstacles and the
+    grid's edge not counted), for every agent at once: what an honest mark write in an action row can be."""
+    from world_server.grid import L_MARK, L_OBST
+    from world_server.grid_wire import mark_floors
+
+    layers = np.zeros((8, 3, 4), np.int64)
+    layers[L_MARK] = [[MARK_NONE, 7, 3, 9], [6, MARK_NONE, 8, 2], [MARK_NONE, MARK_NONE, MARK_NONE, MARK_NONE]]
+    layers[L_OBST, 1, 3] = 1  # the 2 beside (0, 3) is behind an obstacle
+    pos = np.array([[0, 0], [0, 3], [2, 2], [1, 1], [2, 0]], np.int64)
+    floors = np.full(5, -1, np.int64)
+    mark_floors(layers, pos, np.array([0, 1, 2, 3], np.int64), floors)
+    assert floors.tolist() == [7, 4, 9, 7, -1]  # agent 4 not asked for

@@ -1,8 +1,10 @@
 """The grid's world process: world_server.server bound to the grid.
 
-The grid's shared environment is the marks key space: agents put their
-UPDATE-VALUE writes on `swarm/<run>/marks/<group>` (merged by min, each
-checked against the rule), and any client can `get swarm/<run>/marks/**`.
+The grid's shared environment is the marks key space: any client can `get
+swarm/<run>/marks/**`.  Agents' UPDATE-VALUE writes ride their action rows
+(the row's mark, checked against the rule on the agent's cell, applied with
+the tick and merged by min, as in-process): one message per agent process
+and tick each way.  A put on `marks/<group>` is counted and refused.
 A lost agent's body leaves the grid, its cargo dropped on its cell as
 resource (on the base: delivered), so the others can still finish the run;
 a new agent taking the slot over starts with a fresh body at the base.
@@ -10,6 +12,7 @@ a new agent taking the slot over starts with a fresh body at the base.
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -19,12 +22,13 @@ from agents.controllers.layout import A_MARK, A_MODE, A_MOVE, A_TRAIL_OP, MARK_N
 from swarm import protocol as proto
 from swarm.engine import UNTIL, is_done
 from world_server import grid_wire, persist
-from world_server.grid import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, L_OBST, GridWorld, write_mark
+from world_server.grid import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, GridWorld
 from world_server.grid_wire import (
     OBS_OVERHEAD,
     REFUSALS,
     accept_messages,
     accept_rows,
+    mark_floors,
     observe_rows,
     write_observations,
 )
@@ -40,14 +44,14 @@ class GridServer(WorldServer):
         grid_wire.warm_up(self.world)
         self.cparams = controller_params(self.scenario)
         n = self.scenario.agents
-        self.mark_due = np.zeros(n, dtype=bool)  # its action announced a mark write
-        self.mark_got = np.zeros(n, dtype=bool)  # that mark write arrived
+        self.mark_floor = np.zeros(n, dtype=np.int64)  # the lowest mark each agent may write on its cell this tick
         self.memory = new_memory(n)  # every controller's memory after its last step (saved: exact resume)
         self.refused = np.zeros(len(REFUSALS), dtype=np.int64)  # action rows refused since the last count, by reason
         self.accepted = 0  # action rows accepted this tick
         self.arrived: list[tuple[bytes, str]] = []  # action messages not applied yet: (bytes, process)
         self._laid_out: tuple | None = None  # (the groups, their agents in order, where each group's rows start)
         self.expected = 0  # action messages still to come before the tick applies them
+        self._arriving = threading.Lock()  # zenoh's threads add to `arrived` and `expected`; the world takes them
         self.state_file = persist.state_path(self.state_dir, self.keys.run) if self.state_dir else None
 
     def _declare_shared(self, put) -> list:
@@ -132,8 +136,6 @@ class GridServer(WorldServer):
     def _begin_tick(self) -> None:
         w = self.world
         self.accepted = 0
-        self.mark_due[:] = False
-        self.mark_got[:] = False
         w.acts[:, A_MOVE] = STAY
         w.acts[:, A_MARK] = MARK_NONE
         w.acts[:, A_TRAIL_OP:A_MODE] = 0  # the mode stays as last reported
@@ -147,10 +149,12 @@ class GridServer(WorldServer):
         pf = np.zeros((len(agents), PERC_F_LEN), dtype=np.float64)
         observe_rows(w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked, agents,
                      ints, pf, self.null)  # fmt: skip
+        mark_floors(w.layers, w.pos, agents, self.mark_floor)  # marks change only when the tick resolves
         out = np.empty(len(groups) * OBS_OVERHEAD + ints.nbytes + pf.nbytes, np.uint8)
         offsets = np.empty(len(groups) + 1, np.int64)
         data = out[:write_observations(tick, ints, pf, bounds, out, offsets)].tobytes()
-        self.expected = len(groups)
+        with self._arriving:
+            self.expected = len(groups)
         at = offsets.tolist()
         return [(group, data[at[g]:at[g + 1]]) for g, group in enumerate(groups)]
 
@@ -164,29 +168,44 @@ class GridServer(WorldServer):
             self._laid_out = (groups, agents, bounds)
         return self._laid_out[1], self._laid_out[2]
 
-    def _on_act(self, sample) -> None:
-        """An action message waits, as it came, until the tick's messages are
-        all in (or a mark write or the barrier's end needs them applied): then
-        one compiled call reads and applies every plain one where its bytes
-        lie (`grid_wire.accept_messages`), and the parser takes the rest,
-        counts them and says why it refuses them."""
-        raw = sample.payload.to_bytes()
-        self.bytes_in += len(raw)
-        self.arrived.append((raw, str(sample.key_expr).rsplit("/", 1)[1]))
-        self.expected -= 1
+    def _act_callback(self, put):
+        """An action message waits, as it came, in `arrived` until the tick's
+        messages are all in (or the barrier's end needs them applied): zenoh's
+        thread adds it there and wakes the world only for the tick's last
+        message, not for each of a hundred (on two cores each wake of the
+        world's thread costs as much as the message's own work).
+        Then one compiled call reads and applies every plain message where its
+        bytes lie (`grid_wire.accept_messages`), and the parser takes the
+        rest, counts them and says why it refuses them."""
+        arriving, wake = self._arriving, ("wake", None)
+
+        def on_act(sample) -> None:
+            raw = sample.payload.to_bytes()
+            group = str(sample.key_expr).rsplit("/", 1)[1]
+            with arriving:
+                self.arrived.append((raw, group))
+                self.expected -= 1
+                last = self.expected <= 0
+            if last:
+                put(wake)
+
+        return on_act
 
     def _apply_arrived(self) -> None:
-        arrived, self.arrived = self.arrived, []
+        with self._arriving:
+            arrived, self.arrived = self.arrived, []
         if not arrived:
             return
         starts = np.zeros(len(arrived) + 1, np.int64)
         np.cumsum(np.fromiter((len(raw) for raw, _ in arrived), np.int64, len(arrived)), out=starts[1:])
+        self.bytes_in += int(starts[-1])
         groups = np.array([self.group_index.get(group, -1) for _, group in arrived], np.int64)
         status = np.empty(len(arrived), np.int64)
         first, last = self._window()
-        self.accepted += accept_messages(np.frombuffer(b"".join(raw for raw, _ in arrived), np.uint8), starts, groups,
-                                         first, last, self.slots, self.group_ids, self.mode == "lockstep", self.acted,
-                                         self.world.acts, self.mark_due, self.memory, self.refused, status)  # fmt: skip
+        buf = np.frombuffer(b"".join(raw for raw, _ in arrived), np.uint8)
+        self.accepted += accept_messages(buf, starts, groups, first, last, self.slots, self.group_ids,
+                                         self.mode == "lockstep", self.acted, self.world.acts, self.mark_floor,
+                                         self.memory, self.refused, status)  # fmt: skip
         for m in np.flatnonzero(status == proto.NOT_PLAIN).tolist():
             self.accepted += self._parsed_act(*arrived[m])
 
@@ -200,7 +219,7 @@ class GridServer(WorldServer):
             self.stats.reject("act: not for this tick", len(msg.rows))
             return 0
         refused = accept_rows(msg.rows, self.slots, self.group_ids, self.group_index.get(group, -1),
-                              self.mode == "lockstep", self.acted, self.world.acts, self.mark_due,
+                              self.mode == "lockstep", self.acted, self.world.acts, self.mark_floor,
                               self.memory)  # fmt: skip
         self.refused += refused
         return len(msg.rows) - int(refused.sum())
@@ -214,29 +233,9 @@ class GridServer(WorldServer):
             self.refused[:] = 0
 
     def _on_mark(self, sample) -> None:
-        self._apply_arrived()  # a mark write is checked against its agent's action
-        received = self._receive(sample, proto.parse_marks, "mark")
-        if received is None:
-            return
-        msg, group = received
-        w = self.world
-        width = w.layers.shape[2]
-        for a, cell, value in zip(msg.agents.tolist(), msg.cells.tolist(), msg.values.tolist(), strict=True):
-            if not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
-                self.stats.reject("mark: unknown agent")
-            elif self.group_of.get(a) != group:
-                self.stats.reject("mark: names an agent of another process")
-            elif not self._current(msg.tick) or (
-                self.mode == "lockstep" and (self.mark_got[a] or (self.acted[a] and not self.mark_due[a]))
-            ):
-                self.stats.reject("mark: not for this tick")
-            elif cell != w.pos[a, 0] * width + w.pos[a, 1]:
-                self.stats.reject("mark: not the agent's cell")
-            elif value < _update_bound(w.layers, int(w.pos[a, 0]), int(w.pos[a, 1])):
-                self.stats.reject("mark: lower than UPDATE-VALUE allows")
-            else:
-                write_mark(w.layers, int(w.pos[a, 0]), int(w.pos[a, 1]), np.int64(value), w.counters)
-                self.mark_got[a] = True
+        """Agents' mark writes ride their action rows: a put on the marks key space is counted and refused."""
+        self.bytes_in += len(sample.payload)
+        self.stats.reject("mark: mark writes go in the action rows (swarm/<run>/act/<group>), not on marks/")
 
     def _on_marks_query(self, query) -> None:
         marks = self.world.layers[L_MARK]
@@ -259,11 +258,6 @@ class GridServer(WorldServer):
     def _finish(self) -> None:
         self._apply_arrived()  # what came after the last tick's barrier
         self._count_refusals()
-
-    def answered(self, agents: np.ndarray) -> np.ndarray:
-        if self.mode == "realtime":
-            return self.acted[agents]
-        return self.acted[agents] & (~self.mark_due[agents] | self.mark_got[agents])
 
     def _missed(self, agent: int) -> None:
         self.world.acts[agent, A_MOVE] = STAY
@@ -292,14 +286,3 @@ class GridServer(WorldServer):
             "grid": list(w.layout.shape), **w.bodies.summary(s.agents),
         }  # fmt: skip
 
-
-def _update_bound(layers: np.ndarray, r: int, c: int) -> int:
-    """The lowest value UPDATE-VALUE can write on (r, c) now."""
-    marks, obst = layers[L_MARK], layers[L_OBST]
-    h, w = marks.shape
-    best = MARK_NONE
-    for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
-        nr, nc = r + dr, c + dc
-        if 0 <= nr < h and 0 <= nc < w and not obst[nr, nc]:
-            best = min(best, int(marks[nr, nc]))
-    return int(min(marks[r, c], best + 1 if best != MARK_NONE else MARK_NONE))

@@ -45,14 +45,31 @@ from swarm.wire_bytes import (
     write_uint,
     write_words,
 )
-from world_server.grid import perceive
+from world_server.grid import L_MARK, L_OBST, perceive
 
 ACTIVE = 2  # world_server.server.ACTIVE (a slot whose agent is in the run)
 
 # Why an action row was refused (index into the counts `accept_rows` returns).
 REFUSALS = ("act: unknown agent", "act: names an agent of another process", "act: second action in one tick",
-            "act: out-of-range action")  # fmt: skip
-UNKNOWN, FOREIGN, SECOND, OUT_OF_RANGE = range(4)
+            "act: out-of-range action", "act: a mark lower than UPDATE-VALUE allows")  # fmt: skip
+UNKNOWN, FOREIGN, SECOND, OUT_OF_RANGE, LOW_MARK = range(5)
+
+
+@njit(cache=True)
+def mark_floors(layers, pos, agents, floors):
+    """floors[a] for each of `agents`: the lowest mark UPDATE-VALUE may write
+    on a's cell now (its mark, or one more than its lowest free neighbour's),
+    against which the mark write of a's action row is checked."""
+    marks, obst = layers[L_MARK], layers[L_OBST]
+    h, w = marks.shape
+    for a in agents:
+        r, c = pos[a, 0], pos[a, 1]
+        best = MARK_NONE
+        for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+            nr, nc = r + dr, c + dc
+            if 0 <= nr < h and 0 <= nc < w and not obst[nr, nc]:
+                best = min(best, marks[nr, nc])
+        floors[a] = min(marks[r, c], best + 1 if best != MARK_NONE else MARK_NONE)
 
 
 @njit(cache=True)
@@ -111,17 +128,17 @@ def _valid(row) -> bool:
 
 
 @njit(cache=True)
-def accept_rows(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory):
+def accept_rows(rows, slots, group_ids, group, lockstep, acted, acts, mark_floor, memory):
     """Check every row of one action message from process `group` and apply
     those that pass; returns the refusals counted by reason (REFUSALS).  A
     refused row changes nothing."""
     refused = np.zeros(len(REFUSALS), dtype=np.int64)
-    _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused)
+    _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_floor, memory, refused)
     return refused
 
 
 @njit(cache=True)
-def _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused):
+def _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_floor, memory, refused):
     """Rows accepted; each refusal added to its reason's count in `refused`."""
     n = len(slots)
     accepted = 0
@@ -136,20 +153,20 @@ def _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memo
             refused[SECOND] += 1
         elif not _valid(row):
             refused[OUT_OF_RANGE] += 1
-        else:
+        elif row[R_ACT + A_MARK] != MARK_NONE and row[R_ACT + A_MARK] < mark_floor[a]:
+            refused[LOW_MARK] += 1
+        else:  # the mark write rides the row and is applied with the tick (min-merged, as in-process)
             for k in range(ACT_LEN):
                 acts[a, k] = row[R_ACT + k]
-            acts[a, A_MARK] = MARK_NONE  # marks travel on the marks key space
             for k in range(MEM_LEN):
                 memory[a, k] = row[R_MEM + k]
             acted[a] = True
-            mark_due[a] = row[R_MARKED] == 1
             accepted += 1
     return accepted
 
 
 @njit(cache=True)
-def accept_message(buf, first_tick, last_tick, slots, group_ids, group, lockstep, acted, acts, mark_due, memory,
+def accept_message(buf, first_tick, last_tick, slots, group_ids, group, lockstep, acted, acts, mark_floor, memory,
                    refused):  # fmt: skip
     """An action message from process `group`, read where its bytes lie (laid
     out as `swarm.protocol.pack_actions` packs it) and applied as `accept_rows`
@@ -174,11 +191,11 @@ def accept_message(buf, first_tick, last_tick, slots, group_ids, group, lockstep
         return NOT_PLAIN
     count = rows_len // (ACT_ROW * 8)
     rows = words(buf, rows_at, count * ACT_ROW).view(np.int64).reshape((count, ACT_ROW))
-    return _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_due, memory, refused)
+    return _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_floor, memory, refused)
 
 
 @njit(cache=True)
-def accept_messages(buf, starts, groups, first_tick, last_tick, slots, group_ids, lockstep, acted, acts, mark_due,
+def accept_messages(buf, starts, groups, first_tick, last_tick, slots, group_ids, lockstep, acted, acts, mark_floor,
                     memory, refused, status):  # fmt: skip
     """`accept_message` for each message of buf[starts[m]:starts[m + 1]] from
     process `groups[m]`, in order: one call for all that came since the last,
@@ -187,7 +204,7 @@ def accept_messages(buf, starts, groups, first_tick, last_tick, slots, group_ids
     total = 0
     for m in range(len(groups)):
         status[m] = accept_message(buf[starts[m]:starts[m + 1]], first_tick, last_tick, slots, group_ids, groups[m],
-                                   lockstep, acted, acts, mark_due, memory, refused)  # fmt: skip
+                                   lockstep, acted, acts, mark_floor, memory, refused)  # fmt: skip
         if status[m] != NOT_PLAIN:
             total += status[m]
     return total
@@ -199,9 +216,10 @@ def warm_up(world) -> None:
     observe_rows(world.layers, world.pher, world.pheromone_on, world.base[0], world.base[1], world.pos,
                  world.payload, world.blocked, none, ints, pf, False)  # fmt: skip
     n = len(world.pos)
+    mark_floors(world.layers, world.pos, none, np.zeros(n, np.int64))
     accept_rows(np.zeros((0, ACT_ROW), np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64), 0, True,
-                np.zeros(n, bool), world.acts, np.zeros(n, bool), np.zeros((n, MEM_LEN), np.int64))  # fmt: skip
+                np.zeros(n, bool), world.acts, np.zeros(n, np.int64), np.zeros((n, MEM_LEN), np.int64))  # fmt: skip
     accept_messages(np.zeros(0, np.uint8), np.zeros(1, np.int64), none, 0, 0, np.zeros(n, np.int64),
-                    np.zeros(n, np.int64), True, np.zeros(n, bool), world.acts, np.zeros(n, bool),
+                    np.zeros(n, np.int64), True, np.zeros(n, bool), world.acts, np.zeros(n, np.int64),
                     np.zeros((n, MEM_LEN), np.int64), np.zeros(len(REFUSALS), np.int64), none)  # fmt: skip
     write_observations(0, ints, pf, np.zeros(1, np.int64), np.zeros(0, np.uint8), np.zeros(1, np.int64))

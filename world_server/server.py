@@ -116,7 +116,7 @@ class WorldServer:
         self._decls = [
             self.session.declare_queryable(k.join, lambda q: put(("join", q))),
             self.session.declare_queryable(k.info, lambda q: put(("info", q))),
-            self.session.declare_subscriber(k.acts, lambda s: put(("act", s))),
+            self.session.declare_subscriber(k.acts, self._act_callback(put)),
             # history: tokens declared before this subscriber (agents back before a restarted world) count too
             self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s)), history=True),
             *self._declare_shared(put),
@@ -128,6 +128,11 @@ class WorldServer:
 
     def _make_world(self) -> None:
         raise NotImplementedError
+
+    def _act_callback(self, put):
+        """What zenoh calls with an action message: by default it queues the
+        message for `_on_act` like every other event."""
+        return lambda sample: put(("act", sample))
 
     def _declare_shared(self, put) -> list:
         """Declarations of the kind's shared key spaces (events go through `put`)."""
@@ -251,6 +256,8 @@ class WorldServer:
             self._reply(item, self.keys.info, proto.pack(self.info()))
         elif kind == "alive":
             self._on_alive(item)
+        elif kind == "wake":
+            pass  # the barrier looks again (`may_all_have_answered`)
         else:
             self._handle_shared(kind, item)
 
