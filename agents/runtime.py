@@ -249,7 +249,7 @@ class GridAgentRuntime(AgentRuntime):
         """Step every agent of ours in the observation and send the action
         message, envelope and all from one compiled call (`envelope`); mark
         writes ride the action rows."""
-        size = self.answer_message(self.kind, np.frombuffer(raw, np.uint8), self.mem, self.slot_table, self.rows,
+        size = self.answer_message(self.kind, raw, self.mem, self.slot_table, self.rows,
                                    self.params, self.seed, self.null, self.out, self.info)  # fmt: skip
         if size == proto.NOT_PLAIN:
             return None

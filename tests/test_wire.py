@@ -123,7 +123,7 @@ def _answer(message: bytes, kind, params, count=5):
 
     mems, rows = new_memory(count), np.zeros((count, proto.ACT_ROW), np.int64)
     out, info = np.zeros(proto.ENVELOPE + count * proto.ACT_ROW * 8, np.uint8), np.zeros(3, np.int64)
-    size = answer_message(kind, np.frombuffer(message, np.uint8), mems, np.arange(count, dtype=np.int64), rows,
+    size = answer_message(kind, message, mems, np.arange(count, dtype=np.int64), rows,
                           params, np.int64(9), False, out, info)  # fmt: skip
     return size, out[: max(size, 0)].tobytes(), rows, mems, info
 

@@ -44,11 +44,12 @@ def signature():
 
 
 def envelope_signature():
-    """envelope.answer_message: kind, the message's bytes (read-only), memories, slot table, action rows, params,
-    seed, null, the action message's bytes, info."""
+    """envelope.answer_message: kind, the message (a Python `bytes`, read where it lies: a numpy view of it
+    would cost an agent more than the rest of the call), memories, slot table, action rows, params, seed, null,
+    the action message's bytes, info."""
     from numba import types as t
 
-    return t.int64(t.int64, t.Array(t.uint8, 1, "C", readonly=True), t.int64[:, ::1], t.int64[::1],
+    return t.int64(t.int64, t.Bytes(t.uint8, 1, "C", readonly=True), t.int64[:, ::1], t.int64[::1],
                    t.int64[:, ::1], t.float64[::1], t.int64, t.boolean, t.uint8[::1], t.int64[::1])  # fmt: skip
 
 

@@ -108,7 +108,7 @@ def warm_up() -> None:
     from agents.controllers.envelope import answer_message
     from swarm.protocol import ENVELOPE, observations
 
-    message = np.frombuffer(observations(0, np.zeros((1, OBS_INTS), np.int64), pf[None]), np.uint8)
+    message = observations(0, np.zeros((1, OBS_INTS), np.int64), pf[None])  # bytes, as the runtime passes them
     answer_message(MARKING, message, new_memory(1), np.zeros(1, np.int64), out, np.zeros(N_PARAMS), np.int64(0), False,
                    np.zeros(ENVELOPE + ACT_ROW * 8, np.uint8), np.zeros(3, np.int64))  # fmt: skip
 

@@ -37,7 +37,7 @@ from swarm.wire_bytes import (
 
 @njit(cache=True)
 def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info):
-    """Answer the observation in `buf` into `out` (the action message's bytes);
+    """Answer the observation in `buf` (its `bytes`, or a uint8 array) into `out` (the action message's bytes);
     returns their length, -1 for an observation whose blocks are malformed (not
     answered, as `answer_rows` says), or NOT_PLAIN.  `info`: rows written,
     whether any row put a mark write, the tick."""
