@@ -275,14 +275,17 @@ def test_the_world_applies_the_messages_of_a_tick_in_one_call_as_one_by_one():
 
 def test_the_mark_floor_is_update_value_on_the_agents_cell():
     """grid_wire.mark_floors: a cell's mark, or one more than its lowest free neighbour's (obstacles and the
-    grid's edge not counted), for every agent at once: what an honest mark write in an action row can be."""
+    grid's edge not counted), from the perception rows the world sends: what an honest mark write can be."""
     from world_server.grid import L_MARK, L_OBST
-    from world_server.grid_wire import mark_floors
+    from world_server.grid_wire import mark_floors, observe_rows
 
     layers = np.zeros((8, 3, 4), np.int64)
     layers[L_MARK] = [[MARK_NONE, 7, 3, 9], [6, MARK_NONE, 8, 2], [MARK_NONE, MARK_NONE, MARK_NONE, MARK_NONE]]
     layers[L_OBST, 1, 3] = 1  # the 2 beside (0, 3) is behind an obstacle
     pos = np.array([[0, 0], [0, 3], [2, 2], [1, 1], [2, 0]], np.int64)
-    floors = np.full(5, -1, np.int64)
-    mark_floors(layers, pos, np.array([0, 1, 2, 3], np.int64), floors)
+    floors, agents = np.full(5, -1, np.int64), np.array([0, 1, 2, 3], np.int64)
+    ints, pf = np.zeros((4, proto.OBS_INTS), np.int64), np.zeros((4, 5))
+    observe_rows(layers, np.zeros((3, 4)), False, 0, 0, pos, np.zeros(5, np.int64), np.zeros(5, np.int64), agents, ints,
+                 pf, False)  # fmt: skip
+    mark_floors(ints, agents, floors)
     assert floors.tolist() == [7, 4, 9, 7, -1]  # agent 4 not asked for

@@ -149,7 +149,7 @@ class GridServer(WorldServer):
         pf = np.zeros((len(agents), PERC_F_LEN), dtype=np.float64)
         observe_rows(w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked, agents,
                      ints, pf, self.null)  # fmt: skip
-        mark_floors(w.layers, w.pos, agents, self.mark_floor)  # marks change only when the tick resolves
+        mark_floors(ints, agents, self.mark_floor)  # marks change only when the tick resolves
         out = np.empty(len(groups) * OBS_OVERHEAD + ints.nbytes + pf.nbytes, np.uint8)
         offsets = np.empty(len(groups) + 1, np.int64)
         data = out[:write_observations(tick, ints, pf, bounds, out, offsets)].tobytes()

@@ -28,7 +28,18 @@ from agents.controllers.layout import (
     STAY,
     TRAIL_ERASE,
 )  # fmt: skip
-from swarm.protocol import ACT_ROW, MAX_MESSAGE_BYTES, NOT_PLAIN, OBS_INTS, R_ACT, R_AGENT, R_MARKED, R_MEM
+from agents.controllers.moves import update_value
+from swarm.protocol import (
+    ACT_ROW,
+    MAX_MESSAGE_BYTES,
+    NOT_PLAIN,
+    OBS_INTS,
+    OBS_PERCEPTION,
+    R_ACT,
+    R_AGENT,
+    R_MARKED,
+    R_MEM,
+)
 from swarm.wire_bytes import (
     ACT_HEAD,
     INTS_KEY,
@@ -45,7 +56,7 @@ from swarm.wire_bytes import (
     write_uint,
     write_words,
 )
-from world_server.grid import L_MARK, L_OBST, perceive
+from world_server.grid import perceive
 
 ACTIVE = 2  # world_server.server.ACTIVE (a slot whose agent is in the run)
 
@@ -56,20 +67,13 @@ UNKNOWN, FOREIGN, SECOND, OUT_OF_RANGE, LOW_MARK = range(5)
 
 
 @njit(cache=True)
-def mark_floors(layers, pos, agents, floors):
-    """floors[a] for each of `agents`: the lowest mark UPDATE-VALUE may write
-    on a's cell now (its mark, or one more than its lowest free neighbour's),
-    against which the mark write of a's action row is checked."""
-    marks, obst = layers[L_MARK], layers[L_OBST]
-    h, w = marks.shape
-    for a in agents:
-        r, c = pos[a, 0], pos[a, 1]
-        best = MARK_NONE
-        for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
-            nr, nc = r + dr, c + dc
-            if 0 <= nr < h and 0 <= nc < w and not obst[nr, nc]:
-                best = min(best, marks[nr, nc])
-        floors[a] = min(marks[r, c], best + 1 if best != MARK_NONE else MARK_NONE)
+def mark_floors(ints, agents, floors):
+    """floors[agents[i]]: the lowest mark the agent of observation row i may
+    write on its cell this tick, against which its action row's mark is
+    checked: UPDATE-VALUE (`moves.update_value`, the controllers' own) on the
+    perception the world has just sent it."""
+    for i in range(len(agents)):
+        floors[agents[i]] = update_value(ints[i, OBS_PERCEPTION:])
 
 
 @njit(cache=True)
@@ -216,7 +220,7 @@ def warm_up(world) -> None:
     observe_rows(world.layers, world.pher, world.pheromone_on, world.base[0], world.base[1], world.pos,
                  world.payload, world.blocked, none, ints, pf, False)  # fmt: skip
     n = len(world.pos)
-    mark_floors(world.layers, world.pos, none, np.zeros(n, np.int64))
+    mark_floors(ints, none, np.zeros(n, np.int64))
     accept_rows(np.zeros((0, ACT_ROW), np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64), 0, True,
                 np.zeros(n, bool), world.acts, np.zeros(n, np.int64), np.zeros((n, MEM_LEN), np.int64))  # fmt: skip
     accept_messages(np.zeros(0, np.uint8), np.zeros(1, np.int64), none, 0, 0, np.zeros(n, np.int64),
