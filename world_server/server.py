@@ -297,7 +297,8 @@ class WorldServer:
             self.slots[agent] = JOINING
             self.misses[agent] = 0
             self.stats.joins += 1
-        info = {"run": self.keys.run, "seed": self.scenario.seed, "tick": self.tick, **self._welcome(agent)}
+        info = {"run": self.keys.run, "seed": self.scenario.seed, "tick": self.tick,
+                "lockstep": self.mode == "lockstep", **self._welcome(agent)}  # fmt: skip
         self._reply(query, self.keys.join, proto.join_reply(agent, nonce, info))
 
     def _assign_group(self, agent: int, group: str) -> None:
