@@ -154,6 +154,23 @@ def test_localizing_against_a_packed_map_equals_matching_node_by_node():
     assert int(np.argmax(packed)) == 0
 
 
+def test_the_side_by_side_kernel_equals_the_node_by_node_one_cell_for_cell():
+    """localize_costs runs LANES nodes at once, sorted by length, the last batch padded: every
+    cost must still be cyclic_cost's, for empty nodes, an empty query and a map not a multiple of LANES."""
+    from agents.controllers.fingerprint.align import LANES, SYMBOLS, localize_costs
+    from agents.controllers.fingerprint.signatures import pack
+
+    m = Matcher()
+    rng = np.random.default_rng(11)
+    nodes = [rng.integers(0, SYMBOLS, rng.integers(0, 60)).astype(np.int8) for _ in range(3 * LANES + 5)]
+    nodes[7] = nodes[7][:0]
+    codes, offsets, _ = pack(nodes)
+    for query in (rng.integers(0, SYMBOLS, 40).astype(np.int8), nodes[3][::-1].copy(), np.zeros(0, np.int8)):
+        expected = [cyclic_cost(query, b, m.sub, m.gap) for b in nodes]
+        assert localize_costs(query, codes, offsets, m.sub, m.gap).tolist() == expected
+    assert localize_costs(nodes[0], *pack([])[:2], m.sub, m.gap).tolist() == []
+
+
 def test_the_probability_calibration_recovers_a_known_logistic():
     from swarm.arena.fingerprint import fit_logistic
 
