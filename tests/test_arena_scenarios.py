@@ -39,11 +39,20 @@ def _animat_at(name: str, x: float, y: float, theta: float = 0.0) -> ArenaWorld:
 
 
 def test_bg_exp1_resources_cannot_be_seen_from_each_others_vicinity():
-    for x, y in ((1.2, 2.4), (2.0, 1.4), (2.2, 2.2)):  # within about 1 m of Ep: E (white) is hidden
+    for x, y in ((1.2, 2.2), (2.0, 1.4), (1.9, 2.1), (2.6, 1.0)):  # within about 1 m of Ep: E (white) is hidden
         assert not _sees(_animat_at("bg-exp1", x, y), 255), (x, y)
     for x, y in ((1.2, 6.6), (2.0, 7.6), (2.2, 6.8)):  # within about 1 m of E: Ep (127) is hidden
         assert not _sees(_animat_at("bg-exp1", x, y), 127), (x, y)
-    assert _sees(_animat_at("bg-exp1", 1.2, 2.4), 127)  # but each is seen from its own vicinity
+    assert _sees(_animat_at("bg-exp1", 1.2, 2.2), 127)  # but each is seen from its own vicinity
+    assert _sees(_animat_at("bg-exp1", 1.2, 6.6, math.pi / 2), 255)
+
+
+def test_bg_exp1_ep_sits_in_a_niche_seen_only_through_its_door():
+    """Ep's niche (stop 36) hides it from most of the south room: seen from the door's side, not from behind
+    the niche's north wall or from the room's middle north of it."""
+    assert _sees(_animat_at("bg-exp1", 4.0, 1.4, math.pi), 127)  # looking west through the door
+    for x, y in ((1.2, 3.2), (3.5, 3.2), (2.6, 3.8)):
+        assert not _sees(_animat_at("bg-exp1", x, y, -math.pi / 2), 127), (x, y)
 
 
 def test_bg_exp2_blocks_are_told_apart_by_their_greys():
