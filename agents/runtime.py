@@ -142,7 +142,7 @@ class AgentRuntime:
                     continue
                 batch = [raw]
             else:  # behind (real time): answer only the newest
-                batch, more = [raw, more], None
+                batch = [raw, more]
                 while (more := try_recv()) is not None:
                     batch.append(more)
             stop, steps = self._answer_batch(batch)

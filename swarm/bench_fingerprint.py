@@ -23,6 +23,7 @@ from agents.controllers.fingerprint.signatures import FingerprintSignatures, pac
 from agents.controllers.navigation.topomap import Link, Node, TopoMap
 
 SIZES = (20, 200, 1000)
+TARGET_MS = 10.0  # issue 14: one fingerprint against 1000 nodes, all rotations, on one core
 
 
 def collect(every: int, quick: bool) -> tuple[list[dict], list[Fingerprint]]:
@@ -119,9 +120,9 @@ def format_fingerprint_bench(r: dict) -> str:
         lines.append(
             f"| {row['nodes']} | {row['likelihoods_ms']} ms | {row['markov_step_ms']} ms | {row['cells_per_s']:,} |"
         )
-    lines.append("\ntarget: localizing one fingerprint against 1000 nodes (all rotations) in at most 10 ms")
-    big = [row for row in r["localize"] if row["nodes"] == 1000]
-    if big:
-        ms = big[0]["markov_step_ms"]
-        lines.append(f"  {'holds' if ms <= 10 else 'MISSED'}: the whole Markov step at 1000 nodes took {ms} ms")
+    lines.append(f"\ntarget: localizing one fingerprint against 1000 nodes (all rotations) in at most {TARGET_MS:g} ms")
+    for row in r["localize"]:
+        if row["nodes"] == 1000:
+            ms, verdict = row["markov_step_ms"], "holds" if row["markov_step_ms"] <= TARGET_MS else "MISSED"
+            lines.append(f"  {verdict}: the whole Markov step at 1000 nodes took {ms} ms")
     return "\n".join(lines)

@@ -41,6 +41,8 @@ LETTERS = "ABCDEFGHIJKLMNOP" + "vc"
 SCALE = 1000  # costs are integers in thousandths of a nat (exact sums, one integer per cell)
 SHIFT = 12  # a DP cell is cost << SHIFT | the column where its path entered (strings up to 2047)
 MAX_LENGTH = (1 << (SHIFT - 1)) - 1
+MASK = (1 << SHIFT) - 1  # a cell's entry column
+NEVER = 1 << 60  # a cell no path may take (more than one turn of the node)
 
 
 def to_string(codes: np.ndarray) -> str:
@@ -140,26 +142,45 @@ def cyclic_cost_exact(a, b, sub, gap):  # pragma: no cover - compiled
     return best
 
 
+@njit(cache=True, inline="always")
+def _load_node(codes, o, m, w, gap, cb, prefix, gb, row):  # pragma: no cover - compiled
+    """The node codes[o:o+m] written twice over columns 1..w: its symbol (cb), gap (gb, shifted) and the
+    gaps of the columns before (prefix); and the pass's first row, where a path enters the node's string
+    at one of its m characters (a rotation)."""
+    prefix[0] = 0
+    for j in range(1, w + 1):
+        c = codes[o + (j - 1) % m]
+        cb[j] = c
+        prefix[j] = prefix[j - 1] + gap[c]
+        gb[j] = gap[c] << SHIFT
+    for j in range(w + 1):
+        row[j] = j if j < m else NEVER | j
+
+
+@njit(cache=True, inline="always")
+def _cell(up, diag, left, sub, gap, ga, j, m):  # pragma: no cover - compiled
+    """One cell of the pass at column j: from above (a query symbol gapped, `ga`), the diagonal (a
+    substitution, `sub`) or the left (a node symbol gapped, `gap`); a path may consume at most one turn
+    of the node (j - its entry column <= m).  Both kernels' cells are this one."""
+    best = up + ga
+    s = diag + sub
+    s = s if j - (diag & MASK) <= m else NEVER
+    best = s if s < best else best
+    h = left + gap
+    h = h if j - (left & MASK) <= m else NEVER
+    return h if h < best else best
+
+
 @njit(cache=True)
 def _cyclic(qsub, qgap, b, gap):  # pragma: no cover - compiled
     """The one-pass kernel for a query given as its rows of the substitution
     table and its gaps, both shifted (computed once per query, not per node)."""
-    n, m = len(qgap), len(b)
+    m = len(b)
     w = 2 * m
-    mask = (1 << SHIFT) - 1
-    never = np.int64(1) << np.int64(60)
-    gb = np.empty(w + 1, np.int64)  # gap of the node's character that column j consumes, shifted
-    cb = np.empty(w + 1, np.int64)
-    prefix = np.zeros(w + 1, np.int64)  # gap costs of bb[:j]
-    gb[0], cb[0] = 0, 0
-    for j in range(1, w + 1):
-        cb[j] = b[(j - 1) % m]
-        prefix[j] = prefix[j - 1] + gap[cb[j]]
-        gb[j] = gap[cb[j]] << SHIFT
-    row = np.empty(w + 1, np.int64)
-    for j in range(w + 1):  # a path enters the node's string at one of its m characters: a rotation
-        row[j] = j if j < m else never | j
-    for i in range(n):
+    tables = np.empty((4, w + 1), np.int64)
+    cb, gb, prefix, row = tables[0], tables[1], tables[2], tables[3]
+    _load_node(b, 0, m, w, gap, cb, prefix, gb, row)
+    for i in range(len(qgap)):
         srow = qsub[i]
         ga = qgap[i]
         diag = row[0]
@@ -167,15 +188,8 @@ def _cyclic(qsub, qgap, b, gap):  # pragma: no cover - compiled
         row[0] = left
         for j in range(1, w + 1):
             up = row[j]
-            best = up + ga
-            s = diag + srow[cb[j]]
-            s = s if j - (diag & mask) <= m else never  # at most one turn of the node
-            best = s if s < best else best
-            h = left + gb[j]
-            h = h if j - (left & mask) <= m else never
-            best = h if h < best else best
-            row[j] = best
-            left = best
+            left = _cell(up, diag, left, srow[cb[j]], gb[j], ga, j, m)
+            row[j] = left
             diag = up
     return _closed(row, prefix, m)
 
@@ -184,10 +198,9 @@ def _cyclic(qsub, qgap, b, gap):  # pragma: no cover - compiled
 def _closed(row, prefix, m):  # pragma: no cover - compiled
     """The best cost in the last row of a pass over a node of m symbols written twice:
     a path that entered at column e and ends at j has left out the turn's characters j..e+m."""
-    mask = (1 << SHIFT) - 1
-    best = np.int64(1) << np.int64(60)
+    best = NEVER
     for j in range(2 * m + 1):
-        end = (row[j] & mask) + m
+        end = (row[j] & MASK) + m
         if j <= end and end <= 2 * m:
             best = min(best, (row[j] >> SHIFT) + prefix[end] - prefix[j])
     return best
@@ -230,20 +243,12 @@ def _distinct(a):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _load_lanes(codes, offsets, nodes, gap, m, cb, prefix, gb, row):  # pragma: no cover - compiled
-    """Each lane's node written twice (cb), its gaps (gb, prefix) and the DP's first row; the
-    width is the longest lane's.  A shorter lane computes columns past its own width: no cell it
-    reads later depends on them."""
+    """Each lane's node (`_load_node`, a column of each table); the width is the longest lane's.  A
+    shorter lane computes columns past its own width: no cell it reads later depends on them."""
     w = 2 * m.max()
-    never = np.int64(1) << np.int64(60)
     for lane in range(LANES):
-        o, mm = offsets[nodes[lane]], m[lane]
-        for j in range(1, w + 1):
-            c = codes[o + (j - 1) % mm]
-            cb[j, lane] = c
-            prefix[j, lane] = prefix[j - 1, lane] + gap[c]
-            gb[j, lane] = gap[c] << SHIFT
-        for j in range(w + 1):
-            row[j, lane] = j if j < mm else never | j
+        _load_node(codes, offsets[nodes[lane]], m[lane], w, gap, cb[:, lane], prefix[:, lane], gb[:, lane],
+                   row[:, lane])  # fmt: skip
     return w
 
 
@@ -252,8 +257,6 @@ def _lanes_pass(qgap, rank, tab, w, m, cb, gb, row, spare):  # pragma: no cover 
     """`_cyclic`'s pass for LANES nodes at once: the lane loop has no dependency between its
     iterations (last row and this row are two arrays), so it compiles to vector instructions.
     Returns the array holding the last row."""
-    mask = (1 << SHIFT) - 1
-    never = np.int64(1) << np.int64(60)
     cur, prev = spare, row
     for i in range(len(qgap)):
         ga = qgap[i]
@@ -263,16 +266,7 @@ def _lanes_pass(qgap, rank, tab, w, m, cb, gb, row, spare):  # pragma: no cover 
             up, diag, left, here = prev[j], prev[j - 1], cur[j - 1], cur[j]
             sub, gj = tab[rank[i], j], gb[j]
             for lane in range(LANES):
-                best = up[lane] + ga
-                d = diag[lane]
-                s = d + sub[lane]
-                s = s if j - (d & mask) <= m[lane] else never  # at most one turn of the node
-                best = s if s < best else best
-                f = left[lane]
-                h = f + gj[lane]
-                h = h if j - (f & mask) <= m[lane] else never
-                best = h if h < best else best
-                here[lane] = best
+                here[lane] = _cell(up[lane], diag[lane], left[lane], sub[lane], gj[lane], ga, j, m[lane])
         cur, prev = prev, cur
     return prev
 
