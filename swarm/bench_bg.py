@@ -60,7 +60,7 @@ def _timed_run(engine, ticks: int) -> tuple[int, float, float, float]:
 
 
 def bench_bg(quick: bool = False) -> dict:
-    from agents.controllers.bg.senses import proximity, resource_pixels
+    from agents.controllers.bg.senses import sense
 
     rounds, repeat, ticks = (3, 200, 400) if quick else (5, 1000, 2000)
     engine = _engine(200 if quick else 2000)
@@ -72,8 +72,7 @@ def bench_bg(quick: bool = False) -> dict:
         s_d, s_v = c.last["s_dorsal"], c.last["s_ventral"]
         grey, heading = p["camera_grey"], float(p["compass"])
         rows["gpr"].append(_per_call(lambda c=c, s_d=s_d, s_v=s_v: c.bg.run(s_d, s_v, period), repeat))
-        rows["sensing"].append(_per_call(lambda grey=grey, heading=heading: proximity(resource_pixels(grey, heading)),
-                                         repeat))  # fmt: skip
+        rows["sensing"].append(_per_call(lambda grey=grey, heading=heading: sense(grey, heading), repeat))
         ran, animat, navigation, total = _timed_run(engine, ticks)
         if ran == 0:  # the animat died: a fresh one
             engine = _engine(200)

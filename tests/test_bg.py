@@ -13,7 +13,7 @@ import pytest
 from agents.controllers.bg import BgController
 from agents.controllers.bg.places import ANGLES, Navigator, NavParams, _explore_channel
 from agents.controllers.bg.saliences import Drives, plan_vector, saliences
-from agents.controllers.bg.senses import Reflex, proximity, resource_pixels, to_allocentric
+from agents.controllers.bg.senses import Reflex, proximity, resource_pixels, sense, to_allocentric
 from agents.controllers.navigation.dijkstra import shortest_routes
 from swarm import protocol_arena as proto
 from swarm.arena.engine import ArenaEngine
@@ -506,6 +506,63 @@ def test_an_animat_put_down_on_a_loaded_map_localizes_itself_before_it_plans():
     engine.step(1)
     assert not nav.relocalize and nav.observations == made["observations"]  # localized, nothing mapped yet
     assert math.hypot(*nav.map.nodes[nav.map.current].position) < 1.5  # a node near its start (the map's origin)
+
+
+def test_sense_reads_the_camera_as_resource_pixels_and_proximity_do():
+    """The controller's one compiled pass equals the two readable steps, for every heading and any grey."""
+    rng = np.random.default_rng(3)
+    levels = np.array([31, 127, 255, 180, 0], np.uint8)
+    for _ in range(200):
+        grey = rng.choice(levels, size=36, p=[0.2, 0.25, 0.2, 0.3, 0.05]).astype(np.uint8)
+        heading = float(rng.uniform(-4 * math.pi, 4 * math.pi))
+        prox, seen = sense(grey, heading)
+        expected = proximity(resource_pixels(grey, heading))
+        assert np.array_equal(prox, expected) and np.array_equal(seen, expected.any(axis=1))
+    assert not sense(np.full(36, 180, np.uint8), 0.0)[1].any()
+
+
+def test_the_plan_cache_key_and_the_selection_sum_are_numpys_to_the_bit():
+    """`places._classes` (the plan cache's key and its test) and `gpr._released` (the ventral selection's
+    weights and their sum) each replace a few numpy calls a tick and must give numpy's numbers."""
+    from agents.controllers.bg.gpr import _released
+    from agents.controllers.bg.places import _classes
+
+    rng = np.random.default_rng(8)
+    for n in (1, 2, 7, 8, 9, 36, 50, 128):
+        for _ in range(50):
+            strength = rng.uniform(0, 1, n) * rng.choice([1e-4, 1.0], n)
+            classes = np.empty(n)
+            assert _classes(strength, classes) == strength.max()
+            assert np.array_equal(classes, np.rint(strength * 100))
+            d, threshold = rng.normal(0, 1, n), float(rng.uniform(-1, 1))
+            w = np.empty(n)
+            total = _released(d, threshold, w)
+            assert np.array_equal(w, np.maximum(d - threshold, 0.0)) and total == np.maximum(d - threshold, 0.0).sum()
+    assert math.isnan(_classes(np.array([0.5, np.nan, 0.2]), np.empty(3)))
+
+
+def test_with_learn_map_off_an_animat_localizes_on_a_loaded_map_and_leaves_it_as_it_is():
+    """`learn_map = false`: the belief follows the animat's views over the loaded map, which gains no node or
+    link and whose nodes stay where they were (until stop 37 the belief froze after the first fix)."""
+    from swarm.arena.bg_experiments import _with
+
+    maker = ArenaEngine(load_scenario("bg-exp1").with_overrides(max_ticks=1200))
+    maker.step(1200)
+    made = maker.controllers[0].map_data()
+    engine = ArenaEngine(_with(load_scenario("bg-exp1"), bg={"map": made, "learn_map": False}, max_ticks=800))
+    nav = engine.controllers[0].nav
+    start = engine.world.pose[0, :2].copy()
+    visited, misses, farthest = set(), [], 0.0
+    for _ in range(30):  # 75 s, within the part of the room the map knows
+        engine.step(10)
+        visited.add(nav.map.current)
+        here = engine.world.pose[0, :2] - start
+        misses.append(math.dist(nav.map.nodes[nav.map.current].position, here))
+        farthest = max(farthest, math.hypot(*here))
+    assert len(nav.map.nodes) == len(made["map"]["nodes"]) and len(nav.map.links) == len(made["map"]["links"])
+    assert [list(n.position) for n in nav.map.nodes] == [n["position"] for n in made["map"]["nodes"]]
+    assert nav.observations > made["observations"] + 10 and len(visited) >= 5  # it kept localizing as it moved
+    assert farthest > 2.0 and np.median(misses) < 1.0, (farthest, np.round(misses, 1))  # on nodes near where it is
 
 
 def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):

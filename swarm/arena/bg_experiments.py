@@ -104,7 +104,8 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
     ticks = int(MAPPING_SECONDS / s.control_period)
     levels = {"energy": MAPPING_LEVELS[0], "potential": MAPPING_LEVELS[1], "lifetime": MAPPING_LIFETIME,
               "danger_rate": 0.0}  # mapping is learning the floor, not surviving it
-    bg = _merged(bg or {}, {"saliences": "survival"})  # mapping explores as in exp. 1 (exp. 3's barely explore)
+    # mapping explores as in exp. 1 (exp. 3's saliences barely explore), and maps (a test may not)
+    bg = _merged(bg or {}, {"saliences": "survival", "learn_map": True})
     s = _with(s, bg=bg, metabolism={**levels, "stop_at": "death"}, seed=seed, absent=absent, max_ticks=ticks)
     kinds = {"ingesting": "Ep", "digesting": "E", "dangerous": "DA"}
     present = [o for o in s.obstacles if o.zone is not None and o.name not in absent]

@@ -23,7 +23,7 @@ from agents.controllers.bg.colony import ColonyMap
 from agents.controllers.bg.gpr import BasalGanglia, select_dorsal, select_ventral
 from agents.controllers.bg.places import DIRECTIONS, Navigator, NavParams
 from agents.controllers.bg.saliences import SALIENCES, Drives, saliences
-from agents.controllers.bg.senses import RESOURCES, Reflex, proximity, resource_pixels
+from agents.controllers.bg.senses import RESOURCES, Reflex, sense
 from agents.controllers.tables import params_from_table
 from swarm.arena.models import ZONE_KINDS
 
@@ -45,7 +45,7 @@ class BgParams:
     too_close: float = 0.45  # m from the centre: the sonar reflex takes over
     reflex_hold: float = 2.0  # s the reflex drives straight on once the front is clear
     align: float = math.radians(30)  # heading error beyond which the animat turns on the spot
-    learn_map: bool = True  # keep mapping (False: a loaded map stays as it is)
+    learn_map: bool = True  # keep mapping (False: a loaded map stays as it is; the animat localizes on it)
     share: bool = False  # a colony: publish the map and what its places hold on swarm/<run>/map/**, merge the others'
     map: str = ""  # a saved map (BgController.map_data() as JSON) to start from; "" none
 
@@ -90,6 +90,7 @@ class BgController:
         self.agent, self.tick = agent, 0
         self.bg = BasalGanglia()
         self.nav = Navigator(self.nav_params, seed, agent, RESOURCES)
+        self.nav.mapping = self.p.learn_map
         given = table.get("map") if isinstance(table.get("map"), dict) else None
         if self.p.map:
             try:
@@ -117,13 +118,15 @@ class BgController:
         zones = int(perception.get("zones", 0))
         usable = {r: bool(zones & bit) for r, bit in USABLE_BITS.items()}
         self.nav.move(float(perception["odometry"][0]), heading)
-        prox = proximity(resource_pixels(grey, heading))
+        prox, seen = sense(grey, heading)
         if self.p.planning:
-            if (self.p.learn_map or self.nav.relocalize) and self.nav.due():
+            if self.nav.due():
                 self.colony.adopt(self.nav.observe(grey, sonar, heading))
-            seen = prox.any(axis=1)
             self.nav.learn(usable, {r: bool(seen[k]) for k, r in enumerate(RESOURCES)}, self.dt)
-            plan = np.stack([self.nav.plan(r) for r in RESOURCES])
+            plan = np.zeros((len(RESOURCES), DIRECTIONS))
+            for k, r in enumerate(RESOURCES):
+                if r != "DA" or self.p.saliences == "fear":  # P(DA) counts only in experiment 3.1's eq. 1
+                    plan[k] = self.nav.plan(r)
             bka, disorientation = self.nav.back_to_known(), self.nav.D
         else:
             plan, bka, disorientation = np.zeros((3, DIRECTIONS)), np.zeros(DIRECTIONS), 0.0
@@ -134,8 +137,9 @@ class BgController:
                                                  self.p.w_plan if self.p.planning else 0.0, self.p.w_taxon)  # fmt: skip
         self.bg.run(s_dorsal, s_ventral, self.dt)
         d, v = self.bg.disinhibition()
-        works = np.array([usable["E"], usable["Ep"]])  # DORSAL_ACTS' zones
-        chosen = select_dorsal(d, np.where(works, self.p.usable_threshold, self.p.dorsal_threshold), self.acting)
+        works = (self.p.usable_threshold if usable["E"] else self.p.dorsal_threshold,  # DORSAL_ACTS' zones
+                 self.p.usable_threshold if usable["Ep"] else self.p.dorsal_threshold)  # fmt: skip
+        chosen = select_dorsal(d, works, self.acting)
         self.acting = chosen
         direction, strength = select_ventral(v, self.p.ventral_threshold)
         reflex = self.reflex(sonar, self.dt) if chosen < 0 else None

@@ -24,6 +24,8 @@ dt is not the cure: the instability is in the coupling, not in each neuron.
 from __future__ import annotations
 
 import functools
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,14 +61,14 @@ def _out(a: float, eps: float, m: float) -> float:
 
 
 @exported("bg_outputs", "void(float64[:, :], float64[:, :], float64[:], float64[:])")
-@njit(cache=True)
+@njit(cache=True, inline="always")  # inlined in run_loops, with _euler: a fifth off the period's 250 steps
 def _outputs(a: np.ndarray, y: np.ndarray, eps: np.ndarray, slope: np.ndarray) -> None:
     for k in range(a.shape[0]):
         for i in range(a.shape[1]):
             y[k, i] = _out(a[k, i], eps[k], slope[k])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _euler(a: np.ndarray, y: np.ndarray, salience: np.ndarray, feedback: float, ctx_rest: np.ndarray,
            lateral: np.ndarray, stn_other: float, dopamine: float, h: float, sums: np.ndarray) -> None:  # fmt: skip
     """One Euler step of one loop in place: a += h (I - a), the inputs I of eqs. 5-14 from the outputs `y`.
@@ -85,9 +87,8 @@ def _euler(a: np.ndarray, y: np.ndarray, salience: np.ndarray, feedback: float, 
     for j in range(n):  # over the striatal channels with output (few), along a row of `lateral`
         y1, y2 = y[D1, j], y[D2, j]
         if y1 > 0.0 or y2 > 0.0:
-            for i in range(n):
+            for i in range(n):  # both sums in one loop: half the loops' set-up, for 36 channels a share
                 sums[0, i] += lateral[j, i] * y1
-            for i in range(n):
                 sums[1, i] += lateral[j, i] * y2
     up, down = 1.0 + dopamine, 1.0 - dopamine
     for i in range(n):
@@ -210,14 +211,50 @@ class BasalGanglia:
         self.a_v[...] = state["a_v"]
 
 
-def select_dorsal(disinhibition: np.ndarray, threshold: float | np.ndarray, incumbent: int = -1) -> int:
+def select_dorsal(disinhibition: np.ndarray, threshold: float | Sequence[float], incumbent: int = -1) -> int:
     """Winner-takes-all: the most disinhibited channel if it is released beyond `threshold` (one for every
     channel, or one per channel) -- or, for the channel selected last (`incumbent`), released at all (below
     its resting output): an act goes on until its channel is inhibited again, as the thalamo-cortical
-    loop's persistence means it to.  Else -1."""
-    k = int(np.argmax(disinhibition))
-    floor = 0.0 if k == incumbent else float(np.broadcast_to(threshold, disinhibition.shape)[k])
-    return k if disinhibition[k] > floor else -1
+    loop's persistence means it to.  Else -1.  (Plain indexing, no numpy call but argmax: this runs
+    every control period.)"""
+    k = int(disinhibition.argmax())
+    own = float(threshold) if isinstance(threshold, (int, float)) else float(threshold[k])
+    return k if disinhibition[k] > (0.0 if k == incumbent else own) else -1
+
+
+@exported("bg_released", "float64(float64[::1], float64, float64[::1])")
+@njit(cache=True)
+def _released(disinhibition: np.ndarray, threshold: float, w: np.ndarray) -> float:
+    """w = np.maximum(disinhibition - threshold, 0.0); returns w.sum() in numpy's order (its pairwise sum:
+    eight running sums, then the rest in turn; numpy/_core/src/umath/loops_utils.h.src), to the bit."""
+    n = w.shape[0]
+    for i in range(n):
+        x = disinhibition[i] - threshold
+        w[i] = x if x > 0.0 or x != x else 0.0  # np.maximum keeps nan
+    if n < 8:
+        total = -0.0  # numpy's reduction starts from the identity -0.0, as its loop does
+        for i in range(n):
+            total += w[i]
+        return total
+    if n > 128:
+        raise ValueError("more than 128 channels: numpy splits the sum further")
+    r0, r1, r2, r3, r4, r5, r6, r7 = w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]
+    i = 8
+    while i < n - n % 8:
+        r0 += w[i]
+        r1 += w[i + 1]
+        r2 += w[i + 2]
+        r3 += w[i + 3]
+        r4 += w[i + 4]
+        r5 += w[i + 5]
+        r6 += w[i + 6]
+        r7 += w[i + 7]
+        i += 8
+    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        total += w[i]
+        i += 1
+    return total
 
 
 @functools.cache
@@ -232,13 +269,13 @@ def select_ventral(disinhibition: np.ndarray, threshold: float) -> tuple[float, 
     `threshold`, each weighted by how far beyond it (channel i points at
     i * 360/N degrees); strength 0 (direction nan) when none is, or when the
     released channels point every way (their sum is under a tenth of their weight)."""
-    w = np.maximum(disinhibition - threshold, 0.0)  # each channel's weight: how far beyond the threshold
-    total = float(w.sum())
+    w = np.empty(len(disinhibition))  # each channel's weight: how far beyond the threshold
+    total = _released(np.ascontiguousarray(disinhibition, np.float64), float(threshold), w)
     if total == 0.0:  # none beyond it
         return float("nan"), 0.0
     cos, sin = _circle(len(disinhibition))
-    x, y = float(w @ cos), float(w @ sin)
+    x, y = float(w.dot(cos)), float(w.dot(sin))  # w @ cos's BLAS sums, with less of numpy's dispatch
     length = float(np.hypot(x, y))
     if length < 0.1 * total:
         return float("nan"), 0.0
-    return float(np.arctan2(y, x) % (2 * np.pi)), length
+    return math.atan2(y, x) % (2 * math.pi), length  # libm's atan2, as np.arctan2

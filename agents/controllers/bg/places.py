@@ -146,6 +146,21 @@ def _hebbian(w: np.ndarray, b: np.ndarray, rate: float, usable: bool) -> None:
             w[i] -= rate * b[i] * w[i]
 
 
+@exported("bg_classes", "float64(float64[::1], float64[::1])")
+@njit(cache=True)
+def _classes(strength: np.ndarray, classes: np.ndarray) -> float:
+    """classes = np.rint(strength * 100); returns strength.max() (nan if any is): one call, every tick."""
+    most = -np.inf
+    for i in range(strength.shape[0]):
+        v = strength[i]
+        classes[i] = np.rint(v * 100)
+        if v != v:
+            most = np.nan
+        elif v > most:
+            most = v
+    return most
+
+
 _SONAR_ANGLES = np.arange(9) * (2 * math.pi / 8)  # the 8 sonars' directions, the first again at 360 degrees
 
 
@@ -191,6 +206,7 @@ class Navigator:
         self.D = 0.0
         self.created = 0
         self.relocalize = False
+        self.mapping = True  # make and move nodes (False: only localize on the map as it is)
         self._edge_key: tuple = ()
         self._edge_cache: tuple[np.ndarray, np.ndarray, np.ndarray] = ()  # type: ignore[assignment]
         self._towards: dict[tuple, np.ndarray] = {}  # P vectors, until the map or what nodes hold changes
@@ -205,14 +221,14 @@ class Navigator:
     # ----------------------------------------------------------- sensing
 
     def move(self, forward: float, heading: float) -> None:
-        d = forward * np.array([math.cos(heading), math.sin(heading)])
-        self.xy = self.xy + d
-        self.since = self.since + d
+        dx, dy = forward * math.cos(heading), forward * math.sin(heading)  # new arrays: others may hold the old
+        self.xy = np.array((self.xy[0] + dx, self.xy[1] + dy))
+        self.since = np.array((self.since[0] + dx, self.since[1] + dy))
 
     def due(self) -> bool:
         """Time for an observation: every `spacing` metres, on an empty map, and at once when put down on a
         map (a test's first plan must start from where the animat is, not from where the map was left)."""
-        return self.relocalize or float(np.hypot(*self.since)) >= self.p.spacing or not self.map.nodes
+        return self.relocalize or float(np.hypot(self.since[0], self.since[1])) >= self.p.spacing or not self.map.nodes
 
     def lost(self) -> None:
         """The animat was put down somewhere on a map it has (a loaded one): the next observation
@@ -230,6 +246,13 @@ class Navigator:
             self.xy, self.since, self.relocalize = self.map.nodes[node].position.copy(), np.zeros(2), False
             self.at = self.xy.copy()
             return node
+        if not self.mapping:  # a map that stays as it is: the belief follows the view, no node is made or moved
+            _, belief = self.map.localize(observation, self.since)
+            self.map.current = int(np.argmax(belief))
+            self.since, self.at = np.zeros(2), self.xy.copy()
+            self.observations += 1
+            self.D *= self.p.d_fall
+            return self.map.current
         before, folded = len(self.map.nodes), len(self.map.folded)
         node = self.map.observe(observation, self.xy, self.since, self.p.extent)
         if len(self.map.folded) > folded:  # a young node turned out to be a known place: what it held goes there
@@ -294,9 +317,12 @@ class Navigator:
         """36-vector pointing along the route to the nodes of largest strength * exp(-route / reach)."""
         k = len(self.map.nodes)
         here = self.map.current
-        if k == 0 or here < 0 or len(strength) == 0 or not strength.max() > 1e-3:
+        if k == 0 or here < 0 or len(strength) == 0:
             return np.zeros(DIRECTIONS)
-        key = (self.observations, self.news, here, np.rint(strength * 100).tobytes())  # np.round(strength, 2)'s classes
+        classes = np.empty(len(strength))  # np.round(strength, 2)'s classes key the cache
+        if not _classes(np.ascontiguousarray(strength, np.float64), classes) > 1e-3:
+            return np.zeros(DIRECTIONS)
+        key = (self.observations, self.news, here, classes.tobytes())
         if key in self._towards:
             return self._towards[key]
         rows, cols, lengths = self._edges()

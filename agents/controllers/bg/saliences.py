@@ -17,7 +17,7 @@ from swarm.kernels import exported, njit
 SALIENCES = ("survival", "fear", "tmaze")  # eqs. 15-17 (exps. 1, 2); 15, 16, 18 (exp. 3.1); 19, 20 (exp. 3.2)
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)  # not frozen: a frozen dataclass sets each field through object.__setattr__, every tick
 class Drives:
     """What the saliences are made of this tick (RESOURCES order where indexed: DA, Ep, E)."""
 

@@ -91,6 +91,37 @@ def _runs(pixels: np.ndarray, out: np.ndarray) -> None:
             out[r, d] = (left + right - 1) / WINDOW
 
 
+def sense(grey: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]:
+    """(proximity(resource_pixels(grey, heading)), which resources show in any direction): what the
+    animat reads off its camera every control period, in one compiled pass instead of some ten numpy calls."""
+    n = len(grey)
+    pixels, prox, seen = np.empty((len(RESOURCE_GREY), n), np.bool_), np.empty((len(RESOURCE_GREY), n)), \
+        np.empty(len(RESOURCE_GREY), np.bool_)  # fmt: skip
+    _sense(np.ascontiguousarray(grey, np.float64), round(heading * n / (2 * math.pi)) % n, _GREY_LEVELS, pixels,
+           prox, seen)  # fmt: skip
+    return prox, seen
+
+
+_GREY_LEVELS = RESOURCE_GREY.astype(np.float64)
+
+
+@exported("bg_sense", "void(float64[::1], int64, float64[::1], boolean[:, ::1], float64[:, ::1], boolean[::1])")
+@njit(cache=True)
+def _sense(grey: np.ndarray, shift: int, levels: np.ndarray, pixels: np.ndarray, prox: np.ndarray,
+           seen: np.ndarray) -> None:  # fmt: skip
+    """`sense` compiled: direction k shows sector k - shift (resource_pixels), then the runs (proximity)."""
+    n = grey.shape[0]
+    for r in range(levels.shape[0]):
+        for k in range(n):
+            pixels[r, k] = grey[(k - shift) % n] == levels[r]
+    _runs(pixels, prox)
+    for r in range(levels.shape[0]):
+        seen[r] = False
+        for k in range(n):
+            if prox[r, k] != 0.0:
+                seen[r] = True
+
+
 SIDE = 1 / 3
 
 
