@@ -89,8 +89,9 @@ class BgController:
         self.dt = float(params["control_period"])
         self.agent, self.tick = agent, 0
         self.bg = BasalGanglia()
-        self.nav = Navigator(self.nav_params, seed, agent, RESOURCES)
-        self.nav.mapping = self.p.learn_map
+        self.nav = Navigator(self.nav_params, seed, agent, RESOURCES, mapping=self.p.learn_map)
+        # P(DA) counts only in experiment 3.1's eq. 1: elsewhere its row of the plans stays 0
+        self.plan_for = tuple((k, r) for k, r in enumerate(RESOURCES) if r != "DA" or self.p.saliences == "fear")
         given = table.get("map") if isinstance(table.get("map"), dict) else None
         if self.p.map:
             try:
@@ -124,9 +125,8 @@ class BgController:
                 self.colony.adopt(self.nav.observe(grey, sonar, heading))
             self.nav.learn(usable, {r: bool(seen[k]) for k, r in enumerate(RESOURCES)}, self.dt)
             plan = np.zeros((len(RESOURCES), DIRECTIONS))
-            for k, r in enumerate(RESOURCES):
-                if r != "DA" or self.p.saliences == "fear":  # P(DA) counts only in experiment 3.1's eq. 1
-                    plan[k] = self.nav.plan(r)
+            for k, r in self.plan_for:
+                plan[k] = self.nav.plan(r)
             bka, disorientation = self.nav.back_to_known(), self.nav.D
         else:
             plan, bka, disorientation = np.zeros((3, DIRECTIONS)), np.zeros(DIRECTIONS), 0.0

@@ -190,8 +190,9 @@ def _explore_channel(sonar: np.ndarray, open_range: float, novel: np.ndarray, wa
 
 
 class Navigator:
-    def __init__(self, params: NavParams, seed: int, agent: int, resources: tuple[str, ...]):
+    def __init__(self, params: NavParams, seed: int, agent: int, resources: tuple[str, ...], mapping: bool = True):
         self.p, self.seed, self.agent = params, seed, agent
+        self.mapping = mapping  # make and move nodes (False: only localize on the map as it is)
         self.map = TopoMap(PlaceSignatures(params.grey_scale, params.sonar_scale),
                            MapParams(theta=params.theta, closure_match=params.closure_match, near=params.near,
                                      recent=params.recent, closure_radius=params.closure_radius,
@@ -206,7 +207,6 @@ class Navigator:
         self.D = 0.0
         self.created = 0
         self.relocalize = False
-        self.mapping = True  # make and move nodes (False: only localize on the map as it is)
         self._edge_key: tuple = ()
         self._edge_cache: tuple[np.ndarray, np.ndarray, np.ndarray] = ()  # type: ignore[assignment]
         self._towards: dict[tuple, np.ndarray] = {}  # P vectors, until the map or what nodes hold changes

@@ -48,8 +48,12 @@ def resource_pixels(grey: np.ndarray, heading: float) -> np.ndarray:
     """(3, n) booleans: which allocentric sectors show each resource (RESOURCES order).
     Sector k of the camera points at heading + k * 360/n; it goes to the nearest direction."""
     n = len(grey)
-    shift = round(heading * n / (2 * math.pi)) % n
-    return np.asarray(grey)[_turned(n, shift)] == _RESOURCE_GREY_COLUMN
+    return np.asarray(grey)[_turned(n, _shift(n, heading))] == _RESOURCE_GREY_COLUMN
+
+
+def _shift(n: int, heading: float) -> int:
+    """The camera's sectors to turn by: heading in whole sectors, to the nearest."""
+    return round(heading * n / (2 * math.pi)) % n
 
 
 _RESOURCE_GREY_COLUMN = RESOURCE_GREY[:, None]
@@ -97,8 +101,7 @@ def sense(grey: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]:
     n = len(grey)
     pixels, prox, seen = np.empty((len(RESOURCE_GREY), n), np.bool_), np.empty((len(RESOURCE_GREY), n)), \
         np.empty(len(RESOURCE_GREY), np.bool_)  # fmt: skip
-    _sense(np.ascontiguousarray(grey, np.float64), round(heading * n / (2 * math.pi)) % n, _GREY_LEVELS, pixels,
-           prox, seen)  # fmt: skip
+    _sense(np.ascontiguousarray(grey, np.float64), _shift(n, heading), _GREY_LEVELS, pixels, prox, seen)
     return prox, seen
 
 
