@@ -9,7 +9,6 @@ directions, so every egocentric reading is turned by the compass first.
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -48,7 +47,9 @@ def resource_pixels(grey: np.ndarray, heading: float) -> np.ndarray:
     """(3, n) booleans: which allocentric sectors show each resource (RESOURCES order).
     Sector k of the camera points at heading + k * 360/n; it goes to the nearest direction."""
     n = len(grey)
-    return np.asarray(grey)[_turned(n, _shift(n, heading))] == _RESOURCE_GREY_COLUMN
+    pixels = np.empty((len(RESOURCE_GREY), n), np.bool_)
+    _pixels(np.ascontiguousarray(grey, np.float64), _shift(n, heading), _GREY_LEVELS, pixels)
+    return pixels
 
 
 def _shift(n: int, heading: float) -> int:
@@ -56,13 +57,16 @@ def _shift(n: int, heading: float) -> int:
     return round(heading * n / (2 * math.pi)) % n
 
 
-_RESOURCE_GREY_COLUMN = RESOURCE_GREY[:, None]
+_GREY_LEVELS = RESOURCE_GREY.astype(np.float64)
 
 
-@functools.cache
-def _turned(n: int, shift: int) -> np.ndarray:
-    """Indices that turn n sectors by `shift`, one row per resource: direction k shows sector k - shift."""
-    return np.tile((np.arange(n) - shift) % n, (len(RESOURCE_GREY), 1))
+@njit(cache=True)
+def _pixels(grey: np.ndarray, shift: int, levels: np.ndarray, pixels: np.ndarray) -> None:
+    """`resource_pixels` compiled: direction k shows sector k - shift."""
+    n = grey.shape[0]
+    for r in range(levels.shape[0]):
+        for k in range(n):
+            pixels[r, k] = grey[(k - shift) % n] == levels[r]
 
 
 def proximity(pixels: np.ndarray) -> np.ndarray:
@@ -105,19 +109,14 @@ def sense(grey: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]:
     return prox, seen
 
 
-_GREY_LEVELS = RESOURCE_GREY.astype(np.float64)
-
-
 @exported("bg_sense", "void(float64[::1], int64, float64[::1], boolean[:, ::1], float64[:, ::1], boolean[::1])")
 @njit(cache=True)
 def _sense(grey: np.ndarray, shift: int, levels: np.ndarray, pixels: np.ndarray, prox: np.ndarray,
            seen: np.ndarray) -> None:  # fmt: skip
-    """`sense` compiled: direction k shows sector k - shift (resource_pixels), then the runs (proximity)."""
-    n = grey.shape[0]
-    for r in range(levels.shape[0]):
-        for k in range(n):
-            pixels[r, k] = grey[(k - shift) % n] == levels[r]
+    """`sense` compiled: the resource pixels, then their runs (proximity), then which resources show."""
+    _pixels(grey, shift, levels, pixels)
     _runs(pixels, prox)
+    n = grey.shape[0]
     for r in range(levels.shape[0]):
         seen[r] = False
         for k in range(n):
