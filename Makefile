@@ -38,6 +38,7 @@ docker:
 
 test: install browser docker
 	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
 	$(BIN)/python -m pytest -q
 
 lint: install

@@ -186,18 +186,34 @@ def build_parser() -> argparse.ArgumentParser:
     )
     exp.add_argument("--reps", type=_positive, help="runs per configuration (default per experiment)")
     exp.add_argument("--noise", choices=["none", "low", "high"], help="dft-*: only the conditions at this noise level")
-    exp.add_argument("--max-steps", type=_positive, metavar="T",
-                     help="dft-*: run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)")
-    exp.add_argument("--ratios", type=_ratios, metavar="R,R,...",
-                     help="bg-tmaze: right / left branch length ratios to run (default 1,1.5,2: tmaze-R scenarios)")
-    exp.add_argument("--maps", type=_positive, metavar="N",
-                     help="bg-choice | bg-forget | bg-fear | bg-tmaze: mapping runs per scenario; test k loads map "
-                          "k mod N (default: one per test; 1: one map for every test)")
-    exp.add_argument("--bg", type=_bg_setting, action="append", metavar="KEY=VALUE",
-                     help="bg-*: change a [bg] setting in every run, mapping runs included (repeatable; e.g. "
-                          "usable_threshold=0.5, navigation.pursuit=0.5: docs/bg.md)")
-    exp.add_argument("--sizes", type=_sizes, metavar="N,N,...",
-                     help="bg-colony: colony sizes to run (default 1,2,4,8)")
+    exp.add_argument(
+        "--max-steps",
+        type=_positive,
+        metavar="T",
+        help="dft-*: run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)",
+    )
+    exp.add_argument(
+        "--ratios",
+        type=_ratios,
+        metavar="R,R,...",
+        help="bg-tmaze: right / left branch length ratios to run (default 1,1.5,2: tmaze-R scenarios)",
+    )
+    exp.add_argument(
+        "--maps",
+        type=_positive,
+        metavar="N",
+        help="bg-choice | bg-forget | bg-fear | bg-tmaze: mapping runs per scenario; test k loads map "
+        "k mod N (default: one per test; 1: one map for every test)",
+    )
+    exp.add_argument(
+        "--bg",
+        type=_bg_setting,
+        action="append",
+        metavar="KEY=VALUE",
+        help="bg-*: change a [bg] setting in every run, mapping runs included (repeatable; e.g. "
+        "usable_threshold=0.5, navigation.pursuit=0.5: docs/bg.md)",
+    )
+    exp.add_argument("--sizes", type=_sizes, metavar="N,N,...", help="bg-colony: colony sizes to run (default 1,2,4,8)")
     exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
     exp.add_argument("--seed", type=_seed, default=0, help="first seed (runs use seed..seed+reps-1)")
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")

@@ -97,8 +97,12 @@ def parse_memory(raw, agents: np.ndarray | None = None) -> Memories | Rejected:
     named = None if agents is None else set(agents.tolist())
     out = []
     for item in raw:
-        if not (isinstance(item, list) and len(item) == 2 and type(item[0]) is int
-                and isinstance(item[1], bytes | memoryview)):  # a view where the message was read with views
+        if not (
+            isinstance(item, list)
+            and len(item) == 2
+            and type(item[0]) is int
+            and isinstance(item[1], bytes | memoryview)
+        ):  # a view where the message was read with views
             return Rejected("memory: expected [agent, bytes]")
         if named is not None and item[0] not in named:
             return Rejected("memory: names an agent the message does not act for")

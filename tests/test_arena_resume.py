@@ -314,8 +314,14 @@ def _no_views(value):
 _SIZES = [0, 1, 15, 16, 31, 32, 255, 256, 65_535, 65_536]
 _KEYS = st.text(max_size=5) | st.integers(-3, 3) | st.binary(max_size=3)
 _PLAIN = st.recursive(
-    st.none() | st.booleans() | st.integers(-(2**63), 2**64 - 1) | st.floats(allow_nan=False, width=32) | st.text()
-    | st.binary() | st.sampled_from(_SIZES).map(lambda n: "é" * n) | st.sampled_from(_SIZES).map(bytes),
+    st.none()
+    | st.booleans()
+    | st.integers(-(2**63), 2**64 - 1)
+    | st.floats(allow_nan=False, width=32)
+    | st.text()
+    | st.binary()
+    | st.sampled_from(_SIZES).map(lambda n: "é" * n)
+    | st.sampled_from(_SIZES).map(bytes),
     lambda inner: st.lists(inner) | st.dictionaries(_KEYS, inner),
     max_leaves=40,
 )

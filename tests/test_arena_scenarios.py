@@ -12,8 +12,18 @@ from swarm.scenario import bundled_scenarios, is_arena, load_scenario
 from tests.arena_helpers import arena
 from world_server.arena import ArenaWorld
 
-ARENAS = ["zmaze", "large-maze", "bg-exp1", "bg-exp2", "bg-exp3", "tmaze-1", "tmaze-1.5", "tmaze-2", "office",
-          "bg-colony"]
+ARENAS = [
+    "zmaze",
+    "large-maze",
+    "bg-exp1",
+    "bg-exp2",
+    "bg-exp3",
+    "tmaze-1",
+    "tmaze-1.5",
+    "tmaze-2",
+    "office",
+    "bg-colony",
+]
 
 
 def test_every_bundled_arena_loads_and_ticks():

@@ -24,7 +24,7 @@ from tests.arena_helpers import arena, box, resumed_pair, rrd_rows
 from world_server.arena import ArenaWorld
 
 FOOD = (
-    '[metabolism]\n{extra}\n'
+    "[metabolism]\n{extra}\n"
     '[[resource]]\nname = "food"\nkind = "ingesting"\ncentre = [0.6, 0.5]\n'
     '[[resource]]\nname = "rest"\nkind = "digesting"\ncentre = [2.4, 0.5]\n'
     '[[resource]]\nname = "danger"\nkind = "dangerous"\ncentre = [1.5, 1.5]\n'
@@ -586,8 +586,16 @@ def test_bg_experiment_tests_share_maps_across_conditions():
 
     maps = {"bg-exp3": [{"id": 0}, {"id": 1}]}
     jobs = _tests("bg-fear", 4, 10, maps)
-    assert [(j[1], j[3], j[8]) for j in jobs] == [(0.1, 10, 0), (0.1, 11, 1), (0.1, 12, 0), (0.1, 13, 1),
-                                                  (0.5, 10, 0), (0.5, 11, 1), (0.5, 12, 0), (0.5, 13, 1)]
+    assert [(j[1], j[3], j[8]) for j in jobs] == [
+        (0.1, 10, 0),
+        (0.1, 11, 1),
+        (0.1, 12, 0),
+        (0.1, 13, 1),
+        (0.5, 10, 0),
+        (0.5, 11, 1),
+        (0.5, 12, 0),
+        (0.5, 13, 1),
+    ]
     assert all(j[9] is maps["bg-exp3"][j[8]] for j in jobs)
 
 

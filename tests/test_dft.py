@@ -470,8 +470,13 @@ def test_malformed_context_is_refused_whole():
     s = replace(s, controller_params={"dft": {"obstacles": "sensed"}})
     engine = ArenaEngine(s)
     c = engine.controllers[1]
-    bad_ones = ({"tick": 1, "marked": [1], "cleared": []}, {"tick": 1, "marked": [5, 99999], "cleared": []},
-                {"tick": "x", "marked": [], "cleared": []}, [1, 2], {"tick": 1, "marked": [1.5, 2], "cleared": []})
+    bad_ones = (
+        {"tick": 1, "marked": [1], "cleared": []},
+        {"tick": 1, "marked": [5, 99999], "cleared": []},
+        {"tick": "x", "marked": [], "cleared": []},
+        [1, 2],
+        {"tick": 1, "marked": [1.5, 2], "cleared": []},
+    )
     for bad in bad_ones:
         with pytest.raises(ValueError):
             c.receive(0, bad)
@@ -528,9 +533,14 @@ def test_the_swarm_summary_measures_how_much_earlier_robot_0_replans():
         return {"condition": c, "run": k, "route": route, "south_tick": south, "turn_tick": turn, "reached": True,
                 "ticks_to_goal": 900, "appear": 100, "duration": 600}  # fmt: skip
 
-    rows = [row("alone-told", 1, "south", 300, 270), row("alone-told", 2, "south", 300, 270),
-            row("alone-sensed", 1, "north-then-south", 800, 700), row("alone-sensed", 2, "north", None, 650),
-            row("scout-sensed", 1, "north-then-south", 550, 430), row("scout-sensed", 2, "north-then-south", 560, 440)]
+    rows = [
+        row("alone-told", 1, "south", 300, 270),
+        row("alone-told", 2, "south", 300, 270),
+        row("alone-sensed", 1, "north-then-south", 800, 700),
+        row("alone-sensed", 2, "north", None, 650),
+        row("scout-sensed", 1, "north-then-south", 550, 430),
+        row("scout-sensed", 2, "north-then-south", 560, 440),
+    ]
     assert replan_tick(rows[2]) == 700 and replan_tick(rows[3]) is None and replan_tick(rows[0]) == 300
     summary, md = summarise_together(rows)
     last = summary[-1]

@@ -60,8 +60,10 @@ def test_bad_traffic_is_counted_and_changes_nothing():
             s.put(keys.act("intruder"), act(tick=2**64 - 1))
             s.put(keys.act("intruder"), act(rows=b"short"))
             s.put(keys.act("intruder"), act(family="bees"))
-            s.put(keys.mark("intruder"), proto.pack({"type": "mark", "family": "grid", "tick": 0, "agents": [0],
-                                                     "cells": [0], "values": [0]}))  # a mark write: not on this key
+            s.put(
+                keys.mark("intruder"),
+                proto.pack({"type": "mark", "family": "grid", "tick": 0, "agents": [0], "cells": [0], "values": [0]}),
+            )  # a mark write: not on this key
             for _ in range(300):  # a flood
                 s.put(keys.act("flood"), b"\x93\x01\x02")
             replies = list(s.get(keys.marks, timeout=5.0))

@@ -243,7 +243,7 @@ def test_the_world_writes_every_observation_message_byte_for_byte_in_one_call():
         assert offsets[0] == 0 and offsets[-1] == end <= len(out)
         for g in range(len(sizes)):
             a, b = bounds[g], bounds[g + 1]
-            assert out[offsets[g]:offsets[g + 1]].tobytes() == proto.observations(tick, ints[a:b], pf[a:b])
+            assert out[offsets[g] : offsets[g + 1]].tobytes() == proto.observations(tick, ints[a:b], pf[a:b])
 
 
 def test_the_world_applies_the_messages_of_a_tick_in_one_call_as_one_by_one():

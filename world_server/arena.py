@@ -214,8 +214,14 @@ class ArenaWorld:
         """Per row of (k, 2) wheel speeds, or (k, 3) with an act, for these
         robots: the index in REJECT_REASONS of why it cannot be acted on, or -1."""
         why = np.empty(len(actions), np.int64)
-        refusals(np.ascontiguousarray(actions, np.float64), self.max_wheel, np.ascontiguousarray(robots, np.int64),
-                 len(ACTS), self.metabolism is not None, why)  # no metabolism here: no act means anything
+        refusals(
+            np.ascontiguousarray(actions, np.float64),
+            self.max_wheel,
+            np.ascontiguousarray(robots, np.int64),
+            len(ACTS),
+            self.metabolism is not None,
+            why,
+        )  # no metabolism here: no act means anything
         return why
 
     def judge(self, agent: int, wheels: np.ndarray) -> str | None:

@@ -152,11 +152,11 @@ class GridServer(WorldServer):
         mark_floors(ints, agents, self.mark_floor)  # marks change only when the tick resolves
         out = np.empty(len(groups) * OBS_OVERHEAD + ints.nbytes + pf.nbytes, np.uint8)
         offsets = np.empty(len(groups) + 1, np.int64)
-        data = out[:write_observations(tick, ints, pf, bounds, out, offsets)].tobytes()
+        data = out[: write_observations(tick, ints, pf, bounds, out, offsets)].tobytes()
         with self._arriving:
             self.expected = len(groups)
         at = offsets.tolist()
-        return [(group, data[at[g]:at[g + 1]]) for g, group in enumerate(groups)]
+        return [(group, data[at[g] : at[g + 1]]) for g, group in enumerate(groups)]
 
     def _layout(self, groups: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """The agents in group order and where each group's rows start: worked
@@ -285,4 +285,3 @@ class GridServer(WorldServer):
             "reachable_cells": w.reachable, "rejected_moves": int(w.counters[C_REJECTED]),
             "grid": list(w.layout.shape), **w.bodies.summary(s.agents),
         }  # fmt: skip
-

@@ -41,8 +41,13 @@ TABLES = {
 SHARES = {"fingerprint": "map", "dft": "context", "bg": "map"}
 MAX_SHARE_BYTES = 4 * 1024 * 1024
 # What a controller needs its robot to sense (checked when a scenario is loaded).
-REQUIRES = {"carrot": ("position", "compass"), "wander": (), "fingerprint": ("camera", "laser", "odometry", "compass"),
-            "dft": ("position", "compass", "ir"), "bg": ("camera", "sonar", "odometry", "compass")}
+REQUIRES = {
+    "carrot": ("position", "compass"),
+    "wander": (),
+    "fingerprint": ("camera", "laser", "odometry", "compass"),
+    "dft": ("position", "compass", "ir"),
+    "bg": ("camera", "sonar", "odometry", "compass"),
+}
 
 
 class ArenaController(Protocol):

@@ -76,4 +76,3 @@ def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info
     at = write_key(out, at, ROWS_KEY)
     at = write_tagged(out, at, size, 0xC4, 3)  # bin 8, 16, 32
     return write_words(out, at, rows.reshape(-1).view(np.uint64), 0, got * ACT_ROW)
-

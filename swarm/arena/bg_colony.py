@@ -39,8 +39,13 @@ def colony_scenario(size: int, share: bool, seed: int, max_ticks: int | None = N
     group = dataclasses.replace(s.groups[0], count=size, starts=starts)
     params = dict(s.controller_params)
     params["bg"] = {**params.get("bg", {}), "share": share}
-    return dataclasses.replace(s, groups=(group,), controller_params=params, seed=seed,
-                               max_ticks=s.max_ticks if max_ticks is None else max_ticks)
+    return dataclasses.replace(
+        s,
+        groups=(group,),
+        controller_params=params,
+        seed=seed,
+        max_ticks=s.max_ticks if max_ticks is None else max_ticks,
+    )
 
 
 def run_colony(job: tuple) -> dict:

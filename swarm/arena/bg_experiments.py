@@ -102,8 +102,12 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
 
     s = load_scenario(name)
     ticks = int(MAPPING_SECONDS / s.control_period)
-    levels = {"energy": MAPPING_LEVELS[0], "potential": MAPPING_LEVELS[1], "lifetime": MAPPING_LIFETIME,
-              "danger_rate": 0.0}  # mapping is learning the floor, not surviving it
+    levels = {
+        "energy": MAPPING_LEVELS[0],
+        "potential": MAPPING_LEVELS[1],
+        "lifetime": MAPPING_LIFETIME,
+        "danger_rate": 0.0,
+    }  # mapping is learning the floor, not surviving it
     # mapping explores as in exp. 1 (exp. 3's saliences barely explore), and maps (a test may not)
     bg = _merged(bg or {}, {"saliences": "survival", "learn_map": True})
     s = _with(s, bg=bg, metabolism={**levels, "stop_at": "death"}, seed=seed, absent=absent, max_ticks=ticks)
@@ -115,8 +119,11 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
         engine.step(1)
         xy = engine.world.pose[0, :2]
         visited |= {o.name for o in present if math.hypot(xy[0] - o.centre[0], xy[1] - o.centre[1]) <= o.reach}
-        if engine.world.tick % 40 == 0 and len(visited) == len(present) and all(
-                len(nav.assoc[kinds[o.zone]]) and nav.assoc[kinds[o.zone]].max() > 0.5 for o in present):
+        if (
+            engine.world.tick % 40 == 0
+            and len(visited) == len(present)
+            and all(len(nav.assoc[kinds[o.zone]]) and nav.assoc[kinds[o.zone]].max() > 0.5 for o in present)
+        ):
             break  # been at every resource (the harness's ground truth) and the map holds every kind
     data = engine.controllers[0].map_data()
     data["mapped_seconds"] = engine.world.tick * s.control_period
@@ -298,8 +305,10 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
         rows = pool_map(work, run_survival, jobs, experiment, progress)
         rows.sort(key=lambda r: (r["condition"], r["run"]))
         summary, md = _survival_summary(rows)
-        title = f"# Experiment 1 (Girard et al. 2005): survival with and without the map\n\n{reps} runs per " \
-                f"condition, at most 4 h; seed {seed}.\n\n"
+        title = (
+            f"# Experiment 1 (Girard et al. 2005): survival with and without the map\n\n{reps} runs per "
+            f"condition, at most 4 h; seed {seed}.\n\n"
+        )
     else:
         made = _maps(experiment, maps, seed, ratios, jobs, progress, changes)
         (out / "maps.json").write_text(json.dumps(made))
@@ -343,10 +352,10 @@ def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None,
 def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
            changes: dict[str, Any] | None = None) -> list[tuple]:  # fmt: skip
     """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions)."""
+
     def job(label, k: int, name: str, bg: dict, metabolism: dict, absent: tuple[str, ...]) -> tuple:
         m = k % len(maps[name])
-        return (experiment, label, k, seed + k, name, _merged(changes or {}, bg), metabolism, absent, m,
-                maps[name][m])
+        return (experiment, label, k, seed + k, name, _merged(changes or {}, bg), metabolism, absent, m, maps[name][m])
 
     if experiment == "bg-choice":
         return [job(w, k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)]
@@ -359,6 +368,7 @@ def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
 
 def _maps_line(made: list[dict]) -> str:
     """What the maps of one scenario hold: nodes, mapping time, resources been at, nodes holding each kind."""
+
     def spread(values) -> str:
         lo, mid, hi = min(values), float(np.median(values)), max(values)
         return f"{lo:.0f}" if lo == hi else f"median {mid:.0f} ({lo:.0f} : {hi:.0f})"
@@ -376,13 +386,19 @@ def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int,
                   maps: dict[str, list[dict]]) -> tuple[list[dict], str, str]:  # fmt: skip
     held = "; ".join(f"{name}: {_maps_line(made)}" for name, made in maps.items())
     n = len(next(iter(maps.values())))
-    head = f"{reps} tests per condition; seed {seed}; " + \
-           ("every test on the map of one mapping run" if n == 1 else
-            "test k of every condition on the map of mapping run k (seed + k)" if n == reps else
-            f"test k of every condition on the map of mapping run k mod {n} (seed + k mod {n})") + \
-           f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full " \
-           f"E lasting 4 h, the saliences of exp. 1) until it has been at every resource and its map holds every " \
-           f"kind, or {MAPPING_SECONDS / 60:.0f} min.\n\n"
+    head = (
+        f"{reps} tests per condition; seed {seed}; "
+        + (
+            "every test on the map of one mapping run"
+            if n == 1
+            else "test k of every condition on the map of mapping run k (seed + k)"
+            if n == reps
+            else f"test k of every condition on the map of mapping run k mod {n} (seed + k mod {n})"
+        )
+        + f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full "
+        f"E lasting 4 h, the saliences of exp. 1) until it has been at every resource and its map holds every "
+        f"kind, or {MAPPING_SECONDS / 60:.0f} min.\n\n"
+    )
     if experiment == "bg-choice":
         summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
         title = "# Experiment 2.1 (Girard et al. 2005): a new resource, planning against taxon\n\n" + head

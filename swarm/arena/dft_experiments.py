@@ -360,19 +360,22 @@ def summarise_together(rows: list[dict]) -> tuple[list[dict], str]:
     south_scout = sum(replan[id(b)] is not None for _, b in both)
     earlier = [replan[id(a)] - replan[id(b)] for a, b in both
                if replan[id(a)] is not None and replan[id(b)] is not None]  # fmt: skip
-    sooner = sum(1 for a, b in both
-                 if replan[id(b)] is not None and (replan[id(a)] is None or replan[id(b)] < replan[id(a)]))
+    sooner = sum(
+        1 for a, b in both if replan[id(b)] is not None and (replan[id(a)] is None or replan[id(b)] < replan[id(a)])
+    )
     head = ("| condition | runs | robot 0 reached | north | south | north then south | other | median ticks to goal |\n"
             "|---|---|---|---|---|---|---|---|\n")  # fmt: skip
     med, q1, q3 = (_fmt(float(np.percentile(earlier, q)) if earlier else math.nan, 0) for q in (50, 25, 75))
-    tail = (f"\nWith the scout sharing what it sensed, robot 0 gave the north route up (replanned) in {south_scout} "
-            f"of {len(both)} runs, against {south_alone} alone with its own sensors; it replanned sooner than "
-            f"alone (or alone never did) in {sooner} runs.  In the {len(earlier)} runs where it replanned both "
-            f"times, it did so a median of {med} ticks earlier with the scout (quartiles {q1}, {q3}).  Replanning "
-            f"is the tick robot 0 turned back ({TURN_BACK * 100:.0f} cm south of its northmost point since t_i) or, "
-            "on the south route from the start, the tick it passed y = 0.505.  "
-            "'alone-told' is the paper's case 3 (the supervisor writes the box into the map the moment it "
-            "appears).\n")
+    tail = (
+        f"\nWith the scout sharing what it sensed, robot 0 gave the north route up (replanned) in {south_scout} "
+        f"of {len(both)} runs, against {south_alone} alone with its own sensors; it replanned sooner than "
+        f"alone (or alone never did) in {sooner} runs.  In the {len(earlier)} runs where it replanned both "
+        f"times, it did so a median of {med} ticks earlier with the scout (quartiles {q1}, {q3}).  Replanning "
+        f"is the tick robot 0 turned back ({TURN_BACK * 100:.0f} cm south of its northmost point since t_i) or, "
+        "on the south route from the start, the tick it passed y = 0.505.  "
+        "'alone-told' is the paper's case 3 (the supervisor writes the box into the map the moment it "
+        "appears).\n"
+    )
     summary.append({"condition": "scout vs alone (sensed)", "runs": len(both), "south_alone": south_alone,
                     "south_scout": south_scout, "sooner_with_scout": sooner,
                     "median_ticks_earlier": float(np.median(earlier)) if earlier else None})  # fmt: skip
@@ -417,8 +420,10 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
         plot_case3(rows, out / "plot.png")
         plot_case3_paths(rows, out / "paths.png")
         np.savez_compressed(out / "paths.npz", **{f"{r['obstacle']}_{r['noise']}_{r['run']}": r["path"] for r in rows})
-        title = f"# Case 3 (Billing et al. 2015): an obstacle across the north route\n\n{reps} runs per obstacle " \
-                f"type and noise level; seed {seed}.\n\n"
+        title = (
+            f"# Case 3 (Billing et al. 2015): an obstacle across the north route\n\n{reps} runs per obstacle "
+            f"type and noise level; seed {seed}.\n\n"
+        )
     else:
         limit = 100 if expected == "zmaze" else 10_000
         reps = 100 if reps is None else reps

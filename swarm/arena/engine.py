@@ -138,8 +138,9 @@ def arena_summary(world: ArenaWorld, wall_seconds: float, runtime: str) -> dict[
         "ticks": world.tick,
         "iterations": world.tick,
         # with goals: all reached; without (explorers): the run went its full length; survival: its rule ended it
-        "finished": all(r["reached"] for r in goals) if goals else (
-            world.tick >= s.max_ticks or (world.metabolism is not None and world.metabolism.done())),
+        "finished": all(r["reached"] for r in goals)
+        if goals
+        else (world.tick >= s.max_ticks or (world.metabolism is not None and world.metabolism.done())),
         "reached": sum(r["reached"] for r in goals),
         "with_goal": len(goals),
         "sim_seconds": round(world.tick * s.control_period, 3),

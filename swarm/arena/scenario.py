@@ -733,8 +733,11 @@ def controller_params(s: ArenaScenario, agent: int) -> dict[str, Any]:
         "noise": s.noise.level,
         "goal_radius": s.goal_radius,
         # the scheduled obstacles, for a controller whose paper tells the robot of them (dft, case 3)
-        "obstacles": [{"rect": list(o.rect), "appear": o.appear, "vanish": o.vanish}
-                      for o in s.obstacles if o.solid and o.zone is None],
+        "obstacles": [
+            {"rect": list(o.rect), "appear": o.appear, "vanish": o.vanish}
+            for o in s.obstacles
+            if o.solid and o.zone is None
+        ],
         **s.controller_params,  # every controller's table: one may drive with another's (fingerprint: carrot)
         group.controller: s.controller_params.get(group.controller, {}),
     }

@@ -223,8 +223,13 @@ class BgController:
     def summary(self) -> dict[str, Any]:
         m = self.nav.map
         held = {r: int((w > 0.5).sum()) for r, w in self.nav.assoc.items()}
-        out = {"nodes": m.size, "links": len(m.links), "loops_closed": m.closures,
-               "disorientation": round(self.nav.D, 4), "nodes_holding": held}
+        out = {
+            "nodes": m.size,
+            "links": len(m.links),
+            "loops_closed": m.closures,
+            "disorientation": round(self.nav.D, 4),
+            "nodes_holding": held,
+        }
         if self.shares:
             out |= {"from_others": self.colony.shared.added, "merged_with_ours": self.colony.shared.merged,
                     "holds_heard": self.colony.heard}  # fmt: skip
