@@ -586,7 +586,7 @@ def test_bg_experiment_tests_share_maps_across_conditions():
 
     maps = {"bg-exp3": [{"id": 0}, {"id": 1}]}
     jobs = _tests("bg-fear", 4, 10, maps)
-    assert [(j[1], j[3], j[8]) for j in jobs] == [
+    assert [(j[1], j[3], j[8]) for j in jobs[:8]] == [
         (0.1, 10, 0),
         (0.1, 11, 1),
         (0.1, 12, 0),
@@ -597,6 +597,35 @@ def test_bg_experiment_tests_share_maps_across_conditions():
         (0.5, 13, 1),
     ]
     assert all(j[9] is maps["bg-exp3"][j[8]] for j in jobs)
+    # the paper's control: the same tests (seeds, maps, Ep) without the dangerous area and without fear
+    control = jobs[8:]
+    assert [(j[1], j[3], j[8], j[6]) for j in control] == [
+        (f"{ep}, no DA", 10 + k, k % 2, {"potential": ep}) for ep in (0.1, 0.5) for k in range(4)
+    ]
+    assert all(j[7] == ("DA",) and j[5]["fear"] == 0.0 for j in control)
+
+
+def test_bg_choice_runs_the_papers_control_of_ten_tests_without_ep2():
+    from swarm.arena.bg_experiments import _tests
+
+    jobs = _tests("bg-choice", 15, 0, {"bg-exp2": [{}]})
+    control = [j for j in jobs if j[1] == "no Ep2"]
+    assert len(jobs) == 3 * 15 + 10 and len(control) == 10  # the paper's ten
+    assert all(j[7] == ("Ep2",) and j[5]["w_plan"] == 0.65 for j in control)
+    assert len([j for j in _tests("bg-choice", 3, 0, {"bg-exp2": [{}]}) if j[1] == "no Ep2"]) == 3
+
+
+def test_a_control_table_counts_each_choice_and_the_time_to_reload():
+    from swarm.arena.bg_experiments import _control_summary, direct_seconds
+
+    tests = [("Ep1", 40.0), ("Ep1", 60.0), ("Ep2", 90.0), ("none", None)]
+    rows = [{"condition": "0.1, no DA", "chose": c, "seconds": t} for c, t in tests]
+    summary, md = _control_summary(rows, ["0.1, no DA"], "Ep at start", "the paper's words", 14.0)
+    assert summary[0] == {"condition": "0.1, no DA", "control": True, "runs": 4, "Ep1": 2, "Ep2": 1,
+                               "neither": 1, "median_s": 60.0, "direct_s": 14.0}  # fmt: skip
+    assert "| 0.1, no DA | 2 | 1 | 1 | 60 |" in md and "the paper's words" in md and "takes 14 s" in md
+    # the most direct paths: bg-forget's by Ep2 is longer than straight to Ep1
+    assert direct_seconds("bg-exp2") > direct_seconds("bg-exp2", ("Ep1",)) > 5.0
 
 
 def test_a_choice_table_says_how_many_of_neither_died():
@@ -633,7 +662,7 @@ def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     animat = engine.controllers[0]
     assert animat.p.usable_threshold == 0.5 and animat.nav.p.anchor == 0.2 and not animat.p.planning
     jobs = _tests("bg-choice", 2, 0, {"bg-exp2": [{}]}, table)  # a test's own [bg] fields kept beside them
-    assert all(job[5] == {**table, "w_plan": job[1], "w_taxon": 0.55} for job in jobs)
+    assert all(job[5] == {**table, "w_plan": 0.65 if job[1] == "no Ep2" else job[1], "w_taxon": 0.55} for job in jobs)
     with pytest.raises(ScenarioError, match=r"--bg.*bogus"):
         run_bg_experiment("bg-survival", None, 2, 1, 0, None, progress=False, bg={"bogus": 1})
     with pytest.raises(ScenarioError, match=r"--bg: \[bg.navigation\] anchor: expected a number, got true"):

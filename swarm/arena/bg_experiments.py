@@ -6,11 +6,14 @@ the experiments of Girard et al. (2005) with the bg animat.
   Mann-Whitney U test (the paper's Table 1 caption swaps A and B; its text
   is right: A uses the map).
 - bg-choice (exp. 2.1, Table 2): a map built without Ep2, then Ep2 appears;
-  which Ep the animat reloads at first, for W_plan 0.65 / 0.55 / 0.45.
+  which Ep the animat reloads at first, for W_plan 0.65 / 0.55 / 0.45; and
+  the paper's control, ten tests in which Ep2 does not appear.
 - bg-forget (exp. 2.2): a map built with Ep2, then Ep2 is gone; the time to
   forget it (the time to reload at Ep1 less the most direct path's).
 - bg-fear (exp. 3.1, Table 3): F = 0.2 and Ep 0.1 or 0.5; Ep1 behind the
-  dangerous area or the far Ep2; Fisher's exact test.
+  dangerous area or the far Ep2; Fisher's exact test; and the paper's
+  control, the same tests without the dangerous area (where "the animat
+  systematically chooses the closest resource").
 - bg-tmaze (exp. 3.2, Table 4): the T-maze with branch ratios 1, 1.5, 2;
   which branch the animat enters first.
 
@@ -52,6 +55,12 @@ PAPER_CHOICE = {0.65: (13, 2), 0.55: (7, 8), 0.45: (2, 13)}
 PAPER_FORGET = (178.0, 78.0, 300.0)  # mean, sd, max seconds
 PAPER_FEAR = {0.1: (13, 7), 0.5: (2, 18)}
 PAPER_TMAZE = {1.0: (3, 12), 1.5: (4, 11), 2.0: (8, 7)}
+# The paper's controls (no numbers given, only what happened): their conditions, tests and words.
+CHOICE_CONTROL = ("no Ep2", 10, "ten tests in which Ep2 is not added: \"it goes directly to Ep1 and activates the "
+                  "ReloadEp action\"; W_plan 0.65")  # fmt: skip
+FEAR_CONTROL = {ep: f"{ep}, no DA" for ep in FEAR_EP}
+FEAR_CONTROL_TEXT = ("\"When the Dangerous Area is absent, the animat systematically chooses the closest resource "
+                     "(Ep1)\"; here the same maps and tests with the dangerous area gone and F = 0")  # fmt: skip
 JUNCTION = (3.1, 4.3)  # T-maze: the stem's walls (x): beyond the first, the left branch; beyond the second, the right
 
 
@@ -209,6 +218,26 @@ def _choice_summary(rows: list[dict], paper: dict, header: str, options: tuple[s
     return summary, md
 
 
+def _control_summary(rows: list[dict], conditions: list[str], header: str, paper: str,
+                     direct: float) -> tuple[list[dict], str]:  # fmt: skip
+    """The paper's control tests beside its words (it gives no numbers): Ep1, Ep2, neither and the median
+    time to reload, against `direct`, the seconds the most direct path to Ep1 takes."""
+    summary, lines = [], []
+    for cond in conditions:
+        sel = [r for r in rows if r["condition"] == cond]
+        n1, n2 = sum(r["chose"] == "Ep1" for r in sel), sum(r["chose"] == "Ep2" for r in sel)
+        times = [r["seconds"] for r in sel if r["seconds"] is not None]
+        median = float(np.median(times)) if times else math.nan
+        summary.append({"condition": cond, "control": True, "runs": len(sel), "Ep1": n1, "Ep2": n2,
+                        "neither": len(sel) - n1 - n2, "median_s": median, "direct_s": direct})  # fmt: skip
+        lines.append(f"| {cond} | {n1} | {n2} | {len(sel) - n1 - n2} | {median:.0f} |")
+    md = (f"\nControl (the paper: {paper}):\n\n| {header} | Ep1 | Ep2 | neither | median time to reload (s) |\n"
+          "|---|---|---|---|---|\n" + "\n".join(lines) +
+          f"\n\nThe most direct path to Ep1 takes {direct:.0f} s (A* from the start into its reach, "
+          "at 0.4 m/s).\n")  # fmt: skip
+    return summary, md
+
+
 def _forget_summary(rows: list[dict], direct: float) -> tuple[list[dict], str]:
     times = np.array([r["seconds"] - direct for r in rows if r["chose"] == "Ep1" and r["seconds"] is not None])
     n = len(rows)
@@ -223,17 +252,20 @@ def _forget_summary(rows: list[dict], direct: float) -> tuple[list[dict], str]:
              "paper_mean_s": pm, "paper_sd_s": ps, "paper_max_s": px}], md  # fmt: skip
 
 
-def direct_seconds(name: str) -> float:
-    """bg-forget's most direct path: start to Ep2's reach, then on to Ep1's reach (A*), at the animat's top speed."""
+def direct_seconds(name: str, stops: tuple[str, ...] = ("Ep2", "Ep1")) -> float:
+    """The most direct path from the start through the reach of each of `stops` in turn (A*), at the animat's
+    top speed: bg-forget's is start, Ep2, Ep1; a control's, start to Ep1."""
     from swarm.arena.engine import _planner
 
     s = load_scenario(name)
     planner = _planner(s.size, s.walls)
     res = {o.name: o for o in s.obstacles}
-    start = tuple(s.groups[0].starts[0][:2])
-    leg1 = planner.plan(start, res["Ep2"].centre)[0] - res["Ep2"].reach
-    leg2 = planner.plan(res["Ep2"].centre, res["Ep1"].centre)[0] - res["Ep1"].reach
-    return (leg1 + res["Ep2"].reach + leg2) / s.groups[0].robot.max_speed
+    here, metres = tuple(s.groups[0].starts[0][:2]), 0.0
+    for k, stop in enumerate(stops):  # into each reach but the last, on from its centre
+        leg = planner.plan(here, res[stop].centre)[0] - res[stop].reach
+        metres += leg + (res[stop].reach if k < len(stops) - 1 else 0.0)
+        here = res[stop].centre
+    return metres / s.groups[0].robot.max_speed
 
 
 # ------------------------------------------------------------------ plots
@@ -257,7 +289,7 @@ def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) ->
         ax.hist(x, bins=10)
         ax.set_xlabel("seconds to reload at Ep1")
     else:
-        rows_ = [r for r in summary if isinstance(r.get("runs"), int)]
+        rows_ = [r for r in summary if isinstance(r.get("runs"), int) and not r.get("control")]
         keys = [k for k in rows_[0] if k not in ("condition", "runs", "neither", "neither_died")
                 and not k.startswith("paper")]  # fmt: skip
         x = np.arange(len(rows_))
@@ -358,11 +390,19 @@ def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
         return (experiment, label, k, seed + k, name, _merged(changes or {}, bg), metabolism, absent, m, maps[name][m])
 
     if experiment == "bg-choice":
-        return [job(w, k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)]
+        control, tests, _ = CHOICE_CONTROL
+        return [job(w, k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)] + [
+            job(control, k, "bg-exp2", {"w_plan": W_PLANS[0], "w_taxon": 0.55}, {}, ("Ep2",))
+            for k in range(min(reps, tests))
+        ]
     if experiment == "bg-forget":
         return [job("Ep2 gone", k, "bg-exp2", {}, {}, ("Ep2",)) for k in range(reps)]
     if experiment == "bg-fear":
-        return [job(ep, k, "bg-exp3", {}, {"potential": ep}, ()) for ep in FEAR_EP for k in range(reps)]
+        return [job(ep, k, "bg-exp3", {}, {"potential": ep}, ()) for ep in FEAR_EP for k in range(reps)] + [
+            job(FEAR_CONTROL[ep], k, "bg-exp3", {"fear": 0.0}, {"potential": ep}, ("DA",))
+            for ep in FEAR_EP
+            for k in range(reps)
+        ]
     return [job(float(name.split("-")[1]), k, name, {}, {}, ()) for name in maps for k in range(reps)]
 
 
@@ -401,12 +441,20 @@ def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int,
     )
     if experiment == "bg-choice":
         summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
+        control, md_control = _control_summary(
+            rows, [CHOICE_CONTROL[0]], "test", CHOICE_CONTROL[2], direct_seconds("bg-exp2", ("Ep1",))
+        )
+        summary, md = summary + control, md + md_control
         title = "# Experiment 2.1 (Girard et al. 2005): a new resource, planning against taxon\n\n" + head
     elif experiment == "bg-forget":
         summary, md = _forget_summary(rows, direct_seconds("bg-exp2"))
         title = "# Experiment 2.2 (Girard et al. 2005): forgetting an exhausted resource\n\n" + head
     elif experiment == "bg-fear":
         summary, md = _choice_summary(rows, PAPER_FEAR, "Ep at start", ("Ep1", "Ep2"), fisher=True)
+        control, md_control = _control_summary(
+            rows, list(FEAR_CONTROL.values()), "Ep at start", FEAR_CONTROL_TEXT, direct_seconds("bg-exp3", ("Ep1",))
+        )
+        summary, md = summary + control, md + md_control
         title = "# Experiment 3.1 (Girard et al. 2005): fear against the need for Ep (F = 0.2)\n\n" + head
     else:
         paper = {r: PAPER_TMAZE[r] for r in sorted({row["condition"] for row in rows})}
