@@ -290,14 +290,17 @@ def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) ->
         ax.set_xlabel("seconds to reload at Ep1")
     else:
         rows_ = [r for r in summary if isinstance(r.get("runs"), int) and not r.get("control")]
+        controls = [r for r in summary if r.get("control")]  # the paper's controls, on the right (no numbers)
         keys = [k for k in rows_[0] if k not in ("condition", "runs", "neither", "neither_died")
                 and not k.startswith("paper")]  # fmt: skip
-        x = np.arange(len(rows_))
+        x = np.arange(len(rows_) + len(controls))
         for k, key in enumerate(keys):
-            ax.bar(x + (k - 0.5) * 0.35, [r[key] for r in rows_], 0.35, label=f"ours: {key}")
-            ax.plot(x + (k - 0.5) * 0.35, [r[f"paper_{key}"] for r in rows_], "k_", markersize=20)
-        ax.set_xticks(x, [str(r["condition"]) for r in rows_])
-        ax.set_ylabel("tests (bars ours, black ticks the paper)")
+            bars = ax.bar(x + (k - 0.5) * 0.35, [r[key] for r in rows_ + controls], 0.35, label=f"ours: {key}")
+            for bar in bars[len(rows_) :]:
+                bar.set_hatch("//")
+            ax.plot(x[: len(rows_)] + (k - 0.5) * 0.35, [r[f"paper_{key}"] for r in rows_], "k_", markersize=20)
+        ax.set_xticks(x, [str(r["condition"]) for r in rows_ + controls])
+        ax.set_ylabel("tests (bars ours, black ticks the paper;\nhatched: the control)")
         ax.legend()
     ax.set_title(experiment)
     _save(fig, path)
