@@ -56,8 +56,9 @@ PAPER_FORGET = (178.0, 78.0, 300.0)  # mean, sd, max seconds
 PAPER_FEAR = {0.1: (13, 7), 0.5: (2, 18)}
 PAPER_TMAZE = {1.0: (3, 12), 1.5: (4, 11), 2.0: (8, 7)}
 # The paper's controls (no numbers given, only what happened): their conditions, tests and words.
-CHOICE_CONTROL = ("no Ep2", 10, "ten tests in which Ep2 is not added: \"it goes directly to Ep1 and activates the "
-                  "ReloadEp action\"; W_plan 0.65")  # fmt: skip
+CHOICE_CONTROL, CHOICE_CONTROL_TESTS = "no Ep2", 10
+CHOICE_CONTROL_TEXT = ("ten tests in which Ep2 is not added: \"it goes directly to Ep1 and activates the ReloadEp "
+                       "action\"; W_plan 0.65")  # fmt: skip
 FEAR_CONTROL = {ep: f"{ep}, no DA" for ep in FEAR_EP}
 FEAR_CONTROL_TEXT = ("\"When the Dangerous Area is absent, the animat systematically chooses the closest resource "
                      "(Ep1)\"; here the same maps and tests with the dangerous area gone and F = 0")  # fmt: skip
@@ -192,14 +193,19 @@ def _survival_summary(rows: list[dict]) -> tuple[list[dict], str]:
     return summary, md
 
 
+def _tally(rows: list[dict], options: tuple[str, str], field: str = "chose") -> tuple[int, int, int]:
+    """How many tests chose each of the two options, and how many neither."""
+    n1 = sum(r[field] == options[0] for r in rows)
+    n2 = sum(r[field] == options[1] for r in rows)
+    return n1, n2, len(rows) - n1 - n2
+
+
 def _choice_summary(rows: list[dict], paper: dict, header: str, options: tuple[str, str], field: str = "chose",
                     fisher: bool = False) -> tuple[list[dict], str]:  # fmt: skip
     summary, lines, table = [], [], []
     for cond, (p1, p2) in paper.items():
         sel = [r for r in rows if r["condition"] == cond]
-        n1 = sum(r[field] == options[0] for r in sel)
-        n2 = sum(r[field] == options[1] for r in sel)
-        other = len(sel) - n1 - n2
+        n1, n2, other = _tally(sel, options, field)
         died = sum(bool(r.get("died")) for r in sel if r[field] not in options)  # the dangerous area's drain
         table.append([n1, n2])
         summary.append({"condition": cond, "runs": len(sel), options[0]: n1, options[1]: n2, "neither": other,
@@ -225,12 +231,12 @@ def _control_summary(rows: list[dict], conditions: list[str], header: str, paper
     summary, lines = [], []
     for cond in conditions:
         sel = [r for r in rows if r["condition"] == cond]
-        n1, n2 = sum(r["chose"] == "Ep1" for r in sel), sum(r["chose"] == "Ep2" for r in sel)
+        n1, n2, other = _tally(sel, ("Ep1", "Ep2"))
         times = [r["seconds"] for r in sel if r["seconds"] is not None]
         median = float(np.median(times)) if times else math.nan
         summary.append({"condition": cond, "control": True, "runs": len(sel), "Ep1": n1, "Ep2": n2,
-                        "neither": len(sel) - n1 - n2, "median_s": median, "direct_s": direct})  # fmt: skip
-        lines.append(f"| {cond} | {n1} | {n2} | {len(sel) - n1 - n2} | {median:.0f} |")
+                        "neither": other, "median_s": median, "direct_s": direct})  # fmt: skip
+        lines.append(f"| {cond} | {n1} | {n2} | {other} | {median:.0f} |")
     md = (f"\nControl (the paper: {paper}):\n\n| {header} | Ep1 | Ep2 | neither | median time to reload (s) |\n"
           "|---|---|---|---|---|\n" + "\n".join(lines) +
           f"\n\nThe most direct path to Ep1 takes {direct:.0f} s (A* from the start into its reach, "
@@ -393,10 +399,9 @@ def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
         return (experiment, label, k, seed + k, name, _merged(changes or {}, bg), metabolism, absent, m, maps[name][m])
 
     if experiment == "bg-choice":
-        control, tests, _ = CHOICE_CONTROL
         return [job(w, k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)] + [
-            job(control, k, "bg-exp2", {"w_plan": W_PLANS[0], "w_taxon": 0.55}, {}, ("Ep2",))
-            for k in range(min(reps, tests))
+            job(CHOICE_CONTROL, k, "bg-exp2", {"w_plan": W_PLANS[0], "w_taxon": 0.55}, {}, ("Ep2",))
+            for k in range(min(reps, CHOICE_CONTROL_TESTS))
         ]
     if experiment == "bg-forget":
         return [job("Ep2 gone", k, "bg-exp2", {}, {}, ("Ep2",)) for k in range(reps)]
@@ -445,7 +450,7 @@ def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int,
     if experiment == "bg-choice":
         summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
         control, md_control = _control_summary(
-            rows, [CHOICE_CONTROL[0]], "test", CHOICE_CONTROL[2], direct_seconds("bg-exp2", ("Ep1",))
+            rows, [CHOICE_CONTROL], "test", CHOICE_CONTROL_TEXT, direct_seconds("bg-exp2", ("Ep1",))
         )
         summary, md = summary + control, md + md_control
         title = "# Experiment 2.1 (Girard et al. 2005): a new resource, planning against taxon\n\n" + head
