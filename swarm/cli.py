@@ -206,6 +206,13 @@ def build_parser() -> argparse.ArgumentParser:
         "k mod N (default: one per test; 1: one map for every test)",
     )
     exp.add_argument(
+        "--mapping",
+        choices=["hungry", "explore"],
+        help="bg-choice | bg-forget | bg-fear | bg-tmaze: how the mapping animat maps: hungry, planning back to "
+        "what it found, or exploring without planning for at least 30 min (default: explore for bg-fear, "
+        "hungry for the others; docs/bg.md)",
+    )
+    exp.add_argument(
         "--bg",
         type=_bg_setting,
         action="append",
@@ -616,8 +623,9 @@ def cmd_experiment(args) -> int:
     if args.noise or args.max_steps:
         raise ScenarioError("command line", "--noise/--max-steps", "these are for the dft-* experiments")
     if args.name == "bg-colony":
-        if args.scenario or args.ratios:
-            raise ScenarioError("command line", "--scenario/--ratios", "bg-colony runs bg-colony; give --sizes")
+        if args.scenario or args.ratios or args.maps or args.mapping:
+            raise ScenarioError("command line", "--scenario/--ratios/--maps/--mapping",
+                                "bg-colony runs bg-colony, with no mapping phase; give --sizes")  # fmt: skip
         from swarm.arena.bg_colony import run_colony_experiment
 
         result = run_colony_experiment(args.sizes, args.reps, args.jobs, args.seed, args.out)
@@ -630,14 +638,16 @@ def cmd_experiment(args) -> int:
         from swarm.arena.bg_experiments import run_bg_experiment
 
         result = run_bg_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
-                                   ratios=args.ratios, maps=args.maps, bg=_bg_table(args.bg))  # fmt: skip
+                                   ratios=args.ratios, maps=args.maps, bg=_bg_table(args.bg),
+                                   mapping=args.mapping)  # fmt: skip
         print(result["markdown"])
         print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
         return 0
     if args.ratios:
         raise ScenarioError("command line", "--ratios", "this is for bg-tmaze")
-    if args.maps:
-        raise ScenarioError("command line", "--maps", "this is for bg-choice, bg-forget, bg-fear and bg-tmaze")
+    if args.maps or args.mapping:
+        raise ScenarioError("command line", "--maps/--mapping",
+                            "these are for bg-choice, bg-forget, bg-fear and bg-tmaze")  # fmt: skip
     if args.name == "carrot":
         from swarm.arena.experiments import run_carrot_experiment
 

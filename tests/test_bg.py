@@ -636,6 +636,31 @@ def test_a_choice_table_says_how_many_of_neither_died():
     summary, md = _choice_summary(rows, PAPER_FEAR, "Ep at start", ("Ep1", "Ep2"), fisher=True)
     assert "| 0.1 | 1 | 0 | 2 (1 died) | 13 | 7 |" in md and "| 0.5 | 0 | 1 | 0 | 2 | 18 |" in md
     assert [s.get("neither_died") for s in summary[:2]] == [1, 0] and "Died: E ran out" in md
+    # Fisher's test on the paper's two columns, and on Ep1 against the rest (neither counts there)
+    from scipy.stats import fisher_exact
+
+    assert summary[-1]["p"] == fisher_exact([[1, 0], [0, 1]]).pvalue
+    assert summary[-1]["p_Ep1_or_not"] == fisher_exact([[1, 2], [0, 1]]).pvalue
+    assert "on (Ep1, Ep2), the paper's" in md and "on (Ep1, not Ep1)" in md
+
+
+def test_an_exploring_mapping_run_maps_half_an_hour_and_knows_both_ep_where_they_are():
+    """bg-fear's mapping (MAPPING_MODES["explore"]): W_plan 0, at least 30 min.  At this seed the hungry
+    mapping animat knew only Ep2 (docs/bg.md, stop 40); the exploring one knows both, on nodes within 1.5 m
+    of each (positions by odometry from the start)."""
+    from swarm.arena.bg_experiments import MAPPING, build_map
+    from swarm.scenario import load_scenario
+
+    assert MAPPING["bg-fear"] == "explore" and MAPPING["bg-choice"] == "hungry"
+    data = build_map("bg-exp3", 1, (), None, "explore")
+    assert data["mapped_seconds"] >= 1800.0 and {"Ep1", "Ep2", "DA", "E"} <= set(data["visited"])
+    s = load_scenario("bg-exp3")
+    places = np.array([n["position"] for n in data["map"]["nodes"]]) + np.array(s.groups[0].starts[0][:2])
+    held = np.array(data["assoc"]["Ep"])
+    for name in ("Ep1", "Ep2"):
+        centre = next(o.centre for o in s.obstacles if o.name == name)
+        near = np.hypot(*(places - np.array(centre)).T) < 1.5
+        assert near.any() and held[near].max() > 0.5, name
 
 
 def test_bg_experiment_maps_option_is_checked():
@@ -646,6 +671,10 @@ def test_bg_experiment_maps_option_is_checked():
         run_bg_experiment("bg-tmaze", None, 2, 1, 0, None, maps=3, progress=False)
     with pytest.raises(ScenarioError, match="--maps"):
         run_bg_experiment("bg-survival", None, 2, 1, 0, None, maps=1, progress=False)
+    with pytest.raises(ScenarioError, match="--mapping"):
+        run_bg_experiment("bg-survival", None, 2, 1, 0, None, mapping="explore", progress=False)
+    with pytest.raises(ScenarioError, match="--mapping: one of hungry, explore"):
+        run_bg_experiment("bg-fear", None, 2, 1, 0, None, mapping="sated", progress=False)
 
 
 def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():

@@ -18,8 +18,9 @@ the experiments of Girard et al. (2005) with the bg animat.
   which branch the animat enters first.
 
 Experiments 2 and 3 give the animat "a previously built map": a mapping run
-(the animat lives `MAPPING_SECONDS` there, hungry, so it meets the
-resources), saved, and loaded by a test.  By default test k of every
+(the animat lives up to `MAPPING_SECONDS` there, hungry, so it meets the
+resources; for bg-fear exploring, not planning: `MAPPING`), saved, and
+loaded by a test.  By default test k of every
 condition loads map k, made with seed + k: the conditions are compared on
 the same maps, and a table is not hostage to one mapping run (`maps=1` is
 one map for every test).  docs/bg.md says every choice.
@@ -45,6 +46,14 @@ REPS = {"bg-survival": 10, "bg-choice": 15, "bg-forget": 15, "bg-fear": 20, "bg-
 MAPPING_SECONDS = 7200.0  # the mapping phase of experiments 2 and 3: at most two hours of the animat's life ...
 MAPPING_LEVELS = (0.5, 0.5)  # E, Ep during mapping: needs enough to seek both resources and reload there ...
 MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping animat must live to map
+# How a mapping animat maps (docs/bg.md, "The mapping phase"): "hungry" lives as in experiment 1, planning back
+# to the resources it found; "explore" does not plan (W_plan 0: the "first phase of random exploration and map
+# building" of experiment 1) and maps at least half an hour, so that its map covers the floor.  Experiment 3.1
+# needs maps that know both Ep ("the animat systematically chooses the closest resource"): on bg-exp3 the hungry
+# animat planned back to the first Ep it found and knew both on 1 map of 20, the exploring one on 18.
+MAPPING_MODES = {"hungry": ({}, 0.0), "explore": ({"w_plan": 0.0}, 1800.0)}  # [bg] changes, least seconds
+MAPPING = {"bg-choice": "hungry", "bg-forget": "hungry", "bg-fear": "explore", "bg-tmaze": "hungry"}
+_MAPPING_TEXT = {"hungry": "", "explore": ", W_plan 0: exploring, not planning, for at least 30 min"}
 TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep by then counts as "none"
 W_PLANS = (0.65, 0.55, 0.45)
 FEAR_EP = (0.1, 0.5)
@@ -105,9 +114,11 @@ def run_survival(job: tuple) -> dict:
             "wall_seconds": summary["wall_seconds"]}  # fmt: skip
 
 
-def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] | None = None) -> dict:
-    """The mapping phase: the animat lives in `name`, hungry, until it has been at every resource there
-    and its map holds every kind (a node that learned it), or MAPPING_SECONDS pass; its map as plain data."""
+def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] | None = None,
+              mode: str = "hungry") -> dict:  # fmt: skip
+    """The mapping phase: the animat lives in `name` (as MAPPING_MODES[mode] says) until it has been at every
+    resource there and its map holds every kind (a node that learned it), or MAPPING_SECONDS pass; its map as
+    plain data."""
     from swarm.arena.engine import ArenaEngine
 
     s = load_scenario(name)
@@ -119,7 +130,8 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
         "danger_rate": 0.0,
     }  # mapping is learning the floor, not surviving it
     # mapping explores as in exp. 1 (exp. 3's saliences barely explore), and maps (a test may not)
-    bg = _merged(bg or {}, {"saliences": "survival", "learn_map": True})
+    changes, least = MAPPING_MODES[mode]
+    bg = _merged(bg or {}, {"saliences": "survival", "learn_map": True, **changes})
     s = _with(s, bg=bg, metabolism={**levels, "stop_at": "death"}, seed=seed, absent=absent, max_ticks=ticks)
     kinds = {"ingesting": "Ep", "digesting": "E", "dangerous": "DA"}
     present = [o for o in s.obstacles if o.zone is not None and o.name not in absent]
@@ -131,6 +143,7 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
         visited |= {o.name for o in present if math.hypot(xy[0] - o.centre[0], xy[1] - o.centre[1]) <= o.reach}
         if (
             engine.world.tick % 40 == 0
+            and engine.world.tick * s.control_period >= least
             and len(visited) == len(present)
             and all(len(nav.assoc[kinds[o.zone]]) and nav.assoc[kinds[o.zone]].max() > 0.5 for o in present)
         ):
@@ -202,12 +215,12 @@ def _tally(rows: list[dict], options: tuple[str, str], field: str = "chose") -> 
 
 def _choice_summary(rows: list[dict], paper: dict, header: str, options: tuple[str, str], field: str = "chose",
                     fisher: bool = False) -> tuple[list[dict], str]:  # fmt: skip
-    summary, lines, table = [], [], []
+    summary, lines, counts = [], [], []
     for cond, (p1, p2) in paper.items():
         sel = [r for r in rows if r["condition"] == cond]
         n1, n2, other = _tally(sel, options, field)
         died = sum(bool(r.get("died")) for r in sel if r[field] not in options)  # the dangerous area's drain
-        table.append([n1, n2])
+        counts.append((n1, n2, other))
         summary.append({"condition": cond, "runs": len(sel), options[0]: n1, options[1]: n2, "neither": other,
                         "neither_died": died, f"paper_{options[0]}": p1, f"paper_{options[1]}": p2})  # fmt: skip
         lines.append(f"| {cond} | {n1} | {n2} | {other}{f' ({died} died)' if died else ''} | {p1} | {p2} |")
@@ -218,9 +231,11 @@ def _choice_summary(rows: list[dict], paper: dict, header: str, options: tuple[s
     if fisher:
         from scipy.stats import fisher_exact
 
-        p = fisher_exact(table).pvalue
-        md += f"\nFisher's exact test: p = {p:.3g} (the paper: p < 0.01).\n"
-        summary.append({"condition": "Fisher", "p": p})
+        p = fisher_exact([[n1, n2] for n1, n2, _ in counts]).pvalue
+        p_not = fisher_exact([[n1, n2 + other] for n1, n2, other in counts]).pvalue
+        md += (f"\nFisher's exact test: p = {p:.3g} on ({options[0]}, {options[1]}), the paper's (p < 0.01); "
+               f"p = {p_not:.3g} on ({options[0]}, not {options[0]}).\n")  # fmt: skip
+        summary.append({"condition": "Fisher", "p": p, f"p_{options[0]}_or_not": p_not})
     return summary, md
 
 
@@ -317,9 +332,11 @@ def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) ->
 
 def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
                       out: Path | None, ratios: tuple[float, ...] | None = None, maps: int | None = None,
-                      progress: bool = True, bg: dict[str, Any] | None = None) -> dict:  # fmt: skip
-    """Run one experiment; `maps` mapping runs per scenario for experiments 2 and 3 (default: one per test);
-    `bg` changes the [bg] table of every run (mapping runs included)."""
+                      progress: bool = True, bg: dict[str, Any] | None = None,
+                      mapping: str | None = None) -> dict:  # fmt: skip
+    """Run one experiment; `maps` mapping runs per scenario for experiments 2 and 3 (default: one per test),
+    made as `mapping` says (MAPPING_MODES; default MAPPING[experiment]); `bg` changes the [bg] table of every
+    run (mapping runs included)."""
     from agents.controllers.bg.controller import check_table
 
     changes = dict(bg or {})
@@ -339,6 +356,11 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
         raise ScenarioError("command line", "--maps", "bg-survival has no mapping phase (condition A maps as it lives)")
     if not 1 <= maps <= reps:
         raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
+    if experiment == "bg-survival" and mapping is not None:
+        raise ScenarioError("command line", "--mapping", "bg-survival has no mapping phase (A maps as it lives)")
+    mapping = MAPPING.get(experiment, "hungry") if mapping is None else mapping
+    if mapping not in MAPPING_MODES:
+        raise ScenarioError("command line", "--mapping", f"one of {', '.join(MAPPING_MODES)}, not {mapping!r}")
     out = Path(out) if out is not None else Path("results") / experiment
     out.mkdir(parents=True, exist_ok=True)
     if experiment == "bg-survival":
@@ -351,12 +373,12 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
             f"condition, at most 4 h; seed {seed}.\n\n"
         )
     else:
-        made = _maps(experiment, maps, seed, ratios, jobs, progress, changes)
+        made = _maps(experiment, maps, seed, ratios, jobs, progress, changes, mapping)
         (out / "maps.json").write_text(json.dumps(made))
         work = _tests(experiment, reps, seed, made, changes)
         rows = pool_map(work, run_test, jobs, experiment, progress)
         rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
-        summary, md, title = _test_summary(experiment, rows, reps, seed, made)
+        summary, md, title = _test_summary(experiment, rows, reps, seed, made, mapping)
     write_runs(out, "runs.csv", list(rows[0]), rows, summary)
     _plot(experiment, rows, summary, out / "plot.png")
     if changes:
@@ -376,15 +398,15 @@ def _mapped(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
 
 
 def _build_map_job(job: tuple) -> dict:
-    name, k, seed, absent, changes = job
-    return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes)}
+    name, k, seed, absent, changes, mode = job
+    return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes, mode)}
 
 
-def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None,
-          progress: bool, changes: dict[str, Any] | None = None) -> dict[str, list[dict]]:  # fmt: skip
+def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None, progress: bool,
+          changes: dict[str, Any] | None = None, mode: str = "hungry") -> dict[str, list[dict]]:  # fmt: skip
     """`count` maps per scenario, map k from a mapping run with seed + k (in parallel)."""
     mapped = _mapped(experiment, ratios)
-    work = [(name, k, seed + k, absent, changes or {}) for name, absent in mapped.items() for k in range(count)]
+    work = [(name, k, seed + k, absent, changes or {}, mode) for name, absent in mapped.items() for k in range(count)]
     made = {(m["scenario"], m["index"]): m["data"]
             for m in pool_map(work, _build_map_job, jobs, f"{experiment} mapping", progress)}  # fmt: skip
     return {name: [made[name, k] for k in range(count)] for name in mapped}
@@ -430,8 +452,8 @@ def _maps_line(made: list[dict]) -> str:
             + "; nodes holding " + ", ".join(f"{r} {h}" for r, h in holding.items()))  # fmt: skip
 
 
-def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int,
-                  maps: dict[str, list[dict]]) -> tuple[list[dict], str, str]:  # fmt: skip
+def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int, maps: dict[str, list[dict]],
+                  mapping: str = "hungry") -> tuple[list[dict], str, str]:  # fmt: skip
     held = "; ".join(f"{name}: {_maps_line(made)}" for name, made in maps.items())
     n = len(next(iter(maps.values())))
     head = (
@@ -444,8 +466,8 @@ def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int,
             else f"test k of every condition on the map of mapping run k mod {n} (seed + k mod {n})"
         )
         + f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full "
-        f"E lasting 4 h, the saliences of exp. 1) until it has been at every resource and its map holds every "
-        f"kind, or {MAPPING_SECONDS / 60:.0f} min.\n\n"
+        f"E lasting 4 h, the saliences of exp. 1{_MAPPING_TEXT[mapping]}) until it has been at every resource and "
+        f'its map holds every kind, or {MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}").\n\n'
     )
     if experiment == "bg-choice":
         summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
