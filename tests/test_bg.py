@@ -605,6 +605,19 @@ def test_bg_experiment_tests_share_maps_across_conditions():
     assert all(j[7] == ("DA",) and j[5]["fear"] == 0.0 for j in control)
 
 
+def test_a_test_goes_on_mapping_a_hungry_map_and_takes_an_explored_one_as_it_is():
+    """A hungry mapping run leaves the way between resources, which a test extends; an exploring one covers
+    the floor, and a test only localizes on it (a node it made would be a leaf whose routes lead back).  The
+    command line's --bg learn_map overrides either."""
+    from swarm.arena.bg_experiments import _tests
+
+    maps = {"bg-exp3": [{}]}
+    assert all(j[5]["learn_map"] for j in _tests("bg-fear", 2, 0, maps))
+    assert not any(j[5]["learn_map"] for j in _tests("bg-fear", 2, 0, maps, None, "explore"))
+    assert all(j[5]["learn_map"] for j in _tests("bg-fear", 2, 0, maps, {"learn_map": True}, "explore"))
+    assert all(j[5]["fear"] == 0.0 for j in _tests("bg-fear", 2, 0, maps, None, "explore") if "no DA" in str(j[1]))
+
+
 def test_bg_choice_runs_the_papers_control_of_ten_tests_without_ep2():
     from swarm.arena.bg_experiments import _tests
 
@@ -691,7 +704,8 @@ def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     animat = engine.controllers[0]
     assert animat.p.usable_threshold == 0.5 and animat.nav.p.anchor == 0.2 and not animat.p.planning
     jobs = _tests("bg-choice", 2, 0, {"bg-exp2": [{}]}, table)  # a test's own [bg] fields kept beside them
-    assert all(job[5] == {**table, "w_plan": 0.65 if job[1] == "no Ep2" else job[1], "w_taxon": 0.55} for job in jobs)
+    assert all(job[5] == {"learn_map": True, **table, "w_plan": 0.65 if job[1] == "no Ep2" else job[1],
+                          "w_taxon": 0.55} for job in jobs)  # fmt: skip
     with pytest.raises(ScenarioError, match=r"--bg.*bogus"):
         run_bg_experiment("bg-survival", None, 2, 1, 0, None, progress=False, bg={"bogus": 1})
     with pytest.raises(ScenarioError, match=r"--bg: \[bg.navigation\] anchor: expected a number, got true"):

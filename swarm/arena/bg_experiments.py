@@ -46,14 +46,20 @@ REPS = {"bg-survival": 10, "bg-choice": 15, "bg-forget": 15, "bg-fear": 20, "bg-
 MAPPING_SECONDS = 7200.0  # the mapping phase of experiments 2 and 3: at most two hours of the animat's life ...
 MAPPING_LEVELS = (0.5, 0.5)  # E, Ep during mapping: needs enough to seek both resources and reload there ...
 MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping animat must live to map
-# How a mapping animat maps (docs/bg.md, "The mapping phase"): "hungry" lives as in experiment 1, planning back
-# to the resources it found; "explore" does not plan (W_plan 0: the "first phase of random exploration and map
-# building" of experiment 1) and maps at least half an hour, so that its map covers the floor.  Experiment 3.1
-# needs maps that know both Ep ("the animat systematically chooses the closest resource"): on bg-exp3 the hungry
-# animat planned back to the first Ep it found and knew both on 1 map of 20, the exploring one on 18.
-MAPPING_MODES = {"hungry": ({}, 0.0), "explore": ({"w_plan": 0.0}, 1800.0)}  # [bg] changes, least seconds
+# How a mapping animat maps, and how a test uses its map (docs/bg.md, Experiments): "hungry" lives as in
+# experiment 1, planning back to the resources it found, and a test goes on mapping from it (the map is the way
+# between resources, not the floor); "explore" does not plan (W_plan 0: the "first phase of random exploration and
+# map building" of experiment 1) and maps at least half an hour, so that its map covers the floor, and a test
+# takes that map as it is (it localizes on it and learns where resources are, but makes no node: a node made in
+# a test is a leaf whose routes lead back the way it came).  Experiment 3.1 needs maps that know both Ep ("the
+# animat systematically chooses the closest resource"): on bg-exp3 the hungry animat planned back to the first Ep
+# it found and knew both on 1 map of 20, the exploring one on 18.
+MAPPING_MODES = {"hungry": ({}, 0.0, True), "explore": ({"w_plan": 0.0}, 1800.0, False)}  # [bg] changes, least
+# seconds, whether a test goes on mapping ([bg] learn_map; --bg learn_map=... overrides it)
 MAPPING = {"bg-choice": "hungry", "bg-forget": "hungry", "bg-fear": "explore", "bg-tmaze": "hungry"}
-_MAPPING_TEXT = {"hungry": "", "explore": ", W_plan 0: exploring, not planning, for at least 30 min"}
+_MAPPING_TEXT = {"hungry": ").  A test goes on mapping from the map it loads",
+                 "explore": ", W_plan 0: exploring, not planning, for at least 30 min).  A test takes the map as it "
+                            "is: it localizes on it and learns where resources are, but makes no node"}  # fmt: skip
 TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep by then counts as "none"
 W_PLANS = (0.65, 0.55, 0.45)
 FEAR_EP = (0.1, 0.5)
@@ -130,7 +136,7 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
         "danger_rate": 0.0,
     }  # mapping is learning the floor, not surviving it
     # mapping explores as in exp. 1 (exp. 3's saliences barely explore), and maps (a test may not)
-    changes, least = MAPPING_MODES[mode]
+    changes, least, _ = MAPPING_MODES[mode]
     bg = _merged(bg or {}, {"saliences": "survival", "learn_map": True, **changes})
     s = _with(s, bg=bg, metabolism={**levels, "stop_at": "death"}, seed=seed, absent=absent, max_ticks=ticks)
     kinds = {"ingesting": "Ep", "digesting": "E", "dangerous": "DA"}
@@ -375,7 +381,7 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
     else:
         made = _maps(experiment, maps, seed, ratios, jobs, progress, changes, mapping)
         (out / "maps.json").write_text(json.dumps(made))
-        work = _tests(experiment, reps, seed, made, changes)
+        work = _tests(experiment, reps, seed, made, changes, mapping)
         rows = pool_map(work, run_test, jobs, experiment, progress)
         rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
         summary, md, title = _test_summary(experiment, rows, reps, seed, made, mapping)
@@ -413,12 +419,14 @@ def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None, prog
 
 
 def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
-           changes: dict[str, Any] | None = None) -> list[tuple]:  # fmt: skip
-    """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions)."""
+           changes: dict[str, Any] | None = None, mapping: str = "hungry") -> list[tuple]:  # fmt: skip
+    """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions).  A test's
+    [bg]: whether it goes on mapping (MAPPING_MODES), under the command line's changes, under its condition's."""
+    base = _merged({"learn_map": MAPPING_MODES[mapping][2]}, changes or {})
 
     def job(label, k: int, name: str, bg: dict, metabolism: dict, absent: tuple[str, ...]) -> tuple:
         m = k % len(maps[name])
-        return (experiment, label, k, seed + k, name, _merged(changes or {}, bg), metabolism, absent, m, maps[name][m])
+        return (experiment, label, k, seed + k, name, _merged(base, bg), metabolism, absent, m, maps[name][m])
 
     if experiment == "bg-choice":
         return [job(w, k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)] + [
@@ -466,8 +474,8 @@ def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int, maps:
             else f"test k of every condition on the map of mapping run k mod {n} (seed + k mod {n})"
         )
         + f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full "
-        f"E lasting 4 h, the saliences of exp. 1{_MAPPING_TEXT[mapping]}) until it has been at every resource and "
-        f'its map holds every kind, or {MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}").\n\n'
+        f"E lasting 4 h, the saliences of exp. 1) until it has been at every resource and its map holds every kind, "
+        f'or {MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}"{_MAPPING_TEXT[mapping]}.\n\n'
     )
     if experiment == "bg-choice":
         summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
