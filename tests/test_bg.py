@@ -641,6 +641,17 @@ def test_a_control_table_counts_each_choice_and_the_time_to_reload():
     assert direct_seconds("bg-exp2") > direct_seconds("bg-exp2", ("Ep1",)) > 5.0
 
 
+def test_the_fear_table_says_what_fear_takes_away_from_ep1_at_each_level():
+    from swarm.arena.bg_experiments import _fear_effect
+
+    rows = [{"condition": 0.1, "chose": c} for c in ("Ep1", "Ep1", "Ep2")]
+    rows += [{"condition": 0.5, "chose": c} for c in ("Ep2", "none", "Ep1")]
+    rows += [{"condition": "0.1, no DA", "chose": c} for c in ("Ep1", "Ep1", "Ep1")]
+    rows += [{"condition": "0.5, no DA", "chose": c} for c in ("Ep1", "Ep1", "none")]
+    md = _fear_effect(rows)
+    assert "Ep 0.1: 2 / 3; Ep 0.5: 1 / 2." in md and "2 of 20 at 0.5" in md
+
+
 def test_a_choice_table_says_how_many_of_neither_died():
     from swarm.arena.bg_experiments import PAPER_FEAR, _choice_summary
 
