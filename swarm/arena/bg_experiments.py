@@ -46,6 +46,8 @@ REPS = {"bg-survival": 10, "bg-choice": 15, "bg-forget": 15, "bg-fear": 20, "bg-
 MAPPING_SECONDS = 7200.0  # the mapping phase of experiments 2 and 3: at most two hours of the animat's life ...
 MAPPING_LEVELS = (0.5, 0.5)  # E, Ep during mapping: needs enough to seek both resources and reload there ...
 MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping animat must live to map
+
+
 # How a mapping animat maps, and how a test uses its map (docs/bg.md, Experiments): "hungry" lives as in
 # experiment 1, planning back to the resources it found, and a test goes on mapping from it (the map is the way
 # between resources, not the floor); "explore" does not plan (W_plan 0: the "first phase of random exploration and
@@ -54,12 +56,21 @@ MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping 
 # a test is a leaf whose routes lead back the way it came).  Experiment 3.1 needs maps that know both Ep ("the
 # animat systematically chooses the closest resource"): on bg-exp3 the hungry animat planned back to the first Ep
 # it found and knew both on 1 map of 20, the exploring one on 18.
-MAPPING_MODES = {"hungry": ({}, 0.0, True), "explore": ({"w_plan": 0.0}, 1800.0, False)}  # [bg] changes, least
-# seconds, whether a test goes on mapping ([bg] learn_map; --bg learn_map=... overrides it)
+@dataclasses.dataclass(frozen=True)
+class MappingMode:
+    changes: dict[str, Any]  # [bg] fields of the mapping run
+    least_seconds: float  # the mapping run goes on at least this long
+    tests_map: bool  # a test goes on mapping ([bg] learn_map; --bg learn_map=... overrides it)
+    text: str  # what the table's head says of it
+
+
+MAPPING_MODES = {
+    "hungry": MappingMode({}, 0.0, True, ").  A test goes on mapping from the map it loads"),
+    "explore": MappingMode({"w_plan": 0.0}, 1800.0, False,
+                           ", W_plan 0: exploring, not planning, for at least 30 min).  A test takes the map as it "
+                           "is: it localizes on it and learns where resources are, but makes no node"),
+}  # fmt: skip
 MAPPING = {"bg-choice": "hungry", "bg-forget": "hungry", "bg-fear": "explore", "bg-tmaze": "hungry"}
-_MAPPING_TEXT = {"hungry": ").  A test goes on mapping from the map it loads",
-                 "explore": ", W_plan 0: exploring, not planning, for at least 30 min).  A test takes the map as it "
-                            "is: it localizes on it and learns where resources are, but makes no node"}  # fmt: skip
 TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep by then counts as "none"
 W_PLANS = (0.65, 0.55, 0.45)
 FEAR_EP = (0.1, 0.5)
@@ -136,8 +147,8 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
         "danger_rate": 0.0,
     }  # mapping is learning the floor, not surviving it
     # mapping explores as in exp. 1 (exp. 3's saliences barely explore), and maps (a test may not)
-    changes, least, _ = MAPPING_MODES[mode]
-    bg = _merged(bg or {}, {"saliences": "survival", "learn_map": True, **changes})
+    how = MAPPING_MODES[mode]
+    bg = _merged(bg or {}, {"saliences": "survival", "learn_map": True, **how.changes})
     s = _with(s, bg=bg, metabolism={**levels, "stop_at": "death"}, seed=seed, absent=absent, max_ticks=ticks)
     kinds = {"ingesting": "Ep", "digesting": "E", "dangerous": "DA"}
     present = [o for o in s.obstacles if o.zone is not None and o.name not in absent]
@@ -149,7 +160,7 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
         visited |= {o.name for o in present if math.hypot(xy[0] - o.centre[0], xy[1] - o.centre[1]) <= o.reach}
         if (
             engine.world.tick % 40 == 0
-            and engine.world.tick * s.control_period >= least
+            and engine.world.tick * s.control_period >= how.least_seconds
             and len(visited) == len(present)
             and all(len(nav.assoc[kinds[o.zone]]) and nav.assoc[kinds[o.zone]].max() > 0.5 for o in present)
         ):
@@ -268,11 +279,11 @@ def _control_summary(rows: list[dict], conditions: list[str], header: str, paper
 def _fear_effect(rows: list[dict]) -> str:
     """Ep1 with the dangerous area against without it, per level of Ep, on the same maps and seeds: what fear
     takes away (the paper: much at Ep 0.5, where its animat chose Ep1 in 2 of 20; little at 0.1, 13 of 20)."""
-    parts = []
-    for ep, control in FEAR_CONTROL.items():
-        with_da = sum(r["chose"] == "Ep1" for r in rows if r["condition"] == ep)
-        without = sum(r["chose"] == "Ep1" for r in rows if r["condition"] == control)
-        parts.append(f"Ep {ep}: {with_da} / {without}")
+
+    def ep1(condition) -> int:
+        return _tally([r for r in rows if r["condition"] == condition], ("Ep1", "Ep2"))[0]
+
+    parts = [f"Ep {ep}: {ep1(ep)} / {ep1(control)}" for ep, control in FEAR_CONTROL.items()]
     return ("\nWhat fear takes away: tests at Ep1 with the dangerous area / without it (the same maps and seeds): "
             + "; ".join(parts) + ".  The paper's animat chose Ep1 in 13 of 20 at Ep 0.1 and 2 of 20 at 0.5, and "
             "\"systematically\" without the dangerous area.\n")  # fmt: skip
@@ -435,7 +446,7 @@ def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
            changes: dict[str, Any] | None = None, mapping: str = "hungry") -> list[tuple]:  # fmt: skip
     """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions).  A test's
     [bg]: whether it goes on mapping (MAPPING_MODES), under the command line's changes, under its condition's."""
-    base = _merged({"learn_map": MAPPING_MODES[mapping][2]}, changes or {})
+    base = _merged({"learn_map": MAPPING_MODES[mapping].tests_map}, changes or {})
 
     def job(label, k: int, name: str, bg: dict, metabolism: dict, absent: tuple[str, ...]) -> tuple:
         m = k % len(maps[name])
@@ -488,7 +499,7 @@ def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int, maps:
         )
         + f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full "
         f"E lasting 4 h, the saliences of exp. 1) until it has been at every resource and its map holds every kind, "
-        f'or {MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}"{_MAPPING_TEXT[mapping]}.\n\n'
+        f'or {MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}"{MAPPING_MODES[mapping].text}.\n\n'
     )
     if experiment == "bg-choice":
         summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
