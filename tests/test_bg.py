@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from agents.controllers.bg import BgController
-from agents.controllers.bg.places import ANGLES, Navigator, NavParams, _explore_channel
+from agents.controllers.bg.places import ANGLES, DIRECTIONS, Navigator, NavParams, _explore_channel
 from agents.controllers.bg.saliences import Drives, plan_vector, saliences
 from agents.controllers.bg.senses import Reflex, proximity, resource_pixels, sense, to_allocentric
 from agents.controllers.navigation.dijkstra import shortest_routes
@@ -373,6 +373,26 @@ def test_with_pursuit_the_plan_points_at_the_next_place_on_the_way_not_across_a_
     assert towards.max() > 0.5 and abs(ANGLES[int(np.argmax(towards))] - heading) <= math.radians(10)
 
 
+@pytest.mark.parametrize("ways", ["best", "places"])
+def test_with_places_each_place_holding_a_resource_pulls_its_own_way(ways):
+    """A corridor eastwards with food at both ends, the animat 0.6 m from the west end and 1.5 m from the east
+    one: the best route alone points west; with `ways = "places"` the east end pulls too, each as strongly
+    as exp(-route / reach) (experiment 3.1: the far Ep2 must compete with the near Ep1, docs/bg.md)."""
+    nav = Navigator(NavParams(ways=ways), seed=0, agent=0, resources=("DA", "Ep", "E"))
+    _corridor(nav, [(0.0, 8)])  # places at x = 0, 0.3, ..., 2.1
+    for end in (7, 0):
+        nav.map.belief = np.eye(nav.map.size)[end]
+        for _ in range(40):
+            nav.learn({"Ep": True}, {"Ep": True}, 0.25)
+    assert nav._places(np.array([0, 7]), nav.assoc["Ep"])[0].tolist() == [0]  # 2.1 m apart: two places
+    nav.map.current, nav.at = 2, nav.map.nodes[2].position.copy()
+    towards = nav.plan("Ep")
+    west, east = towards[DIRECTIONS // 2], towards[0]
+    assert west == pytest.approx(math.exp(-0.6 / nav.p.reach), rel=1e-3)
+    assert east == (pytest.approx(math.exp(-1.5 / nav.p.reach), rel=1e-3) if ways == "places" else
+                    pytest.approx(west * math.exp(-8.0), rel=1e-3))  # the west bump's far tail  # fmt: skip
+
+
 @pytest.mark.parametrize("radius, reached", [(1.0, [False, False, True, True, True, True]), (None, [True] * 6)])
 def test_a_loop_closes_only_onto_a_place_within_the_closure_radius(radius, reached):
     """bg-exp1's two rooms mirror each other across the middle wall: with loops closing onto nodes up to 2 m
@@ -721,6 +741,8 @@ def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
         run_bg_experiment("bg-survival", None, 2, 1, 0, None, progress=False, bg={"bogus": 1})
     with pytest.raises(ScenarioError, match=r"--bg: \[bg.navigation\] anchor: expected a number, got true"):
         run_bg_experiment("bg-tmaze", None, 2, 1, 0, None, progress=False, bg={"navigation": {"anchor": True}})
+    with pytest.raises(ScenarioError, match=r"bg.navigation.ways: expected one of best, places, got 'every'"):
+        run_bg_experiment("bg-fear", None, 2, 1, 0, None, progress=False, bg={"navigation": {"ways": "every"}})
 
 
 def test_swarm_run_prints_the_animats_metabolism_and_map():

@@ -21,7 +21,7 @@ import numpy as np
 
 from agents.controllers.bg.colony import ColonyMap
 from agents.controllers.bg.gpr import BasalGanglia, select_dorsal, select_ventral
-from agents.controllers.bg.places import DIRECTIONS, Navigator, NavParams
+from agents.controllers.bg.places import DIRECTIONS, WAYS, Navigator, NavParams
 from agents.controllers.bg.saliences import SALIENCES, Drives, saliences
 from agents.controllers.bg.senses import RESOURCES, Reflex, sense
 from agents.controllers.tables import params_from_table
@@ -67,7 +67,10 @@ class BgParams:
 
 
 def nav_params(table: dict[str, Any] | None) -> NavParams:
-    return params_from_table(NavParams, table, "bg.navigation", ints=("known_age",))
+    p = params_from_table(NavParams, table, "bg.navigation", ints=("known_age",), texts=("ways",))
+    if p.ways not in WAYS:
+        raise ValueError(f"bg.navigation.ways: expected one of {', '.join(WAYS)}, got {p.ways!r}")
+    return p
 
 
 def check_table(table: dict[str, Any]) -> None:

@@ -52,6 +52,7 @@ from swarm.rng import fill_uniform
 DIRECTIONS = 36
 ANGLES = np.arange(DIRECTIONS) * (2 * math.pi / DIRECTIONS)
 S_EXPLORE = 101  # noise stream of the exploration preference
+WAYS = ("best", "places")  # NavParams.ways
 
 
 @dataclass(frozen=True)
@@ -81,6 +82,8 @@ class NavParams:
     novelty_radius: float = 2.0  # m: nodes nearer than this, in a direction, make it known
     wander_period: float = 20.0  # s between two draws of the exploration preference
     wander_weight: float = 0.5
+    ways: str = "best"  # P(res) is one bump along the best route, or with "places" one per place holding res:
+    place_radius: float = 2.0  # m: nodes holding res this near the one holding it most are one place (docs/bg.md)
 
 
 class PlaceSignatures:
@@ -313,8 +316,10 @@ class Navigator:
             self._edge_key = key
         return self._edge_cache
 
-    def towards(self, strength: np.ndarray) -> np.ndarray:
-        """36-vector pointing along the route to the nodes of largest strength * exp(-route / reach)."""
+    def towards(self, strength: np.ndarray, each_place: bool = False) -> np.ndarray:
+        """36-vector pointing along the route to the nodes of largest strength * exp(-route / reach); with
+        `each_place`, the largest of such vectors to each place (`_places`): every place holding a resource
+        pulls its own way, as eq. 1's "proximity of that resource in 36 directions" reads."""
         k = len(self.map.nodes)
         here = self.map.current
         if k == 0 or here < 0 or len(strength) == 0:
@@ -322,23 +327,51 @@ class Navigator:
         classes = np.empty(len(strength))  # np.round(strength, 2)'s classes key the cache
         if not _classes(np.ascontiguousarray(strength, np.float64), classes) > 1e-3:
             return np.zeros(DIRECTIONS)
-        key = (self.observations, self.news, here, classes.tobytes())
+        key = (self.observations, self.news, here, classes.tobytes(), each_place)
         if key in self._towards:
             return self._towards[key]
-        rows, cols, lengths = self._edges()
         sources = np.flatnonzero(strength > 1e-3)  # a virtual source k reaches each by what it holds
-        dist, pred = shortest_routes(k + 1, k, np.concatenate([rows, np.full(len(sources), k)]),
-                                     np.concatenate([cols, sources]),
-                                     np.concatenate([lengths, -self.p.reach * np.log(strength[sources])]))  # fmt: skip
-        out = np.zeros(DIRECTIONS)
-        if np.isfinite(dist[here]):
-            offset = self._next_place(pred, k) if self.p.pursuit > 0.0 else self._first_metre(pred, k)
-            if offset is not None:  # else here is where it is: the last stretch is the taxon's
-                out = bump(math.atan2(offset[1], offset[0]), math.exp(-dist[here] / self.p.reach), self.p.width)
+        if each_place:
+            out = np.zeros(DIRECTIONS)
+            for place in self._places(sources, strength):
+                np.maximum(out, self._route_bump(place, strength), out=out)
+        else:
+            out = self._route_bump(sources, strength)
         if len(self._towards) > 64:
             self._towards.clear()
         self._towards[key] = out
         return out
+
+    def _route_bump(self, sources: np.ndarray, strength: np.ndarray) -> np.ndarray:
+        """A bump along the best route from here to any of `sources`, of height strength * exp(-route / reach)
+        (zeros when no route leads there, or here is where it leads: the last stretch is the taxon's)."""
+        k, here = len(self.map.nodes), self.map.current
+        rows, cols, lengths = self._edges()
+        dist, pred = shortest_routes(k + 1, k, np.concatenate([rows, np.full(len(sources), k)]),
+                                     np.concatenate([cols, sources]),
+                                     np.concatenate([lengths, -self.p.reach * np.log(strength[sources])]))  # fmt: skip
+        if not np.isfinite(dist[here]):
+            return np.zeros(DIRECTIONS)
+        offset = self._next_place(pred, k) if self.p.pursuit > 0.0 else self._first_metre(pred, k)
+        if offset is None:
+            return np.zeros(DIRECTIONS)
+        return bump(math.atan2(offset[1], offset[0]), math.exp(-dist[here] / self.p.reach), self.p.width)
+
+    def _places(self, sources: np.ndarray, strength: np.ndarray) -> list[np.ndarray]:
+        """`sources` grouped into places: strongest first, each joins the first place whose first node lies
+        within `place_radius` (the nodes round one resource are one place, not one bump each)."""
+        firsts: list[np.ndarray] = []
+        places: list[list[int]] = []
+        for n in sources[np.argsort(-strength[sources], kind="stable")]:
+            at = self.map.nodes[n].position
+            for place, first in zip(places, firsts, strict=True):
+                if math.hypot(at[0] - first[0], at[1] - first[1]) < self.p.place_radius:
+                    place.append(int(n))
+                    break
+            else:
+                firsts.append(at)
+                places.append([int(n)])
+        return [np.array(place, np.int64) for place in places]
 
     def _first_metre(self, pred: np.ndarray, source: int) -> np.ndarray | None:
         """The route's link displacements summed over its first `lookahead` metres (None: no way to go).
@@ -369,7 +402,7 @@ class Navigator:
         return d if a < b else -d
 
     def plan(self, resource: str) -> np.ndarray:
-        return self.towards(self.assoc[resource])
+        return self.towards(self.assoc[resource], self.p.ways == "places")
 
     def back_to_known(self) -> np.ndarray:
         if self._known_key != (self.observations, len(self.born)):  # it changes only with these
