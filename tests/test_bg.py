@@ -393,6 +393,22 @@ def test_with_places_each_place_holding_a_resource_pulls_its_own_way(ways):
                     pytest.approx(west * math.exp(-8.0), rel=1e-3))  # the west bump's far tail  # fmt: skip
 
 
+@pytest.mark.parametrize("known", [1.0, 0.0])
+def test_expl_is_as_high_as_its_direction_is_unmapped_when_known_explore_is_0(known):
+    """Expl points "to explore unmapped areas": with known_explore 0 its bump is as high as the novelty of the
+    direction it picks (none where the map knows the way); with 1 (the default) it is 1 wherever it points."""
+    nav = Navigator(NavParams(known_explore=known), seed=0, agent=0, resources=("DA", "Ep", "E"))
+    assert nav.explore(np.full(8, 5.0), 0.0, 0.0, True).max() == pytest.approx(1.0)  # no map: all novel
+    _corridor(nav, [(0.0, 5), (math.pi / 2, 4)])  # an L of places: the way back is mapped, the rest is not
+    heights = []
+    for period in range(40):
+        out = nav.explore(np.full(8, 5.0), 0.0, 20.0 * period, True)
+        best = int(np.argmax(out))
+        heights.append(out[best])
+        assert out[best] == pytest.approx(1.0 if known == 1.0 else nav._novel[best])
+    assert (min(heights) < 0.9) == (known == 0.0)  # some draws point where the map has nodes
+
+
 @pytest.mark.parametrize("radius, reached", [(1.0, [False, False, True, True, True, True]), (None, [True] * 6)])
 def test_a_loop_closes_only_onto_a_place_within_the_closure_radius(radius, reached):
     """bg-exp1's two rooms mirror each other across the middle wall: with loops closing onto nodes up to 2 m
@@ -636,6 +652,11 @@ def test_a_test_goes_on_mapping_a_hungry_map_and_takes_an_explored_one_as_it_is(
     assert not any(j[5]["learn_map"] for j in _tests("bg-fear", 2, 0, maps, None, "explore"))
     assert all(j[5]["learn_map"] for j in _tests("bg-fear", 2, 0, maps, {"learn_map": True}, "explore"))
     assert all(j[5]["fear"] == 0.0 for j in _tests("bg-fear", 2, 0, maps, None, "explore") if "no DA" in str(j[1]))
+    # ... and explores only where the explored map has a hole; --bg navigation.known_explore overrides it
+    assert all(j[5]["navigation"] == {"known_explore": 0.0} for j in _tests("bg-fear", 2, 0, maps, None, "explore"))
+    assert all("navigation" not in j[5] for j in _tests("bg-fear", 2, 0, maps))
+    override = _tests("bg-fear", 2, 0, maps, {"navigation": {"known_explore": 1.0, "reach": 6.0}}, "explore")
+    assert all(j[5]["navigation"] == {"known_explore": 1.0, "reach": 6.0} for j in override)
 
 
 def test_bg_choice_runs_the_papers_control_of_ten_tests_without_ep2():
@@ -743,6 +764,8 @@ def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
         run_bg_experiment("bg-tmaze", None, 2, 1, 0, None, progress=False, bg={"navigation": {"anchor": True}})
     with pytest.raises(ScenarioError, match=r"bg.navigation.ways: expected one of best, places, got 'every'"):
         run_bg_experiment("bg-fear", None, 2, 1, 0, None, progress=False, bg={"navigation": {"ways": "every"}})
+    with pytest.raises(ScenarioError, match=r"bg.navigation.known_explore: expected a number in \[0, 1\], got 2"):
+        run_bg_experiment("bg-fear", None, 2, 1, 0, None, progress=False, bg={"navigation": {"known_explore": 2}})
 
 
 def test_swarm_run_prints_the_animats_metabolism_and_map():

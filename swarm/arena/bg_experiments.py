@@ -53,22 +53,25 @@ MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping 
 # between resources, not the floor); "explore" does not plan (W_plan 0: the "first phase of random exploration and
 # map building" of experiment 1) and maps at least half an hour, so that its map covers the floor, and a test
 # takes that map as it is (it localizes on it and learns where resources are, but makes no node: a node made in
-# a test is a leaf whose routes lead back the way it came).  Experiment 3.1 needs maps that know both Ep ("the
-# animat systematically chooses the closest resource"): on bg-exp3 the hungry animat planned back to the first Ep
-# it found and knew both on 1 map of 20, the exploring one on 18.
+# a test is a leaf whose routes lead back the way it came) and explores only where the map has a hole (Expl "to
+# explore unmapped areas": known_explore 0; on a map that covers the floor a full-height Expl is noise).
+# Experiment 3.1 needs maps that know both Ep ("the animat systematically chooses the closest resource"): on
+# bg-exp3 the hungry animat planned back to the first Ep it found and knew both on 1 map of 20, the exploring one
+# on 18.
 @dataclasses.dataclass(frozen=True)
 class MappingMode:
     changes: dict[str, Any]  # [bg] fields of the mapping run
     least_seconds: float  # the mapping run goes on at least this long
-    tests_map: bool  # a test goes on mapping ([bg] learn_map; --bg learn_map=... overrides it)
+    tests: dict[str, Any]  # [bg] fields of a test: whether it goes on mapping (learn_map), ... (--bg overrides them)
     text: str  # what the table's head says of it
 
 
 MAPPING_MODES = {
-    "hungry": MappingMode({}, 0.0, True, ").  A test goes on mapping from the map it loads"),
-    "explore": MappingMode({"w_plan": 0.0}, 1800.0, False,
+    "hungry": MappingMode({}, 0.0, {"learn_map": True}, ").  A test goes on mapping from the map it loads"),
+    "explore": MappingMode({"w_plan": 0.0}, 1800.0, {"learn_map": False, "navigation": {"known_explore": 0.0}},
                            ", W_plan 0: exploring, not planning, for at least 30 min).  A test takes the map as it "
-                           "is: it localizes on it and learns where resources are, but makes no node"),
+                           "is: it localizes on it and learns where resources are, but makes no node, and explores "
+                           "only where the map has a hole"),
 }  # fmt: skip
 MAPPING = {"bg-choice": "hungry", "bg-forget": "hungry", "bg-fear": "explore", "bg-tmaze": "hungry"}
 TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep by then counts as "none"
@@ -446,7 +449,7 @@ def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
            changes: dict[str, Any] | None = None, mapping: str = "hungry") -> list[tuple]:  # fmt: skip
     """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions).  A test's
     [bg]: whether it goes on mapping (MAPPING_MODES), under the command line's changes, under its condition's."""
-    base = _merged({"learn_map": MAPPING_MODES[mapping].tests_map}, changes or {})
+    base = _merged(MAPPING_MODES[mapping].tests, changes or {})
 
     def job(label, k: int, name: str, bg: dict, metabolism: dict, absent: tuple[str, ...]) -> tuple:
         m = k % len(maps[name])

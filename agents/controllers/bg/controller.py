@@ -70,6 +70,8 @@ def nav_params(table: dict[str, Any] | None) -> NavParams:
     p = params_from_table(NavParams, table, "bg.navigation", ints=("known_age",), texts=("ways",))
     if p.ways not in WAYS:
         raise ValueError(f"bg.navigation.ways: expected one of {', '.join(WAYS)}, got {p.ways!r}")
+    if not 0.0 <= p.known_explore <= 1.0:
+        raise ValueError(f"bg.navigation.known_explore: expected a number in [0, 1], got {p.known_explore!r}")
     return p
 
 

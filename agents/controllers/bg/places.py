@@ -82,6 +82,8 @@ class NavParams:
     novelty_radius: float = 2.0  # m: nodes nearer than this, in a direction, make it known
     wander_period: float = 20.0  # s between two draws of the exploration preference
     wander_weight: float = 0.5
+    known_explore: float = 1.0  # Expl's height where its direction is known (novelty 0), 1 at novelty 1: 1, its
+    # height is 1 everywhere; 0, Expl points only at unmapped areas (bg-exp3; docs/bg.md, Expl)
     ways: str = "best"  # P(res) is one bump along the best route, or with "places" one per place holding res:
     place_radius: float = 2.0  # m: nodes holding res this near the one holding it most are one place (docs/bg.md)
 
@@ -428,7 +430,12 @@ class Navigator:
             self._wander = bump(float(u[0, 0]) * math.pi, self.p.wander_weight, 2.0)
             self._wander_key = period
         best = _explore_channel(to_allocentric(sonar, heading), self.p.open_range, self._novel, self._wander)
-        return np.zeros(DIRECTIONS) if best < 0 else _channel_bump(best, self.p.width)
+        if best < 0:
+            return np.zeros(DIRECTIONS)
+        out = _channel_bump(best, self.p.width)
+        if self.p.known_explore != 1.0:  # Expl "to explore unmapped areas": weaker where the map knows the way
+            out *= self.p.known_explore + (1.0 - self.p.known_explore) * self._novel[best]
+        return out
 
     def _novelty(self, use_map: bool) -> np.ndarray:
         """Per direction, 1 where no node of the map lies within `novelty_radius`, falling with each one that does."""
