@@ -448,7 +448,8 @@ def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None, prog
 def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
            changes: dict[str, Any] | None = None, mapping: str = "hungry") -> list[tuple]:  # fmt: skip
     """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions).  A test's
-    [bg]: whether it goes on mapping (MAPPING_MODES), under the command line's changes, under its condition's."""
+    [bg]: what its mapping mode gives a test (MAPPING_MODES: learn_map, known_explore), under the command line's
+    changes, under its condition's."""
     base = _merged(MAPPING_MODES[mapping].tests, changes or {})
 
     def job(label, k: int, name: str, bg: dict, metabolism: dict, absent: tuple[str, ...]) -> tuple:

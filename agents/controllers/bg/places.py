@@ -82,10 +82,10 @@ class NavParams:
     novelty_radius: float = 2.0  # m: nodes nearer than this, in a direction, make it known
     wander_period: float = 20.0  # s between two draws of the exploration preference
     wander_weight: float = 0.5
-    known_explore: float = 1.0  # Expl's height where its direction is known (novelty 0), 1 at novelty 1: 1, its
-    # height is 1 everywhere; 0, Expl points only at unmapped areas (bg-exp3; docs/bg.md, Expl)
-    ways: str = "best"  # P(res) is one bump along the best route, or with "places" one per place holding res:
-    place_radius: float = 2.0  # m: nodes holding res this near the one holding it most are one place (docs/bg.md)
+    known_explore: float = 1.0  # Expl's height where the map knows its direction (novelty 0; novelty 1 gives 1):
+    # 1, Expl is 1 wherever it points; 0, it points only at unmapped areas (bg-fear's tests; docs/bg.md, Expl)
+    ways: str = "best"  # P(res): one bump along the best route, or ("places") one towards each place holding res,
+    place_radius: float = 2.0  # m: ... the nodes holding res this near the one holding it most being one place
 
 
 class PlaceSignatures:
