@@ -432,10 +432,10 @@ class Navigator:
         best = _explore_channel(to_allocentric(sonar, heading), self.p.open_range, self._novel, self._wander)
         if best < 0:
             return np.zeros(DIRECTIONS)
-        out = _channel_bump(best, self.p.width)
-        if self.p.known_explore != 1.0:  # Expl "to explore unmapped areas": weaker where the map knows the way
-            out *= self.p.known_explore + (1.0 - self.p.known_explore) * self._novel[best]
-        return out
+        # Expl "to explore unmapped areas": lower where the map knows the way (known_explore 1: x 1.0, exactly)
+        return _channel_bump(best, self.p.width) * (
+            self.p.known_explore + (1.0 - self.p.known_explore) * self._novel[best]
+        )
 
     def _novelty(self, use_map: bool) -> np.ndarray:
         """Per direction, 1 where no node of the map lies within `novelty_radius`, falling with each one that does."""
