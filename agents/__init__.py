@@ -1,3 +1,3 @@
-"""Agents: the controllers (pure perception -> action kernels) and, later, the agent process."""
+"""Agents: the controllers (one package each) and the agent process that runs K of them."""
 
-import swarm as _swarm  # noqa: F401  (configures the compiled-kernel cache first)
+from swarm.core import jitcache as _jitcache  # noqa: F401  (configures the compiled-kernel cache first)

@@ -15,13 +15,12 @@ import numpy as np
 
 from agents.controllers.arena import as_action, deliver, make_controller, publications
 from agents.runtime import AgentRuntime
-from swarm import heap, kernels, memory_codec
-from swarm import protocol as proto
-from swarm import protocol_arena as arena_proto
+from swarm.core import heap, kernels, memory_codec, wire
+from world_server.arena.face import wire as arena_proto
 
 
 class ArenaAgentRuntime(AgentRuntime):
-    family = proto.FAMILY_ARENA
+    family = wire.FAMILY_ARENA
 
     def _prepare(self, count: int) -> None:
         kernels.use_ahead_of_time()  # before any controller is imported: no numba in this process when built
@@ -44,7 +43,7 @@ class ArenaAgentRuntime(AgentRuntime):
             heap.give_back()
 
     def _restore(self, msg: arena_proto.ArenaMemory) -> None:
-        """Each blob (a view of the message: swarm/protocol_arena.py) is let go once decoded, before
+        """Each blob (a view of the message: world_server/arena/face/wire.py) is let go once decoded, before
         any rollback state is taken: for a DFT robot each is MBs (issue 12's 80 MB)."""
         handed = msg.memory
         while handed:
@@ -110,7 +109,7 @@ def restore_or_keep(brain, memory) -> bool:
     """`give_back` of a memory already decoded (a `Rejected` one restores nothing).  A controller whose
     restore() checks everything before it writes (`atomic_restore`) is trusted to change nothing when it
     raises; any other is rolled back to a copy of its state taken first."""
-    if isinstance(memory, proto.Rejected):
+    if isinstance(memory, wire.Rejected):
         return False
     had = None if getattr(brain, "atomic_restore", False) else memory_codec.encode(brain.snapshot())
     try:  # `had` encoded: a snapshot may share the arrays restore() writes

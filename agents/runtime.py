@@ -16,13 +16,13 @@ import uuid
 
 import numpy as np
 
-from agents.controllers import aot
 from agents.controllers.arena import ARENA_CONTROLLERS
-from agents.controllers.layout import controller_kind, new_memory
-from swarm import protocol as proto
-from swarm.bus import DEFAULT_ENDPOINT, open_client
-from swarm.errors import RunError
+from swarm.core import kernels, wire
+from swarm.core.bus import DEFAULT_ENDPOINT, open_client
+from swarm.core.errors import RunError
 from swarm.monitor import world_info
+from world_server.grid.face import wire as proto
+from world_server.grid.face.layout import controller_kind, new_memory
 
 
 class JoinRefused(RunError):
@@ -33,7 +33,7 @@ def load_step():
     """(`envelope.answer_message`, `dispatch.answer_rows`): the ahead-of-time build's
     when it exists (no numba in this process), else the JIT's (compiled or loaded
     from the cache now)."""
-    built = aot.load("answer_message"), aot.load("answer_rows")
+    built = kernels.load("answer_message"), kernels.load("answer_rows")
     if None not in built:
         return built
     from agents.controllers.dispatch import answer_rows, warm_up
@@ -49,7 +49,7 @@ class AgentRuntime:
     def __init__(self, run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
                  join_timeout: float = 60.0, idle_timeout: float = 120.0, null: bool = False,
                  rejoin_after: float = 5.0):  # fmt: skip
-        self.keys = proto.Keys(run_id)
+        self.keys = wire.Keys(run_id)
         self.controller = controller
         self.null = null  # benchmark floor: answer without running the controller
         self._prepare(count)  # before joining: the world observes us at once
@@ -101,13 +101,13 @@ class AgentRuntime:
         nonce = uuid.uuid4().hex
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            request = proto.join_request(nonce, self.group, family=self.family, controller=self.controller)
+            request = wire.join_request(nonce, self.group, family=self.family, controller=self.controller)
             for reply in self.session.get(self.keys.join, payload=request, timeout=2.0):
                 if not reply.ok:
                     continue
                 data, reply = reply.ok.payload.to_bytes(), None  # zenoh's copy goes: a welcome may carry MBs
-                msg, data = proto.unpack(data, proto.MAX_WELCOME_BYTES), None
-                if isinstance(msg, proto.Rejected):
+                msg, data = wire.unpack(data, wire.MAX_WELCOME_BYTES), None
+                if isinstance(msg, wire.Rejected):
                     continue
                 if msg.get("type") == "refused":
                     raise JoinRefused(f"the world refused this agent: {msg.get('reason')}")
@@ -166,10 +166,10 @@ class AgentRuntime:
             if isinstance(msg, dict):
                 if msg.get("type") == "stop":
                     return True, 0
-            elif isinstance(msg, proto.HandBack):
+            elif isinstance(msg, wire.HandBack):
                 self._heard = time.monotonic()
                 self._restore(msg)
-            elif not isinstance(msg, proto.Rejected):
+            elif not isinstance(msg, wire.Rejected):
                 latest = msg
         if latest is not None:
             self._heard = time.monotonic()
@@ -184,7 +184,7 @@ class AgentRuntime:
         """The main thread blocks in the channel: when no observation has come
         for `rejoin_after`, wake it with a message to ourselves so that it can
         check our membership (and give up after `idle_timeout`)."""
-        wake = proto.pack({"type": "wake"})
+        wake = wire.pack({"type": "wake"})
         while not self._closed.wait(self.rejoin_after / 2):
             if time.monotonic() - self._heard >= self.rejoin_after:
                 try:
@@ -226,7 +226,7 @@ class GridAgentRuntime(AgentRuntime):
     """Grid controllers: one compiled call checks and steps the whole batch
     (`dispatch.answer_rows`); memory per agent."""
 
-    family = proto.FAMILY_GRID
+    family = wire.FAMILY_GRID
 
     def _prepare(self, count: int) -> None:
         self.kind = controller_kind(self.controller)

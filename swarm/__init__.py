@@ -1,5 +1,5 @@
 """swarm: a distributed multi-robot swarm simulator (c-marking foraging and friends)."""
 
-from swarm import jitcache as _jitcache  # noqa: F401  (first: where compiled kernels live)
+from swarm.core import jitcache as _jitcache  # noqa: F401  (first: where compiled kernels live)
 
 __version__ = "0.1.0"

@@ -20,9 +20,9 @@ from statistics import median
 
 import numpy as np
 
-from swarm.arena.models import ANIMAT, EPUCK, Laser, RobotModel, Sensors
 from swarm.arena.scenario import ArenaScenario, Group, Wall
-from world_server.arena import ArenaWorld
+from world_server.arena.face.robots import ANIMAT, EPUCK, Laser, RobotModel, Sensors
+from world_server.arena.world import ArenaWorld
 
 SIDE = 20.0
 LASER_BOT = RobotModel("laser64", 0.2, 0.3, 0.5, 0.5, 1.0, sensors=Sensors(laser=Laser(beams=64, range=8.0)))

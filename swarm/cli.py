@@ -18,7 +18,7 @@ from swarm.cli_arena import (
     print_arena_summary,
     run_arena,
 )
-from swarm.errors import RecordingError, RunError, raise_interrupt
+from swarm.core.errors import RecordingError, RunError, raise_interrupt
 from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
 
 CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
@@ -498,7 +498,7 @@ def cmd_world(args) -> int:
 
 def cmd_agent(args) -> int:
     from agents.runtime import JoinRefused, make_runtime
-    from swarm.protocol import ENDED
+    from swarm.core.wire import ENDED
 
     try:
         runtime = make_runtime(args.run_id, args.controller, args.connect, args.count, null=args.null,

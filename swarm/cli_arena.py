@@ -125,7 +125,7 @@ def sense(scenario, pose: tuple[float, ...], group: int = 0) -> dict:
     """What one robot of `group` senses at `pose`, alone in the arena at tick 0."""
     from dataclasses import replace
 
-    from world_server.arena import ArenaWorld
+    from world_server.arena.world import ArenaWorld
 
     if not 0 <= group < len(scenario.groups):
         raise ScenarioError("command line", "--group", f"expected 1 to {len(scenario.groups)}")

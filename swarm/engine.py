@@ -1,7 +1,7 @@
 """The in-process engine: the whole swarm in one process, compiled with numba.
 
 It is both the fast tool for experiments and the yardstick of the distributed
-runtime: it runs exactly the tick of world_server.grid (perceive all, decide
+runtime: it runs exactly the tick of world_server.grid.world (perceive all, decide
 all, apply in agent-id order) with the controllers' own compiled steps.
 """
 
@@ -15,10 +15,10 @@ import numpy as np
 from numba import njit
 
 from agents.controllers.dispatch import controller_params, step_controller
-from agents.controllers.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind, new_memory
 from swarm.layer_classes import K_MARKS, K_RESOURCES, K_TRAILS, class_image
 from swarm.scenario import Layout, Scenario, ScenarioError
-from world_server.grid import (
+from world_server.grid.face.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind, new_memory
+from world_server.grid.world import (
     C_DELIVERED,
     C_EXPLORED,
     C_OPTIMAL,

@@ -18,7 +18,7 @@ import sys
 import threading
 import time
 
-from swarm.bus import open_client, open_router
+from swarm.core.bus import open_client, open_router
 
 OBS = b"obs-payload-64-bytes" * 3
 ACT = b"act-payload-32-bytes-xxxxxxxxxxx"

@@ -25,11 +25,11 @@ from pathlib import Path
 
 from agents.controllers import aot
 from agents.controllers.dispatch import warm_up
-from swarm import protocol as proto
-from swarm.bus import open_client
-from swarm.errors import RunError, raise_interrupt
+from swarm.core import wire
+from swarm.core.bus import open_client
+from swarm.core.errors import RunError, raise_interrupt
 from swarm.scenario import PhysicsParams, is_arena, load_scenario
-from world_server.grid import GridWorld
+from world_server.grid.world import GridWorld
 
 
 def _terminate(procs: list[subprocess.Popen], grace: float = 5.0) -> None:
@@ -149,7 +149,7 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
             if session is not None:  # None: the world is already done (e.g. it resumed a finished run)
                 for i, cmd in enumerate(agent_cmds):
                     children.start(f"agent process {i + 1}", cmd)
-                rss = _follow(session, proto.Keys(run_id), children, agents, progress)
+                rss = _follow(session, wire.Keys(run_id), children, agents, progress)
             world.wait()
             if not summary_file.exists():  # exit 1 with a summary is an unfinished run, not a failure
                 raise children.failure(world)
@@ -229,7 +229,7 @@ def _rss_kb(pid: int) -> int:
     return 0
 
 
-def _follow(session, keys: proto.Keys, children: _Children, agents: int, progress: bool) -> dict:
+def _follow(session, keys: wire.Keys, children: _Children, agents: int, progress: bool) -> dict:
     """Show progress until the world exits; return each agent process's peak RSS (kB).
     An agent process that fails stops the run (RunError)."""
     import queue
@@ -245,12 +245,12 @@ def _follow(session, keys: proto.Keys, children: _Children, agents: int, progres
     try:
         while world.poll() is None:
             try:
-                msg = proto.unpack(states.get(timeout=0.5).payload.to_bytes())
+                msg = wire.unpack(states.get(timeout=0.5).payload.to_bytes())
             except queue.Empty:
                 if (failed := children.failed_agent()) is not None:
                     raise children.failure(failed) from None
                 continue
-            if isinstance(msg, proto.Rejected):
+            if isinstance(msg, wire.Rejected):
                 continue
             if time.monotonic() >= next_look and msg.get("tick", 0) > 0:  # the world ticks ten times this a second
                 next_look = time.monotonic() + 1.0

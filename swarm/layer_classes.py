@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from agents.controllers.layout import MARK_NONE
+from world_server.grid.face.layout import MARK_NONE
 
 K_MARKS, K_TRAILS, K_RESOURCES = 0, 1, 2
 TRAIL_COLOURS = 20

@@ -15,15 +15,15 @@ import sys
 import threading
 import time
 
-from swarm import protocol as proto
-from swarm.bus import open_client, open_router
+from swarm.core import wire
+from swarm.core.bus import open_client, open_router
 
 
-def world_info(session, keys: proto.Keys, timeout: float = 2.0) -> dict | None:
+def world_info(session, keys: wire.Keys, timeout: float = 2.0) -> dict | None:
     """The world's answer on swarm/<run>/info, or None if no world answers."""
     for reply in session.get(keys.info, timeout=timeout):
         if reply.ok:
-            info = proto.unpack(reply.ok.payload.to_bytes())
+            info = wire.unpack(reply.ok.payload.to_bytes())
             if isinstance(info, dict) and info.get("type") == "info":
                 return info
     return None
@@ -38,7 +38,7 @@ def status(connect: str, run_id: str, router_only: bool = False, timeout: float 
     try:
         if router_only:
             return {"router": connect}
-        return world_info(session, proto.Keys(run_id), timeout=timeout)
+        return world_info(session, wire.Keys(run_id), timeout=timeout)
     finally:
         session.close()
 
@@ -65,7 +65,7 @@ def monitor(connect: str, run_id: str, progress: bool, log_every: float = 5.0, s
     run, still gets the summary."""
     from tqdm import tqdm
 
-    keys = proto.Keys(run_id)
+    keys = wire.Keys(run_id)
     session = open_client(connect, timeout=start_timeout)
     states: queue.Queue = queue.Queue()
     sub = session.declare_subscriber(keys.state, states.put)
@@ -84,7 +84,7 @@ def monitor(connect: str, run_id: str, progress: bool, log_every: float = 5.0, s
             latest = None
             try:
                 while True:
-                    msg = proto.unpack(states.get(timeout=0.05 if latest else 1.0).payload.to_bytes())
+                    msg = wire.unpack(states.get(timeout=0.05 if latest else 1.0).payload.to_bytes())
                     if isinstance(msg, dict):
                         latest = msg
             except queue.Empty:

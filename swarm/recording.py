@@ -32,18 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.controllers.layout import (
-    A_MODE,
-    ERASE,
-    RETURN,
-    RETURN_COLOUR,
-    RETURN_MEND,
-    RETURN_REMOVE,
-    SEARCH,
-)
 from swarm.layer_classes import K_MARKS, K_TRAILS, class_images, level_range, n_levels
-from world_server.bodies import cell_centres
-from world_server.grid import C_DELIVERED, C_EXPLORED, C_OPTIMAL, L_MARK, L_RES, L_TRAIL, GridWorld
+from world_server.grid.bodies import cell_centres
+from world_server.grid.face.layout import A_MODE, ERASE, RETURN, RETURN_COLOUR, RETURN_MEND, RETURN_REMOVE, SEARCH
+from world_server.grid.world import C_DELIVERED, C_EXPLORED, C_OPTIMAL, L_MARK, L_RES, L_TRAIL, GridWorld
 
 STATES = ("searching", "returning", "colouring", "removing", "carrying", "absent")
 STATE_COLOURS = ((80, 160, 255), (170, 170, 170), (60, 200, 90), (230, 60, 60), (255, 190, 0), (90, 90, 90))

@@ -21,7 +21,7 @@ from urllib.parse import quote
 
 import numpy as np
 
-from swarm.errors import RecordingError
+from swarm.core.errors import RecordingError
 from swarm.recording import METRICS, STATES
 
 

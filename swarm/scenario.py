@@ -63,7 +63,7 @@ PHYSICS_MODES = ("ideal", "physical")
 
 @dataclass(frozen=True)
 class PhysicsParams:
-    """Robot bodies (world_server/bodies.py).  Lengths in cells, times in seconds."""
+    """Robot bodies (world_server/grid/bodies.py).  Lengths in cells, times in seconds."""
 
     mode: str = "ideal"  # ideal: instant cell-to-cell moves (the paper); physical: pymunk discs
     diameter: float = 0.4  # body diameter (two fit side by side in a corridor)
@@ -439,7 +439,7 @@ def _layout_from_ascii(s: Scenario) -> Layout:
     grid = np.array([list(r) for r in rows])
     obstacles = grid == "#"
     base_r, base_c = (int(v[0]) for v in np.nonzero(grid == "B"))
-    from swarm.wavefront import bfs_distances  # compiled: loaded only where a map is built
+    from world_server.grid.wavefront import bfs_distances
 
     bfs = bfs_distances(obstacles, base_r, base_c)
     resources = np.where(grid == "R", s.quantity, 0).astype(np.int64)
@@ -459,7 +459,7 @@ def generate_layout(g: Generator, quantity: int, seed: int, source: str = "gener
     resources on distinct cells reachable from the base.  A draw whose base is
     walled into a pocket holding less than half the free cells (or fewer cells
     than resources) is redrawn from the same seed's stream."""
-    from swarm.wavefront import bfs_distances
+    from world_server.grid.wavefront import bfs_distances
 
     rng = np.random.default_rng([seed, MAP_STREAM])
     h, w = g.height, g.width

@@ -77,14 +77,14 @@ def run_world(scenario, run_id: str, agents: list[tuple[str, int, int]], attack=
     """A world in a thread and its agent processes, `agents` as (controller,
     processes, agents per process); `attack(endpoint, keys)` runs once they are
     started.  Returns the summary and the world, once every process exited 0."""
-    from swarm import protocol as proto
+    from swarm.core import wire
 
     endpoint = free_endpoint()
     world = ServerThread(scenario, run_id, endpoint, deadline=deadline, **kw).start()
     procs = [p for controller, n, count in agents for p in start_agents(endpoint, run_id, controller, n, count)]
     try:
         if attack is not None:
-            attack(endpoint, proto.Keys(run_id))
+            attack(endpoint, wire.Keys(run_id))
         summary = world.join(timeout=240)
         for p in procs:
             p.wait(timeout=30)

@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from agents.controllers.layout import MARK_NONE
 from swarm.scenario import Scenario, parse_scenario_text
-from world_server.grid import L_BFS, L_MARK, L_OBST
+from world_server.grid.face.layout import MARK_NONE
+from world_server.grid.world import L_BFS, L_MARK, L_OBST
 
 
 def ascii_scenario(rows: list[str], **fields) -> Scenario:

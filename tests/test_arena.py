@@ -12,7 +12,7 @@ from agents.controllers.navigation.astar import Planner
 from swarm.arena.engine import ArenaEngine
 from swarm.scenario import ScenarioError, load_scenario, parse_scenario_text
 from tests.arena_helpers import arena, box
-from world_server.arena import ArenaWorld
+from world_server.arena.world import ArenaWorld
 
 ONE = '[[group]]\ncount = 1\ncontroller = "wander"\nstart = [{x}, {y}, {t}]\n'
 
@@ -72,7 +72,7 @@ def test_bad_actions_are_counted_and_never_acted_on():
 
 
 def test_the_compiled_wheel_checks_and_limits_are_numpys_to_the_bit():
-    from world_server.wheels import limited, refusals
+    from world_server.arena.wheels import limited, refusals
 
     rng = np.random.default_rng(8)
     for width in (2, 3):
@@ -303,7 +303,7 @@ def test_wall_distance_is_scipys_transform_up_to_the_clearance():
 
 AOT_CHILD = """
 import pickle, sys
-from swarm import kernels
+from swarm.core import kernels
 assert kernels.use_ahead_of_time()
 from agents.controllers.arena import as_action, make_controller
 name, seed, params, readings = pickle.loads(open(sys.argv[1], "rb").read())
@@ -317,9 +317,10 @@ pickle.dump((actions, "numba" in sys.modules, "scipy" in sys.modules), open(sys.
 def test_the_agents_compiled_astar_equals_the_jit():
     from agents.controllers import aot
     from agents.controllers.navigation.astar import astar_cells
+    from swarm.core import kernels
 
     aot.build()  # once per source version (swarm up builds it too)
-    compiled = aot.load("astar")
+    compiled = kernels.load("astar")
     free = np.random.default_rng(3).random((60, 80)) > 0.3
     for si, sj, gi, gj in ((0, 0, 79, 59), (5, 40, 70, 2), (10, 10, 10, 10)):
         free[sj, si] = free[gj, gi] = True
@@ -331,7 +332,7 @@ def test_the_agents_compiled_astar_equals_the_jit():
     ("carrot", "zmaze"), ("wander", "zmaze"), ("bg", "bg-exp1"), ("fingerprint", "office"), ("dft", "zmaze"),
 ])  # fmt: skip
 def test_an_agent_process_steps_its_controller_without_numba_exactly_as_in_process(controller, ref, tmp_path):
-    """The agents' ahead-of-time kernels (swarm.kernels) give the JIT's actions, tick for tick, in a process
+    """The agents' ahead-of-time kernels (swarm.core.kernels) give the JIT's actions, tick for tick, in a process
     without numba or scipy (each costs an agent process tens of MB: docs/distributed.md)."""
     import pickle
     import subprocess

@@ -4,14 +4,15 @@ to the in-process engine pose for pose, bad traffic counted and refused."""
 import numpy as np
 import pytest
 
-from swarm import protocol as proto
-from swarm import protocol_arena as arena_proto
 from swarm.arena.engine import ArenaEngine
-from swarm.bus import open_client
+from swarm.core import wire
+from swarm.core.bus import open_client
 from swarm.review import read_recording, summary_from
 from swarm.scenario import load_scenario, parse_scenario_text
 from tests.arena_helpers import box
 from tests.distributed import ServerThread, free_endpoint, run_world, start_agents, stop
+from world_server.arena.face import wire as arena_proto
+from world_server.grid.face import wire as proto
 
 
 def _distributed(scenario, run_id, procs_for, attack=None, **kw):
@@ -68,10 +69,10 @@ def test_bad_arena_traffic_is_counted_and_never_acted_on():
         s = open_client(endpoint)
         try:
             s.put(keys.act("intruder"), b"\x00\xffgarbage")
-            s.put(keys.act("intruder"), proto.pack({"type": "act", "family": "arena", "tick": 0}))
+            s.put(keys.act("intruder"), wire.pack({"type": "act", "family": "arena", "tick": 0}))
             s.put(keys.act("intruder"), arena_proto.actions(0, [0], np.array([[0.1, 0.1]])))  # another's agent
             s.put(keys.act("intruder"), arena_proto.actions(0, [7], np.array([[0.1, 0.1]])))  # unknown agent
-            s.put(keys.act("intruder"), proto.pack({"type": "act", "family": "arena", "tick": 0, "agents": [0],
+            s.put(keys.act("intruder"), wire.pack({"type": "act", "family": "arena", "tick": 0, "agents": [0],
                                                     "wheels": b"short"}))  # fmt: skip
             s.put(keys.act("intruder"), proto.actions(0, [0], np.zeros((1, 8), np.int64), [False]))  # grid family
             s.put(keys.act("intruder"), arena_proto.actions(0, [0], np.array([[0.1, 0.1]]), memory=[(0, b"x")]))
@@ -105,16 +106,16 @@ def test_nan_and_huge_wheel_speeds_from_an_agent_are_refused():
     s = open_client(endpoint)
     group, nonce = uuid.uuid4().hex, uuid.uuid4().hex
     got: list = []
-    sub = s.declare_subscriber(proto.Keys("arena-nan").obs(group), lambda smp: got.append(smp.payload.to_bytes()))
+    sub = s.declare_subscriber(wire.Keys("arena-nan").obs(group), lambda smp: got.append(smp.payload.to_bytes()))
     try:
-        keys = proto.Keys("arena-nan")
+        keys = wire.Keys("arena-nan")
         for _ in range(50):
-            request = proto.join_request(nonce, group, family="arena", controller="carrot")
+            request = wire.join_request(nonce, group, family="arena", controller="carrot")
             replies = list(s.get(keys.join, payload=request, timeout=2.0))
             if replies and replies[0].ok:
                 break
             time.sleep(0.1)
-        agent = proto.unpack(replies[0].ok.payload.to_bytes(), proto.MAX_WELCOME_BYTES)["agent"]
+        agent = wire.unpack(replies[0].ok.payload.to_bytes(), wire.MAX_WELCOME_BYTES)["agent"]
         token = s.liveliness().declare_token(keys.alive(agent))
         answered = set()
         stop_at = time.monotonic() + 30
@@ -300,7 +301,7 @@ def test_an_arena_state_of_another_scenario_is_refused_in_one_line(tmp_path):
     import sys
 
     from world_server import persist
-    from world_server.arena import ArenaWorld
+    from world_server.arena.world import ArenaWorld
 
     world = ArenaWorld(load_scenario("zmaze"))
     persist.save_arrays(tmp_path / "other.arena.npz", {**world.snapshot(), "slots": np.zeros(1, np.int64)},

@@ -12,14 +12,14 @@ from hypothesis import strategies as st
 
 from agents.arena_runtime import give_back
 from agents.controllers.arena import make_controller
-from swarm import memory_codec, msgpack_views
-from swarm import protocol_arena as arena_proto
 from swarm.arena.engine import ArenaEngine
 from swarm.arena.scenario import controller_params
-from swarm.protocol import Rejected, pack
+from swarm.core import memory_codec, msgpack_views
+from swarm.core.wire import Rejected, pack
 from swarm.scenario import load_scenario
 from tests.arena_helpers import arena
-from world_server.arena import ArenaWorld
+from world_server.arena.face import wire as arena_proto
+from world_server.arena.world import ArenaWorld
 
 CROWD = arena('[[group]]\ncount = 12\ncontroller = "wander"\n', w=0.8, h=0.8, max_ticks=100_000)
 
@@ -268,7 +268,7 @@ def test_the_publication_history_keeps_what_came_before_the_save_and_survives_a_
 
 HEAP_CHILD = """
 import numpy as np
-from swarm import heap
+from swarm.core import heap
 
 def rss_mb():
     with open("/proc/self/status") as f:
@@ -285,7 +285,7 @@ print(heap._trim() is not None, heap.give_back(), before, rss_mb())
 
 
 def test_freed_heap_memory_goes_back_to_the_system():
-    """swarm.heap: what an agent process packed for a save and freed is not kept by glibc's heap
+    """swarm.core.heap: what an agent process packed for a save and freed is not kept by glibc's heap
     (in a fresh process: a test process's heap is full of holes the blocks would fall into)."""
     import subprocess
     import sys

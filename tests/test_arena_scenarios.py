@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from swarm.arena.engine import ArenaEngine
-from swarm.arena.models import ZONE_KINDS
 from swarm.scenario import bundled_scenarios, is_arena, load_scenario
 from tests.arena_helpers import arena
-from world_server.arena import ArenaWorld
+from world_server.arena.face.robots import ZONE_KINDS
+from world_server.arena.world import ArenaWorld
 
 ARENAS = [
     "zmaze",

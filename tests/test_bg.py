@@ -15,13 +15,13 @@ from agents.controllers.bg.places import ANGLES, DIRECTIONS, Navigator, NavParam
 from agents.controllers.bg.saliences import Drives, plan_vector, saliences
 from agents.controllers.bg.senses import Reflex, proximity, resource_pixels, sense, to_allocentric
 from agents.controllers.navigation.dijkstra import shortest_routes
-from swarm import protocol_arena as proto
 from swarm.arena.engine import ArenaEngine
 from swarm.arena.scenario import controller_params
-from swarm.protocol import Rejected
+from swarm.core.wire import Rejected
 from swarm.scenario import ScenarioError, load_scenario
 from tests.arena_helpers import arena, box, resumed_pair, rrd_rows
-from world_server.arena import ArenaWorld
+from world_server.arena.face import wire as proto
+from world_server.arena.world import ArenaWorld
 
 FOOD = (
     "[metabolism]\n{extra}\n"
@@ -55,8 +55,8 @@ def test_a_full_energy_lasts_33_minutes_then_the_animat_dies_and_stops():
 
 
 def test_a_metabolism_step_gives_the_numpy_formulas_numbers_to_the_bit():
-    from swarm.arena.models import ZONE_KINDS
-    from world_server.metabolism import Metabolism, MetabolismParams
+    from world_server.arena.face.robots import ZONE_KINDS
+    from world_server.arena.metabolism import Metabolism, MetabolismParams
 
     rng = np.random.default_rng(9)
     n, p, dt = 64, MetabolismParams(lifetime=30.0, danger_rate=0.05), 0.25
@@ -143,7 +143,7 @@ def test_acts_cross_the_wire_only_when_there_are_some():
     assert plain.wheels.shape == (2, 2)
     acting = proto.parse_acts(proto.actions(3, [0, 1], np.array([[0.1, 0.1, 2.0], [0.2, 0.2, 0.0]])))
     assert acting.wheels.shape == (2, 3) and acting.wheels[0, 2] == 2.0
-    from swarm.protocol import pack, unpack
+    from swarm.core.wire import pack, unpack
 
     m = unpack(proto.actions(3, [0, 1], np.array([[0.1, 0.1, 2.0], [0.2, 0.2, 0.0]])), 1 << 20)
     m["acts"] = b"\x00" * 3

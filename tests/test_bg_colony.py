@@ -13,7 +13,7 @@ from agents.controllers.bg.places import Navigator, NavParams
 from agents.controllers.bg.senses import RESOURCES
 from swarm.arena.bg_colony import colony_scenario
 from swarm.arena.engine import ArenaEngine
-from swarm.protocol import pack
+from swarm.core.wire import pack
 from tests.arena_helpers import MapSharer, resumed_pair
 
 

@@ -4,7 +4,8 @@ import numpy as np
 
 from agents.controllers.cmarking import new_trail_id
 from agents.controllers.dispatch import controller_params, step_controller
-from agents.controllers.layout import (
+from swarm.scenario import Scenario
+from world_server.grid.face.layout import (
     A_LOAD,
     A_MARK,
     A_MOVE,
@@ -35,8 +36,7 @@ from agents.controllers.layout import (
     new_action,
     new_memory,
     new_perception,
-)  # fmt: skip
-from swarm.scenario import Scenario
+)
 
 N, E, S, W = 0, 1, 2, 3
 PARAMS = controller_params(Scenario("rules", "test", controller="cmarking"))

@@ -4,14 +4,14 @@ import numpy as np
 import pytest
 
 from agents.controllers.dispatch import controller_params, step_controller
-from agents.controllers.layout import controller_kind, new_memory
 from swarm.arena.engine import ArenaEngine
 from swarm.engine import Engine
 from swarm.scenario import load_scenario
 from swarm.stepper import step_world
-from world_server.arena import ArenaWorld
+from world_server.arena.world import ArenaWorld
 from world_server.contract import World
-from world_server.grid import GridWorld
+from world_server.grid.face.layout import controller_kind, new_memory
+from world_server.grid.world import GridWorld
 
 
 def test_both_kinds_keep_the_contract():

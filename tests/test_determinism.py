@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from agents.controllers.dispatch import step_controller
-from agents.controllers.layout import controller_kind, new_perception
 from swarm.engine import Engine
 from swarm.scenario import load_scenario
+from world_server.grid.face.layout import controller_kind, new_perception
 
 
 def _state(engine):
@@ -63,7 +63,7 @@ def test_stepping_agents_in_any_order_gives_the_same_run(controller):
 
 
 def test_the_plain_python_draws_are_the_compiled_draws_bit_for_bit():
-    from swarm import rng, rng_scalar
+    from swarm.core import rng, rng_scalar
 
     cases = [(0, 0, 0, 0), (7, 3, 12345, 2), (2**63 - 1, 99_999, 2**40, 2**30), (123456789, 0, 1, 1 << 50)]
     cases += [tuple(int(v) for v in row) for row in np.random.default_rng(5).integers(0, 2**31, (200, 4))]

@@ -481,7 +481,7 @@ def test_malformed_context_is_refused_whole():
         with pytest.raises(ValueError):
             c.receive(0, bad)
     assert not c.sensed.blocked(1).any()
-    from swarm.protocol import pack
+    from swarm.core.wire import pack
 
     assert deliver(engine.controllers, [0, 1], [(0, "context", b"\xc1garbage"), (0, "context", pack({"tick": 0}))]) == 2
 

@@ -6,12 +6,13 @@ must be counted and rejected without touching the world."""
 import numpy as np
 import pytest
 
-from swarm import protocol as proto
-from swarm.bus import open_client
+from swarm.core import wire
+from swarm.core.bus import open_client
 from swarm.engine import Engine
 from swarm.scenario import load_scenario
 from tests.distributed import ServerThread, free_endpoint, run_world, start_agents, stop
-from world_server.grid import L_MARK
+from world_server.grid.face import wire as proto
+from world_server.grid.world import L_MARK
 
 
 def _run_distributed(scenario, run_id, count=1, attack=None):
@@ -48,11 +49,11 @@ def test_bad_traffic_is_counted_and_changes_nothing():
         rows = proto.action_rows([0], stay, [False])
 
         def act(**fields):
-            return proto.pack({"type": "act", "family": "grid", "tick": 0, "rows": rows.tobytes(), **fields})
+            return wire.pack({"type": "act", "family": "grid", "tick": 0, "rows": rows.tobytes(), **fields})
 
         try:
             s.put(keys.act("intruder"), b"\x00\xffgarbage")  # not msgpack
-            s.put(keys.act("intruder"), proto.pack({"type": "act", "tick": "soon"}))  # wrong schema
+            s.put(keys.act("intruder"), wire.pack({"type": "act", "tick": "soon"}))  # wrong schema
             s.put(keys.act("intruder"), proto.actions(0, [0], stay, [False]))  # another process's agent
             s.put(keys.act("intruder"), proto.actions(0, [99], stay, [False]))  # unknown agent
             s.put(keys.act("intruder"), proto.actions(0, [-1], stay, [False]))  # a negative id
@@ -62,7 +63,7 @@ def test_bad_traffic_is_counted_and_changes_nothing():
             s.put(keys.act("intruder"), act(family="bees"))
             s.put(
                 keys.mark("intruder"),
-                proto.pack({"type": "mark", "family": "grid", "tick": 0, "agents": [0], "cells": [0], "values": [0]}),
+                wire.pack({"type": "mark", "family": "grid", "tick": 0, "agents": [0], "cells": [0], "values": [0]}),
             )  # a mark write: not on this key
             for _ in range(300):  # a flood
                 s.put(keys.act("flood"), b"\x93\x01\x02")
@@ -87,7 +88,7 @@ def test_the_marks_key_space_can_be_read_by_any_client():
         s = open_client(endpoint)
         try:
             reply = next(iter(s.get("swarm/keyspace/marks/**", timeout=5.0))).ok
-            msg = proto.unpack(reply.payload.to_bytes())
+            msg = wire.unpack(reply.payload.to_bytes())
         finally:
             s.close()
         marks = np.array(msg["marks"]).reshape(msg["height"], msg["width"])
@@ -133,7 +134,7 @@ def test_kill_9_an_agent_then_a_fresh_one_joins_and_the_run_finishes():
 
 def test_lost_agents_cargo_is_dropped_where_it_stood():
     scenario = load_scenario("setup2").with_overrides(agents=2, seed=1)
-    from world_server.grid import L_RES, GridWorld
+    from world_server.grid.world import L_RES, GridWorld
 
     w = GridWorld(scenario)
     w.pos[0] = (3, 4)

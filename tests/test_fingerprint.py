@@ -537,7 +537,7 @@ def test_a_malformed_map_from_another_robot_is_refused_and_merges_nothing():
             a.receive(1, bad)
     assert a.map.nodes == []
     from agents.controllers.arena import deliver
-    from swarm.protocol import pack
+    from swarm.core.wire import pack
     from tests.arena_helpers import MapSharer
 
     robots = [MapSharer(a), MapSharer(b)]
@@ -548,8 +548,8 @@ def test_a_malformed_map_from_another_robot_is_refused_and_merges_nothing():
 
 
 def test_shared_items_on_the_wire_are_checked():
-    from swarm import protocol_arena as arena_proto
-    from swarm.protocol import Rejected
+    from swarm.core.wire import Rejected
+    from world_server.arena.face import wire as arena_proto
 
     msg = arena_proto.parse_acts(arena_proto.actions(3, [0], np.zeros((1, 2)), [(0, "map", b"x")]))
     assert msg.shared == [(0, "map", b"x")]
@@ -559,10 +559,10 @@ def test_shared_items_on_the_wire_are_checked():
 
 @pytest.mark.parametrize(("processes", "per_process"), [(2, 1), (1, 2)])
 def test_mapping_together_lockstep_equals_in_process(processes, per_process, tmp_path):
-    from swarm import protocol as proto
     from swarm.arena.engine import ArenaEngine
     from swarm.arena.fingerprint_team import team_scenario
-    from swarm.bus import open_client
+    from swarm.core import wire
+    from swarm.core.bus import open_client
     from tests.distributed import run_world
 
     scenario = team_scenario(2, "low", 0).with_overrides(max_ticks=400)
@@ -579,7 +579,7 @@ def test_mapping_together_lockstep_equals_in_process(processes, per_process, tmp
             for _ in range(300):
                 for reply in session.get(f"{keys.prefix}/map/**", timeout=2.0):
                     if reply.ok is not None:
-                        m = proto.unpack(reply.ok.payload.to_bytes(), 1 << 26)
+                        m = wire.unpack(reply.ok.payload.to_bytes(), 1 << 26)
                         held[m["agent"]] = m["updates"]
                 if len(held) == 2:
                     return

@@ -1,16 +1,16 @@
-"""Robot bodies (world_server/bodies.py): ideal moves and pymunk discs."""
+"""Robot bodies (world_server/grid/bodies.py): ideal moves and pymunk discs."""
 
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from agents.controllers.layout import A_MOVE, ACT_LEN, STAY
 from swarm.engine import Engine
 from swarm.scenario import PhysicsParams, ScenarioError, load_scenario, parse_scenario_text
 from world_server import persist
-from world_server.bodies import Bodies
-from world_server.grid import GridWorld
+from world_server.grid.bodies import Bodies
+from world_server.grid.face.layout import A_MOVE, ACT_LEN, STAY
+from world_server.grid.world import GridWorld
 
 N, E, S, W = 0, 1, 2, 3
 CORRIDOR = np.zeros((3, 9), dtype=bool)
@@ -171,7 +171,7 @@ def test_the_base_is_a_nest_and_robots_leave_it_one_after_another():
 
 
 def test_a_robot_whose_move_failed_senses_it_next_tick():
-    from agents.controllers.layout import BLOCKED, new_perception
+    from world_server.grid.face.layout import BLOCKED, new_perception
 
     text = '[map]\nascii = """\n#######\n#B...R#\n#######\n"""\n[physics]\nmode = "physical"\ndiameter = 0.7\n'
     world = GridWorld(parse_scenario_text(text, "c.toml").with_overrides(agents=2))

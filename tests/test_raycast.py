@@ -5,10 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from swarm.arena.models import IR_DISTANCE, IR_VALUE
 from tests.arena_helpers import arena
-from world_server.arena import ArenaWorld
-from world_server.raycast import NO_HIT, brute_force
+from world_server.arena.face.robots import IR_DISTANCE, IR_VALUE
+from world_server.arena.raycast import NO_HIT, brute_force
+from world_server.arena.world import ArenaWorld
 
 
 def _random_world(seed: int, robots: int, obstacles: int, cell: float | None = None) -> ArenaWorld:

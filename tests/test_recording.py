@@ -72,7 +72,7 @@ def test_the_recording_holds_the_world_the_agents_the_metrics_and_the_metadata(t
 
 
 def test_agent_states_from_mode_payload_and_presence():
-    from agents.controllers.layout import ERASE, RETURN, RETURN_COLOUR, RETURN_MEND, RETURN_REMOVE, SEARCH
+    from world_server.grid.face.layout import ERASE, RETURN, RETURN_COLOUR, RETURN_MEND, RETURN_REMOVE, SEARCH
 
     modes = np.array([SEARCH, RETURN, RETURN, RETURN_COLOUR, RETURN_MEND, RETURN_REMOVE, ERASE, SEARCH])
     payload = np.array([0, 0, 50, 50, 50, 50, 0, 0])

@@ -5,7 +5,7 @@ import pytest
 from swarm.engine import Engine
 from swarm.scenario import load_scenario
 from tests.helpers import ascii_scenario, marks_equal_bfs, maze_rows
-from world_server.grid import L_MARK
+from world_server.grid.world import L_MARK
 
 
 @pytest.mark.parametrize("seed", range(12))

@@ -4,11 +4,9 @@ by reason and changes nothing, and the agent's batch step equals the engine's.""
 import numpy as np
 
 from agents.controllers.dispatch import answer_rows, controller_params, step_controller
-from agents.controllers.layout import A_MARK, A_MOVE, ACT_LEN, MARK, MARK_NONE, controller_kind, new_memory
-from swarm import protocol as proto
+from swarm.core import wire
 from swarm.scenario import load_scenario
-from world_server.grid import GridWorld
-from world_server.grid_wire import (
+from world_server.grid.accept import (
     OBS_OVERHEAD,
     REFUSALS,
     accept_message,
@@ -17,6 +15,9 @@ from world_server.grid_wire import (
     observe_rows,
     write_observations,
 )
+from world_server.grid.face import wire as proto
+from world_server.grid.face.layout import A_MARK, A_MOVE, ACT_LEN, MARK, MARK_NONE, controller_kind, new_memory
+from world_server.grid.world import GridWorld
 
 ACTIVE, FREE = 2, 0
 
@@ -47,11 +48,11 @@ def test_observation_rows_round_trip_and_equal_the_world_perception():
 def test_malformed_observations_are_rejected_not_raised():
     good = proto.observations(1, np.zeros((1, proto.OBS_INTS), np.int64), np.zeros((1, 5)))
     assert isinstance(proto.parse_obs(good), proto.Obs)
-    for bad in (b"", b"\x00\xff", proto.pack({"type": "obs", "tick": 1, "ints": b"123", "pf": b""}),
-                proto.pack({"type": "obs", "tick": -1, "ints": b"", "pf": b""}),
+    for bad in (b"", b"\x00\xff", wire.pack({"type": "obs", "tick": 1, "ints": b"123", "pf": b""}),
+                wire.pack({"type": "obs", "tick": -1, "ints": b"", "pf": b""}),
                 proto.observations(1, np.zeros((1, proto.OBS_INTS), np.int64), np.full((1, 5), np.nan)),
                 proto.observations(1, np.zeros((2, proto.OBS_INTS), np.int64), np.zeros((1, 5)))):  # fmt: skip
-        assert isinstance(proto.parse_obs(bad), proto.Rejected)
+        assert isinstance(proto.parse_obs(bad), wire.Rejected)
     memory = proto.parse_obs(proto.memory_message(np.array([3]), new_memory(1)))
     assert isinstance(memory, proto.Memory) and memory.rows[0, 0] == 3
 
@@ -151,8 +152,8 @@ def test_the_compiled_envelope_leaves_every_other_message_to_the_parser():
     scenario, _ = _world(agents=5, seed=9)
     kind, params = controller_kind(scenario.controller), controller_params(scenario)
     good = proto.observations(4, np.zeros((5, proto.OBS_INTS), np.int64), np.zeros((5, 5)))
-    others = [proto.stop_message("done"), proto.pack({"type": "wake"}), proto.memory_message(np.zeros(1, np.int64),
-              new_memory(1)), b"", b"\x85", proto.pack({"type": "obs", "ints": b"", "pf": b"", "tick": 4})]  # fmt: skip
+    others = [wire.stop_message("done"), wire.pack({"type": "wake"}), proto.memory_message(np.zeros(1, np.int64),
+              new_memory(1)), b"", b"\x85", wire.pack({"type": "obs", "ints": b"", "pf": b"", "tick": 4})]  # fmt: skip
     others += [good[:k] for k in range(0, len(good), 7)]  # every truncation: never a read past the end
     others += [good + b"\x00"]
     for message in others:
@@ -207,9 +208,9 @@ def test_the_world_accepts_a_plain_action_message_in_one_call_as_the_parser_does
 
 def test_the_world_leaves_every_other_action_message_to_the_parser_and_changes_nothing():
     good = proto.pack_actions(300, _mixed_rows())
-    others = [b"", b"\x85", proto.pack({"type": "act", "tick": 300, "family": "grid", "rows": b""}),  # another order
-              good + b"\x00", proto.pack({"type": "wake"}),
-              proto.pack({"v": proto.VERSION, "type": "act", "family": "arena", "tick": 300, "rows": b""})]  # fmt: skip
+    others = [b"", b"\x85", wire.pack({"type": "act", "tick": 300, "family": "grid", "rows": b""}),  # another order
+              good + b"\x00", wire.pack({"type": "wake"}),
+              wire.pack({"v": wire.VERSION, "type": "act", "family": "arena", "tick": 300, "rows": b""})]  # fmt: skip
     others += [good[:k] for k in range(0, len(good), 5)]  # every truncation: never a read past the end
     lying = bytearray(good)
     lying[lying.index(b"rows") + 5] = 0xFF  # a bin length past the end
@@ -224,13 +225,13 @@ def test_the_world_leaves_every_other_action_message_to_the_parser_and_changes_n
         w = _accept_world()
         assert _accept(good, first, last, w)[0] == proto.NOT_PLAIN and not w["acted"].any()
     assert _accept(good, 298, 300, _accept_world())[0] == 2  # real time: one of the last three ticks
-    big = proto.pack_actions(300, np.zeros((proto.MAX_MESSAGE_BYTES // (8 * proto.ACT_ROW) + 1, proto.ACT_ROW), int))
+    big = proto.pack_actions(300, np.zeros((wire.MAX_MESSAGE_BYTES // (8 * proto.ACT_ROW) + 1, proto.ACT_ROW), int))
     assert _accept(big, 300, 300, _accept_world())[0] == proto.NOT_PLAIN  # too large: the parser refuses it
 
 
 def test_the_world_writes_every_observation_message_byte_for_byte_in_one_call():
-    """grid_wire.write_observations equals swarm.protocol.observations per process: every width of the tick,
-    blocks of one to 40 rows (bin 8 and bin 16), read back by the agent's parser."""
+    """grid_wire.write_observations equals the face's wire.observations per process: every width of the
+    tick, blocks of one to 40 rows (bin 8 and bin 16), read back by the agent's parser."""
     rng = np.random.default_rng(3)
     sizes = [1, 3, 40, 2]
     ints = rng.integers(-(2**40), 2**40, size=(sum(sizes), proto.OBS_INTS))
@@ -276,8 +277,8 @@ def test_the_world_applies_the_messages_of_a_tick_in_one_call_as_one_by_one():
 def test_the_mark_floor_is_update_value_on_the_agents_cell():
     """grid_wire.mark_floors: a cell's mark, or one more than its lowest free neighbour's (obstacles and the
     grid's edge not counted), from the perception rows the world sends: what an honest mark write can be."""
-    from world_server.grid import L_MARK, L_OBST
-    from world_server.grid_wire import mark_floors, observe_rows
+    from world_server.grid.accept import mark_floors, observe_rows
+    from world_server.grid.world import L_MARK, L_OBST
 
     layers = np.zeros((8, 3, 4), np.int64)
     layers[L_MARK] = [[MARK_NONE, 7, 3, 9], [6, MARK_NONE, 8, 2], [MARK_NONE, MARK_NONE, MARK_NONE, MARK_NONE]]

@@ -1,9 +1,11 @@
-"""The tick's conflict rules (world_server.grid): loads in id order, paint and
+"""The tick's conflict rules (world_server.grid.world): loads in id order, paint and
 erase merges, min-merged marks, rejected moves, unloads only at the base."""
 
 import numpy as np
 
-from agents.controllers.layout import (
+from swarm.engine import Engine
+from tests.helpers import ascii_scenario
+from world_server.grid.face.layout import (
     A_LOAD,
     A_MARK,
     A_MOVE,
@@ -14,10 +16,8 @@ from agents.controllers.layout import (
     STAY,
     TRAIL_ERASE,
     TRAIL_PAINT,
-)  # fmt: skip
-from swarm.engine import Engine
-from tests.helpers import ascii_scenario
-from world_server.grid import C_DELIVERED, C_REJECTED, L_MARK, L_RES, L_TRAIL, apply_actions
+)
+from world_server.grid.world import C_DELIVERED, C_REJECTED, L_MARK, L_RES, L_TRAIL, apply_actions
 
 ROWS = ["#####", "#B.R#", "#####"]
 
@@ -91,7 +91,7 @@ def test_unload_counts_only_at_the_base():
 
 
 def test_pheromone_diffusion_conserves_mass_without_evaporation():
-    from world_server.grid import diffuse_evaporate
+    from world_server.grid.world import diffuse_evaporate
 
     obst = np.zeros((6, 7), dtype=np.int64)
     obst[2, 3] = 1

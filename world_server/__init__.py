@@ -1,3 +1,4 @@
-"""The world: the authoritative grid and the rules that apply agents' actions."""
+"""The worlds: one package per world kind (grid, arena), each with its controller face, and the
+world process that serves any of them over zenoh."""
 
-import swarm as _swarm  # noqa: F401  (configures the compiled-kernel cache first)
+from swarm.core import jitcache as _jitcache  # noqa: F401  (configures the compiled-kernel cache first)

@@ -11,7 +11,7 @@ This module is the part every world kind shares: joins, presence, the
 lock-step barrier, real time, the state key, info, progress and the summary's
 runtime fields.  What a kind perceives, which actions it accepts, how it
 resolves a tick, persists and records are the hooks its subclass fills:
-`world_server.grid_server.GridServer` and `world_server.arena_server.ArenaServer`.
+`world_server.grid.server.GridServer` and `world_server.arena.server.ArenaServer`.
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 import zenoh
 
-from swarm import protocol as proto
-from swarm.bus import open_client, open_router
+from swarm.core import wire
+from swarm.core.bus import open_client, open_router
 from swarm.scenario import ScenarioError
 
 # JOINING: welcomed, but its observation subscriber may not be routed yet; it is
@@ -73,7 +73,7 @@ class WorldServer:
         self.mode = mode
         self.period = 1.0 / rate
         self.scenario = scenario
-        self.keys = proto.Keys(run_id)
+        self.keys = wire.Keys(run_id)
         self.deadline = deadline
         self.max_misses = max_misses
         # Ticking starts once `start_with` agents are active; more may join later, up to scenario.agents.
@@ -253,7 +253,7 @@ class WorldServer:
         elif kind == "join":
             self._on_join(item)
         elif kind == "info":
-            self._reply(item, self.keys.info, proto.pack(self.info()))
+            self._reply(item, self.keys.info, wire.pack(self.info()))
         elif kind == "alive":
             self._on_alive(item)
         elif kind == "wake":
@@ -269,23 +269,23 @@ class WorldServer:
 
     def _on_join(self, query) -> None:
         raw = query.payload.to_bytes() if query.payload is not None else b""
-        request = proto.parse_join(raw)
-        if isinstance(request, proto.Rejected):
+        request = wire.parse_join(raw)
+        if isinstance(request, wire.Rejected):
             self.stats.reject(f"join: {request.reason}")
-            self._reply(query, self.keys.join, proto.refuse_reply(request.reason))
+            self._reply(query, self.keys.join, wire.refuse_reply(request.reason))
             return
         if (reason := self._join_refusal(request)) is not None:
-            self._reply(query, self.keys.join, proto.refuse_reply(reason))
+            self._reply(query, self.keys.join, wire.refuse_reply(reason))
             return
         if self.final is not None:
-            self._reply(query, self.keys.join, proto.refuse_reply(proto.ENDED))
+            self._reply(query, self.keys.join, wire.refuse_reply(wire.ENDED))
             return
         nonce = request["nonce"]
         agent = self.nonces.get(nonce)  # a retried join gets the same id
         if agent is None:
             free = self._free_slots(request)
             if len(free) == 0:
-                self._reply(query, self.keys.join, proto.refuse_reply("the swarm is full"))
+                self._reply(query, self.keys.join, wire.refuse_reply("the swarm is full"))
                 return
             agent = int(free[0])
             if self.returning[agent]:
@@ -299,7 +299,7 @@ class WorldServer:
             self.stats.joins += 1
         info = {"run": self.keys.run, "seed": self.scenario.seed, "tick": self.tick,
                 "lockstep": self.mode == "lockstep", **self._welcome(agent)}  # fmt: skip
-        self._reply(query, self.keys.join, proto.join_reply(agent, nonce, info))
+        self._reply(query, self.keys.join, wire.join_reply(agent, nonce, info))
 
     def _assign_group(self, agent: int, group: str) -> None:
         self.group_of[agent] = group
@@ -336,7 +336,7 @@ class WorldServer:
         raw = sample.payload.to_bytes()
         self.bytes_in += len(raw)
         msg = parse(raw)
-        if isinstance(msg, proto.Rejected):
+        if isinstance(msg, wire.Rejected):
             self.stats.reject(f"{what}: {msg.reason}")
             return None
         return msg, str(sample.key_expr).rsplit("/", 1)[1]
@@ -448,7 +448,7 @@ class WorldServer:
                                   rejected=self.stats.rejected_total)  # fmt: skip
         if (now := time.monotonic()) >= self._next_state:  # progress for people: ten times a second is plenty
             self._next_state = now + STATE_PERIOD
-            self._state_publisher.put(proto.pack({"type": "state", **self.progress()}))
+            self._state_publisher.put(wire.pack({"type": "state", **self.progress()}))
 
     def _groups(self, agents: np.ndarray) -> dict[str, np.ndarray]:
         """The active agents by agent process, worked out again only when
@@ -534,7 +534,7 @@ class WorldServer:
 
     def stop_agents(self, reason: str) -> None:
         for group in set(self.group_of.values()):
-            self.session.put(self.keys.obs(group), proto.stop_message(reason))
+            self.session.put(self.keys.obs(group), wire.stop_message(reason))
 
     def close(self) -> None:
         if self.recorder is not None:  # an interrupted run still ends its recording
@@ -547,10 +547,10 @@ class WorldServer:
 def make_server(scenario, run_id: str, **kw) -> WorldServer:
     """The server of the scenario's world kind."""
     if getattr(scenario, "kind", "grid") == "arena":
-        from world_server.arena_server import ArenaServer
+        from world_server.arena.server import ArenaServer
 
         return ArenaServer(scenario, run_id, **kw)
-    from world_server.grid_server import GridServer
+    from world_server.grid.server import GridServer
 
     return GridServer(scenario, run_id, **kw)
 

@@ -13,14 +13,15 @@ gets it out of small pockets (with detour 0 ants freeze in cavities, as the
 paper's Figure 11.a shows; deep cavities still hold them for long).
 
 Params: params[P_THRESHOLD], params[P_DETOUR].  Diffusion, evaporation and the deposit amount
-are properties of the world (world_server.grid).
+are properties of the world (world_server.grid.world).
 """
 
 import numpy as np
 from numba import njit
 
 from agents.controllers.foraging import read_load_outcome, seek_resource, unload_if_home
-from agents.controllers.layout import (
+from agents.controllers.moves import pick, random_free_dir, reset_action
+from world_server.grid.face.layout import (
     A_DEPOSIT,
     A_MOVE,
     COMPASS_DC,
@@ -34,7 +35,6 @@ from agents.controllers.layout import (
     PHER,
     RETURN,
 )
-from agents.controllers.moves import pick, random_free_dir, reset_action
 
 P_THRESHOLD = 0
 P_DETOUR = 1

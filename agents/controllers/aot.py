@@ -2,11 +2,11 @@
 
 `import numba` alone costs an agent process 88 MB.  numba's pycc compiles
 the very same `dispatch.answer_rows` (and everything it calls) and every
-kernel the arena controllers declare with `swarm.kernels.exported` (A*, the
+kernel the arena controllers declare with `swarm.core.kernels.exported` (A*, the
 GPR loops, the alignments, the field steps) into a plain extension module.
 Agent processes import that module, which needs only numpy, instead of the JIT.
 The module is named after the source digest and lives in the compile cache
-(swarm.jitcache), so an edited controller is rebuilt rather than run stale.
+(swarm.core.jitcache), so an edited controller is rebuilt rather than run stale.
 Building needs numba and a C compiler; when the build is missing, agent
 processes fall back to the JIT (same step, more memory).
 
@@ -18,14 +18,15 @@ from __future__ import annotations
 import importlib
 import os
 import shutil
-import sys
 import tempfile
 from pathlib import Path
 
-from swarm.jitcache import cache_root, source_digest
+from swarm.core.kernels import EXPORTS, built
+from swarm.core.kernels import ahead_of_time_dir as build_dir
+from swarm.core.kernels import ahead_of_time_module as module_name
 
-# Modules whose kernels agent processes call (swarm.kernels.exported).
-KERNEL_MODULES = ("swarm.rng", "agents.controllers.navigation.astar", "agents.controllers.navigation.dijkstra",
+# Modules whose kernels agent processes call (swarm.core.kernels.exported).
+KERNEL_MODULES = ("swarm.core.rng", "agents.controllers.navigation.astar", "agents.controllers.navigation.dijkstra",
                   "agents.controllers.bg.gpr", "agents.controllers.bg.senses", "agents.controllers.bg.saliences",
                   "agents.controllers.bg.places",
                   "agents.controllers.fingerprint.align", "agents.controllers.dft.fields")  # fmt: skip
@@ -53,18 +54,6 @@ def envelope_signature():
                    t.int64[:, ::1], t.float64[::1], t.int64, t.boolean, t.uint8[::1], t.int64[::1])  # fmt: skip
 
 
-def module_name() -> str:
-    return f"swarm_steps_{source_digest()}"
-
-
-def build_dir() -> Path:
-    return cache_root() / "aot"
-
-
-def built() -> Path | None:
-    return next(iter(sorted(build_dir().glob(f"{module_name()}.*.so"))), None)
-
-
 def build() -> Path:
     """Compile the step module (about a minute on 2 cores) unless it exists."""
     if (done := built()) is not None:
@@ -73,7 +62,6 @@ def build() -> Path:
 
     from agents.controllers.dispatch import answer_rows
     from agents.controllers.envelope import answer_message
-    from swarm import kernels
 
     for module in KERNEL_MODULES:  # they declare their kernels on import
         importlib.import_module(module)
@@ -85,7 +73,7 @@ def build() -> Path:
         cc.output_dir = tmp
         cc.export("answer_rows", signature())(answer_rows.py_func)
         cc.export("answer_message", envelope_signature())(answer_message.py_func)
-        for name, (kernel, sig) in sorted(kernels.EXPORTS.items()):
+        for name, (kernel, sig) in sorted(EXPORTS.items()):
             cc.export(name, sig)(kernel.py_func)
         cc.compile()
         (result,) = Path(tmp).glob(f"{module_name()}.*.so")
@@ -96,20 +84,6 @@ def build() -> Path:
             stale.unlink(missing_ok=True)
     shutil.rmtree(out / "__pycache__", ignore_errors=True)
     return final
-
-
-def load(name: str = "answer_rows"):
-    """A compiled function of the module (`answer_rows`, `astar`), or None when
-    it has not been built for this source."""
-    path = built()
-    if path is None:
-        return None
-    if str(path.parent) not in sys.path:
-        sys.path.insert(0, str(path.parent))
-    try:
-        return getattr(importlib.import_module(module_name()), name)
-    except (ImportError, AttributeError):
-        return None
 
 
 if __name__ == "__main__":

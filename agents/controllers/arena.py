@@ -3,7 +3,7 @@
 An arena controller is an object (it carries maps, fields or neurons):
 `reset(seed, agent, params)` once, then `step(perception) -> (left, right)`
 wheel speeds in m/s each tick, or (left, right, act) for a robot with a
-metabolism (world_server.metabolism.ACTS).  It sees only its robot's sensors (the
+metabolism (world_server.arena.metabolism.ACTS).  It sees only its robot's sensors (the
 perception dict) and what its paper gives the robot beforehand (`params`:
 the map it is given, its goal or route, its body's limits).
 `snapshot()` / `restore()` make a resumed run bit-equal (a snapshot may
@@ -95,7 +95,7 @@ def make_controller(name: str) -> ArenaController:
 
 def publications(controllers, agents) -> list[tuple[int, str, bytes]]:
     """(agent, share, msgpack payload) of every controller that has something to publish, in agent order."""
-    from swarm.protocol import pack
+    from swarm.core.wire import pack
 
     out = []
     for a, c in zip(agents, controllers, strict=True):
@@ -108,7 +108,7 @@ def publications(controllers, agents) -> list[tuple[int, str, bytes]]:
 def deliver(controllers, agents, shared: list[tuple[int, str, bytes]]) -> int:
     """Hand every controller what the others of its share published (not its own), in agent order.
     Returns the payloads refused (undecodable or malformed: counted, nothing of them merged)."""
-    from swarm.protocol import Rejected, unpack
+    from swarm.core.wire import Rejected, unpack
 
     refused = 0
     for a, c in zip(agents, controllers, strict=True):

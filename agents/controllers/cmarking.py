@@ -27,7 +27,15 @@ Params: params[P_CLIMB_PATIENCE].
 from numba import njit
 
 from agents.controllers.foraging import seek_resource, settle_mode, unload_if_home
-from agents.controllers.layout import (
+from agents.controllers.moves import (
+    descent_dir,
+    explore_dir,
+    extreme_dir_among,
+    opposite,
+    reset_action,
+    update_value,
+)
+from world_server.grid.face.layout import (
     A_MARK,
     A_MOVE,
     A_TRAIL_ID,
@@ -54,14 +62,6 @@ from agents.controllers.layout import (
     TRAIL,
     TRAIL_ERASE,
     TRAIL_PAINT,
-)
-from agents.controllers.moves import (
-    descent_dir,
-    explore_dir,
-    extreme_dir_among,
-    opposite,
-    reset_action,
-    update_value,
 )
 
 P_CLIMB_PATIENCE = 0

@@ -15,7 +15,9 @@ from agents.controllers.ant import (
     ant_step,
 )
 from agents.controllers.cmarking import P_CLIMB_PATIENCE, cmarking_step
-from agents.controllers.layout import (
+from agents.controllers.marking import marking_step
+from swarm.scenario import Scenario
+from world_server.grid.face.layout import (
     A_MARK,
     A_MODE,
     A_MOVE,
@@ -30,10 +32,8 @@ from agents.controllers.layout import (
     N_PARAMS,
     PERC_F_LEN,
     STAY,
-)  # fmt: skip
-from agents.controllers.marking import marking_step
-from swarm.protocol import ACT_ROW, OBS_INTS, OBS_PERCEPTION, R_ACT, R_AGENT, R_MARKED, R_MEM
-from swarm.scenario import Scenario
+)
+from world_server.grid.face.wire import ACT_ROW, OBS_INTS, OBS_PERCEPTION, R_ACT, R_AGENT, R_MARKED, R_MEM
 
 
 @njit(cache=True)
@@ -58,10 +58,10 @@ def answer_rows(kind, ints_flat, pf_flat, mems, slot_of, out, params, seed, tick
     """An agent process's whole answer to one observation message, in one call.
 
     `ints_flat` / `pf_flat` are the message's blocks as they came (read-only,
-    unchecked): K rows of agent, cell, integer perception (swarm.protocol.OBS_INTS)
+    unchecked): K rows of agent, cell, integer perception (world_server.grid.face.wire.OBS_INTS)
     and K rows of float perception.  `slot_of[agent]` is the agent's memory row in
     `mems` (-1, or an id past the table: not ours, skipped).  Writes one action row
-    per agent stepped (swarm.protocol.ACT_ROW: agent, action, whether its mark
+    per agent stepped (world_server.grid.face.wire.ACT_ROW: agent, action, whether its mark
     write lowers its cell's mark, memory) and returns how many, or -1 when the
     blocks disagree or hold a value that is not finite.  `null`: the benchmark
     floor, every agent answers STAY without running its controller."""
@@ -97,7 +97,7 @@ def answer_rows(kind, ints_flat, pf_flat, mems, slot_of, out, params, seed, tick
 def warm_up() -> None:
     """Compile, or load from the cache, the step kernel now: an agent's first
     observation must not wait for it (lock-step deadlines are short)."""
-    from agents.controllers.layout import new_action, new_memory, new_perception
+    from world_server.grid.face.layout import new_action, new_memory, new_perception
 
     pi, pf = new_perception()
     step_controller(MARKING, pi, pf, new_memory(1)[0], new_action(), np.zeros(N_PARAMS), np.int64(0), 0, 0)
@@ -106,7 +106,7 @@ def warm_up() -> None:
     answer_rows(MARKING, ints, np.frombuffer(pf.tobytes(), np.float64), new_memory(1), np.zeros(1, np.int64), out,
                 np.zeros(N_PARAMS), np.int64(0), np.int64(0), False)  # fmt: skip
     from agents.controllers.envelope import answer_message
-    from swarm.protocol import ENVELOPE, observations
+    from world_server.grid.face.wire import ENVELOPE, observations
 
     message = observations(0, np.zeros((1, OBS_INTS), np.int64), pf[None])  # bytes, as the runtime passes them
     answer_message(MARKING, message, new_memory(1), np.zeros(1, np.int64), out, np.zeros(N_PARAMS), np.int64(0), False,

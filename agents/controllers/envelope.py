@@ -1,11 +1,11 @@
 """A grid agent process's answer to one observation, envelope included, in one
 compiled call.
 
-The world packs every observation the same way (`swarm.protocol.observations`:
+The world packs every observation the same way (`world_server.grid.face.wire.observations`:
 a msgpack map of v, type, tick, ints, pf, in that order), so the agent reads
 those bytes where they stand instead of unpacking a dict, steps its agents
 (`dispatch.answer_rows`), and writes the action message's msgpack bytes as
-`swarm.protocol.pack_actions` would (tests hold the two byte for byte).  Any
+`world_server.grid.face.wire.pack_actions` would (tests hold the two byte for byte).  Any
 other message - a stop, a resumed run's memory, a wake, anything malformed -
 is left to the Python parser, which says what it is or why it is refused.
 Every read is bounds-checked: a short or lying buffer is NOT_PLAIN, never a
@@ -16,8 +16,8 @@ import numpy as np
 from numba import njit
 
 from agents.controllers.dispatch import answer_rows
-from swarm.protocol import ACT_ROW, ENVELOPE, NOT_PLAIN, R_MARKED
-from swarm.wire_bytes import (
+from world_server.grid.face.wire import ACT_ROW, ENVELOPE, NOT_PLAIN, R_MARKED
+from world_server.grid.face.wire_bytes import (
     ACT_HEAD,
     INTS_KEY,
     OBS_HEAD,

@@ -3,7 +3,8 @@ picking up resource, and dropping it at the base."""
 
 from numba import njit
 
-from agents.controllers.layout import (
+from agents.controllers.moves import opposite, resource_dir
+from world_server.grid.face.layout import (
     A_LOAD,
     A_MOVE,
     A_UNLOAD,
@@ -17,7 +18,6 @@ from agents.controllers.layout import (
     RETURN,
     SEARCH,
 )
-from agents.controllers.moves import opposite, resource_dir
 
 
 @njit(cache=True, inline="always")

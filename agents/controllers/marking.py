@@ -5,14 +5,8 @@ alone and carried home by descending the marks."""
 from numba import njit
 
 from agents.controllers.foraging import read_load_outcome, seek_resource, unload_if_home
-from agents.controllers.layout import (
-    A_MARK,
-    A_MOVE,
-    M_MODE,
-    M_PREV,
-    RETURN,
-)
 from agents.controllers.moves import descent_dir, explore_dir, opposite, reset_action, update_value
+from world_server.grid.face.layout import A_MARK, A_MOVE, M_MODE, M_PREV, RETURN
 
 
 @njit(cache=True, inline="always")

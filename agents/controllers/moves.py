@@ -2,14 +2,15 @@
 
 Candidate neighbours are kept as 4-bit masks (bit d = direction d), so the
 hot path allocates nothing.  Every choice among equals is uniform, drawn from
-the counter-based generator (swarm.rng): a controller's decision depends only
+the counter-based generator (swarm.core.rng): a controller's decision depends only
 on (seed, agent, tick).
 """
 
 import numpy as np
 from numba import njit
 
-from agents.controllers.layout import (
+from swarm.core.rng import draw_below
+from world_server.grid.face.layout import (
     A_DEPOSIT,
     A_LOAD,
     A_MARK,
@@ -24,7 +25,6 @@ from agents.controllers.layout import (
     STAY,
     TRAIL_KEEP,
 )
-from swarm.rng import draw_below
 
 
 @njit(cache=True, inline="always")

@@ -1,5 +1,5 @@
 """The in-process arena engine: the world and every robot's controller in one
-process, in the lock-step tick of world_server.arena (all perceive, all
+process, in the lock-step tick of world_server.arena.world (all perceive, all
 decide, the world integrates one control period)."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from agents.controllers.arena import ShareLog, as_action, deliver, make_controll
 from agents.controllers.navigation.astar import Planner
 from swarm.arena.scenario import ArenaScenario, controller_params
 from swarm.stepper import step_world
-from world_server.arena import ArenaWorld
+from world_server.arena.world import ArenaWorld
 
 OPTIMUM_CELL, OPTIMUM_CLEARANCE = 0.01, 0.04  # the DFT paper's A* optimum
 MAX_OPTIMUM_CELLS = 4_000_000  # coarser cells on large floors (docs/arena.md)
@@ -60,7 +60,7 @@ class ArenaEngine:
             c.reset(scenario.seed, a, controller_params(scenario, a))
             self.controllers.append(c)
         self.wall_seconds = 0.0
-        self.actions = np.zeros((self.world.n, 3))  # wheel speeds and an act (world_server.arena.ACTION_WIDTH)
+        self.actions = np.zeros((self.world.n, 3))  # wheel speeds and an act (world_server.arena.world.ACTION_WIDTH)
         self.agent_ids = list(range(len(self.controllers)))
         self.shares = ShareLog()
         self.refused_shared = 0

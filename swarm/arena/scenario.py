@@ -30,7 +30,8 @@ from typing import Any
 import numpy as np
 
 from agents.controllers.arena import ARENA_CONTROLLERS, REQUIRES, check_table
-from swarm.arena.models import (
+from swarm.scenario import ScenarioError, no_unknown, typed
+from world_server.arena.face.robots import (
     IR,
     MODELS,
     ZONE_KINDS,
@@ -42,9 +43,8 @@ from swarm.arena.models import (
     RobotModel,
     Sonar,
 )
-from swarm.scenario import ScenarioError, no_unknown, typed
-from world_server.metabolism import MetabolismParams
-from world_server.sensors import NOISE_LEVELS, Noise
+from world_server.arena.metabolism import MetabolismParams
+from world_server.arena.sensors import NOISE_LEVELS, Noise
 
 START_STREAM = 0x53544152  # keeps start-pose draws apart from every other use of the seed
 GOAL_STREAM = 0x474F414C

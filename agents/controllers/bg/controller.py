@@ -24,12 +24,12 @@ from agents.controllers.bg.gpr import BasalGanglia, select_dorsal, select_ventra
 from agents.controllers.bg.places import DIRECTIONS, WAYS, Navigator, NavParams
 from agents.controllers.bg.saliences import SALIENCES, Drives, saliences
 from agents.controllers.bg.senses import RESOURCES, Reflex, sense
-from agents.controllers.tables import params_from_table
-from swarm.arena.models import ZONE_KINDS
+from swarm.core.tables import params_from_table
+from world_server.arena.face.robots import ZONE_KINDS
 
 USABLE_ZONE = {"DA": "dangerous", "Ep": "ingesting", "E": "digesting"}
 USABLE_BITS = {r: 1 << ZONE_KINDS.index(z) for r, z in USABLE_ZONE.items()}  # in the world's `zones` reading
-DORSAL_ACTS = ("ReloadE", "ReloadEp")  # channel order; world_server.metabolism.ACTS codes 1, 2
+DORSAL_ACTS = ("ReloadE", "ReloadEp")  # channel order; world_server.arena.metabolism.ACTS codes 1, 2
 
 
 @dataclass(frozen=True)

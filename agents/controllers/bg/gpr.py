@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm.kernels import exported, njit
+from swarm.core.kernels import exported, njit
 
 # Nuclei, in the order of the state's rows.
 D1, D2, STN, GP, EP, VL, TRN, CTX = range(8)

@@ -46,8 +46,8 @@ import numpy as np
 from agents.controllers.bg.senses import to_allocentric
 from agents.controllers.navigation.dijkstra import shortest_routes
 from agents.controllers.navigation.topomap import MapParams, TopoMap, topomap_from_data, topomap_to_data
-from swarm.kernels import exported, njit
-from swarm.rng import fill_uniform
+from swarm.core.kernels import exported, njit
+from swarm.core.rng import fill_uniform
 
 DIRECTIONS = 36
 ANGLES = np.arange(DIRECTIONS) * (2 * math.pi / DIRECTIONS)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm.kernels import exported, njit
+from swarm.core.kernels import exported, njit
 
 SALIENCES = ("survival", "fear", "tmaze")  # eqs. 15-17 (exps. 1, 2); 15, 16, 18 (exp. 3.1); 19, 20 (exp. 3.2)
 

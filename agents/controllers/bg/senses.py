@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from swarm.kernels import exported, njit
+from swarm.core.kernels import exported, njit
 
 RESOURCES = ("DA", "Ep", "E")  # dangerous, potential energy (ingesting), energy (digesting)
 RESOURCE_GREY = np.array([31, 127, 255])

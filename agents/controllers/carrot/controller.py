@@ -16,7 +16,7 @@ import numpy as np
 
 from agents.controllers.navigation.astar import Planner
 from agents.controllers.navigation.follow import CarrotFollower
-from agents.controllers.tables import params_from_table
+from swarm.core.tables import params_from_table
 
 
 @dataclass(frozen=True)

@@ -30,7 +30,7 @@ from agents.controllers.dft.context import SensedContext
 from agents.controllers.dft.fields import Engine, fill_noise, noise_key
 from agents.controllers.dft.robot import Interface, gaussian_2d
 from agents.controllers.navigation.astar import occupancy
-from agents.controllers.tables import params_from_table
+from swarm.core.tables import params_from_table
 
 FIELD_STREAM, MAP_STREAM = 1, 2
 MAP_NOISE = {"none": 0.005, "low": 0.05, "high": 1.0}  # std per map cell, a wall being 1 (original code)

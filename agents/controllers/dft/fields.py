@@ -33,9 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from agents.controllers.dft import pocketfft
-from swarm import rng_scalar
-from swarm.kernels import exported, njit
-from swarm.rng import mix64
+from swarm.core import rng_scalar
+from swarm.core.kernels import exported, njit
+from swarm.core.rng import mix64
 
 DTYPE = np.float32
 CDTYPE = np.complex64
@@ -383,7 +383,7 @@ class Engine:
                 times[f"couplings {grp.label}"] = times.get(f"couplings {grp.label}", 0.0) + t1 - t0
                 t0 = t1
         for g, grp in enumerate(self.groups):
-            grp.update(np.uint64(rng_scalar.mix64(int(key) ^ (g + 1))))  # swarm.rng's mix64, bit for bit
+            grp.update(np.uint64(rng_scalar.mix64(int(key) ^ (g + 1))))  # swarm.core.rng's mix64, bit for bit
             if clock:
                 t1 = clock()
                 times[f"fields {grp.label}"] = times.get(f"fields {grp.label}", 0.0) + t1 - t0

@@ -30,8 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from agents.controllers.tables import params_from_table
-from swarm.kernels import exported, njit
+from swarm.core.kernels import exported, njit
+from swarm.core.tables import params_from_table
 
 HUES = 16  # symbols 0..15: hue bins 'A'..'P'
 V, C, N = 16, 17, 18  # vertical edge, laser corner; N + k - 1: a run of k empty-space quanta

@@ -28,7 +28,7 @@ from agents.controllers.fingerprint.signatures import (
 from agents.controllers.navigation.gridbelief import GridBelief
 from agents.controllers.navigation.mapshare import SharedMap
 from agents.controllers.navigation.topomap import MapParams, TopoMap
-from agents.controllers.tables import params_from_table
+from swarm.core.tables import params_from_table
 
 DRIVES = ("route", "explore")
 MODES = ("map", "localize")

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from agents.controllers.fingerprint.align import HUES, MAX_RUN, C, N, V, paper_length, to_string
-from agents.controllers.tables import params_from_table
+from swarm.core.tables import params_from_table
 
 TWO_PI = 2 * math.pi
 

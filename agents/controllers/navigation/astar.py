@@ -7,7 +7,7 @@ Ours is exact A* (octile heuristic, consistent, cells may be re-opened), where
 the original code stopped at the first chain that reached the start; our L_o is
 therefore never longer than theirs (docs/arena.md).
 
-The search is a compiled kernel (swarm.kernels): the JIT's in process, the
+The search is a compiled kernel (swarm.core.kernels): the JIT's in process, the
 agents' ahead-of-time build in agent processes, which then run without numba.
 """
 
@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from swarm.kernels import exported, njit
+from swarm.core.kernels import exported, njit
 
 SQRT2 = math.sqrt(2.0)
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from swarm.kernels import exported, njit
+from swarm.core.kernels import exported, njit
 
 NO_NODE = -9999  # the predecessor of the source and of unreachable nodes (scipy's value)
 

@@ -5,7 +5,7 @@ It reads whichever range sensor the robot has (laser, sonar or IR) and sees
 than `avoid` (in robot radii from the centre) turns it away from the nearer
 side, on the spot when very close; otherwise it drives at `speed` of its wheel
 limit and every tick starts a random turn with probability `turn_chance`, held
-for a random number of ticks.  Every random number is swarm.rng's draw keyed by
+for a random number of ticks.  Every random number is swarm.core.rng's draw keyed by
 (seed, agent, tick), so a run is reproducible in either runtime.  It needs no
 map and no position: the baseline for exploring, and a second controller for
 mixed arenas.
@@ -19,9 +19,9 @@ from typing import Any
 
 import numpy as np
 
-from agents.controllers.tables import params_from_table
-from swarm.arena.models import IR_DISTANCE, IR_VALUE
-from swarm.rng_scalar import draw_unit
+from swarm.core.rng_scalar import draw_unit
+from swarm.core.tables import params_from_table
+from world_server.arena.face.robots import IR_DISTANCE, IR_VALUE
 
 
 @dataclass(frozen=True)

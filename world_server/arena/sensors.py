@@ -3,8 +3,8 @@
 This is the simulator face of the sensors (ARGoS's split): which rays leave a
 robot, and how ranges and hit colours become readings with noise.  The
 controller face is only the perception dict it receives.  All rays of all
-robots are cast together by world_server.raycast; a suite reads its block of
-the result.  Every noise draw comes from swarm.rng keyed by (seed, agent,
+robots are cast together by world_server.arena.raycast; a suite reads its block of
+the result.  Every noise draw comes from swarm.core.rng keyed by (seed, agent,
 tick, stream), so a reading never depends on who else is in the run.
 """
 
@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm.arena.models import IR_DISTANCE, IR_VALUE, RobotModel
-from swarm.rng import fill_normal, fill_uniform
-from world_server.raycast import MARK, SOLID
+from swarm.core.rng import fill_normal, fill_uniform
+from world_server.arena.face.robots import IR_DISTANCE, IR_VALUE, RobotModel
+from world_server.arena.raycast import MARK, SOLID
 
 # Noise streams, one per kind of draw.
 S_SONAR_BEARING, S_SONAR_RANGE, S_IR, S_LASER, S_ODOMETRY, S_COMPASS, S_POSITION = range(1, 8)

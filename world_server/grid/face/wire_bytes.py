@@ -1,17 +1,17 @@
 """Compiled reading and writing of the grid's msgpack messages where their
 bytes lie: both ends' one-call envelopes (the agent's answer,
 `agents/controllers/envelope.py`, and the world's acceptance of actions,
-`world_server/grid_wire.py`) read and write the same fixed layout that
-`swarm.protocol` packs.  Every read is bounds-checked: a short or lying
+`world_server/grid/accept.py`) read and write the same fixed layout that
+`world_server.grid.face.wire` packs.  Every read is bounds-checked: a short or lying
 buffer gives -1, never a read past its end.
 """
 
 import numpy as np
 from numba import njit
 
-from swarm.protocol import FAMILY_GRID, VERSION
+from swarm.core.wire import FAMILY_GRID, VERSION
 
-# The fixed bytes of both messages (msgpack: fixmap of 5, fixstr keys, in the order swarm.protocol packs them).
+# The fixed bytes of both messages (msgpack: fixmap of 5, fixstr keys, in the order face.wire packs them).
 OBS_HEAD = np.frombuffer(b"\x85\xa1v" + bytes([VERSION]) + b"\xa4type\xa3obs\xa4tick", np.uint8).copy()
 ACT_HEAD = np.frombuffer(b"\x85\xa1v" + bytes([VERSION]) + b"\xa4type\xa3act\xa6family\xa4" + FAMILY_GRID.encode()
                           + b"\xa4tick", np.uint8).copy()  # fmt: skip

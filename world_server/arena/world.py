@@ -14,13 +14,13 @@ from typing import Any
 
 import numpy as np
 
-from swarm.arena.models import ZONE_KINDS
 from swarm.arena.scenario import ArenaScenario
-from world_server.drive import DiffDrive
-from world_server.metabolism import ACTS, Metabolism
-from world_server.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
-from world_server.sensors import Suite
-from world_server.wheels import (
+from world_server.arena.drive import DiffDrive
+from world_server.arena.face.robots import ZONE_KINDS
+from world_server.arena.metabolism import ACTS, Metabolism
+from world_server.arena.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
+from world_server.arena.sensors import Suite
+from world_server.arena.wheels import (
     ACTION_LEN,
     ACTION_WIDTH,
     NOT_FINITE,

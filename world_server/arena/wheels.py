@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit
 
 ACTION_LEN = 2  # left and right wheel speeds, m/s
-ACTION_WIDTH = 3  # ... and a consummatory act (world_server.metabolism.ACTS), optional: 0 when left out
+ACTION_WIDTH = 3  # ... and a consummatory act (world_server.arena.metabolism.ACTS), optional: 0 when left out
 REJECT_REASONS = ("not finite", "over the wheel limit", "wrong shape", "unknown act")
 NOT_FINITE, OVER_LIMIT, UNKNOWN_ACT = (REJECT_REASONS.index(r) for r in ("not finite", "over the wheel limit",
                                                                           "unknown act"))  # fmt: skip

@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
-from world_server import contacts
+from world_server.arena import contacts
 
 WALL_TYPE, ROBOT_TYPE = 1, 2
 BLOCKED_SHARE = 0.5  # moving at under half of the commanded speed counts as blocked
@@ -182,7 +182,7 @@ class DiffDrive:
         return self._positions()[:, 2:]
 
     def contacts(self) -> dict[str, np.ndarray]:
-        """The space's cached contacts and clock (world_server.contacts)."""
+        """The space's cached contacts and clock (world_server.arena.contacts)."""
         return contacts.save(self.space, lambda shape: shape.key)
 
     def take_contacts(self, state: dict[str, np.ndarray]) -> None:

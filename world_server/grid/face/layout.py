@@ -18,7 +18,7 @@ Perception (what the paper's robot senses, never coordinates): the current cell
 
 Float perception: PHER+k, the pheromone on cell k (ants only).
 
-Action (one per tick; the world applies it, see world_server.grid):
+Action (one per tick; the world applies it, see world_server.grid.world):
 
     A_MOVE      0..3 = N, E, S, W; STAY = 4
     A_MARK      value to min-merge into the current cell (MARK_NONE = no write)

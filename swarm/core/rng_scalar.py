@@ -1,4 +1,4 @@
-"""swarm.rng's draws in plain Python, for code that asks for a few numbers per
+"""swarm.core.rng's draws in plain Python, for code that asks for a few numbers per
 tick: the very same bits (tested against the compiled ones), without loading
 numba into an agent process (88 MB) for three draws a tick."""
 
@@ -24,5 +24,5 @@ def draw_u64(seed: int, agent: int, tick: int, draw: int) -> int:
 
 
 def draw_unit(seed: int, agent: int, tick: int, draw: int) -> float:
-    """A uniform float in [0, 1) from the top 53 bits of one draw (swarm.rng.draw_unit)."""
+    """A uniform float in [0, 1) from the top 53 bits of one draw (swarm.core.rng.draw_unit)."""
     return float(draw_u64(int(seed), int(agent), int(tick), int(draw)) >> 11) * _TO_UNIT

@@ -11,7 +11,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from agents.controllers.layout import (
+from agents.controllers.moves import update_value
+from swarm.core.wire import MAX_MESSAGE_BYTES
+from world_server.grid.face.layout import (
     A_DEPOSIT,
     A_LOAD,
     A_MARK,
@@ -27,20 +29,9 @@ from agents.controllers.layout import (
     PERC_F_LEN,
     STAY,
     TRAIL_ERASE,
-)  # fmt: skip
-from agents.controllers.moves import update_value
-from swarm.protocol import (
-    ACT_ROW,
-    MAX_MESSAGE_BYTES,
-    NOT_PLAIN,
-    OBS_INTS,
-    OBS_PERCEPTION,
-    R_ACT,
-    R_AGENT,
-    R_MARKED,
-    R_MEM,
 )
-from swarm.wire_bytes import (
+from world_server.grid.face.wire import ACT_ROW, NOT_PLAIN, OBS_INTS, OBS_PERCEPTION, R_ACT, R_AGENT, R_MARKED, R_MEM
+from world_server.grid.face.wire_bytes import (
     ACT_HEAD,
     INTS_KEY,
     OBS_HEAD,
@@ -56,7 +47,7 @@ from swarm.wire_bytes import (
     write_uint,
     write_words,
 )
-from world_server.grid import perceive
+from world_server.grid.world import perceive
 
 ACTIVE = 2  # world_server.server.ACTIVE (a slot whose agent is in the run)
 
@@ -96,7 +87,7 @@ OBS_OVERHEAD = 64  # bytes of an observation message besides its blocks (at most
 @njit(cache=True)
 def write_observations(tick, ints, pf, bounds, out, offsets):
     """Every agent process's observation message, byte for byte as
-    `swarm.protocol.observations` packs it, one after another in `out`:
+    `world_server.grid.face.wire.observations` packs it, one after another in `out`:
     process g's rows are bounds[g] .. bounds[g + 1] of `ints` and `pf` (both
     C-contiguous), its message out[offsets[g]:offsets[g + 1]].  Returns the
     end.  `out` holds OBS_OVERHEAD bytes a process besides the blocks."""
@@ -173,7 +164,7 @@ def _accept(rows, slots, group_ids, group, lockstep, acted, acts, mark_floor, me
 def accept_message(buf, first_tick, last_tick, slots, group_ids, group, lockstep, acted, acts, mark_floor, memory,
                    refused):  # fmt: skip
     """An action message from process `group`, read where its bytes lie (laid
-    out as `swarm.protocol.pack_actions` packs it) and applied as `accept_rows`
+    out as `world_server.grid.face.wire.pack_actions` packs it) and applied as `accept_rows`
     applies its rows, in one call.  Returns how many rows were accepted (each
     refused one is added to its reason's count in `refused`, which the caller
     reads once a tick), or NOT_PLAIN, having applied nothing: a tick outside

@@ -12,7 +12,7 @@ The tick ends when every body is within `arrive` of its target, or after
 `timeout` simulated seconds.  A move counts only for a body that arrived; a
 body that did not keeps its logical cell, stays where it was pushed, and drives
 on from there next tick (round walls along the grid when it was pushed more than
-a cell away: world_server/steering.py).  The base is a nest (see `_nest`).  A blocked body
+a cell away: world_server/grid/steering.py).  The base is a nest (see `_nest`).  A blocked body
 also steps to its right (keep-right traffic rule), so robots that fit side by
 side pass each other.  Time spent blocked is the simulated time a body with an
 unreached target moved at less than half of its commanded speed.  Bodies
@@ -27,9 +27,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from agents.controllers.layout import A_MOVE, DIR_DC, DIR_DR, N_DIRS, STAY
 from swarm.scenario import PhysicsParams
-from world_server.steering import waypoints
+from world_server.grid.face.layout import A_MOVE, DIR_DC, DIR_DR, N_DIRS, STAY
+from world_server.grid.steering import waypoints
 
 _GOLDEN_ANGLE = np.pi * (3.0 - np.sqrt(5.0))
 # Collision categories: walls; bodies; bodies in the nest (the base cell), which

@@ -20,7 +20,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from agents.controllers.layout import (
+from swarm.scenario import Layout, PhysicsParams, Scenario
+from world_server.grid.bodies import Bodies
+from world_server.grid.face.layout import (
     A_DEPOSIT,
     A_LOAD,
     A_MARK,
@@ -49,10 +51,8 @@ from agents.controllers.layout import (
     TRAIL_PAINT,
     new_perception,
 )
-from swarm.scenario import Layout, PhysicsParams, Scenario
-from world_server.bodies import Bodies
+from world_server.grid.steering import waypoints
 from world_server.persist import ARRAYS as PERSISTED
-from world_server.steering import waypoints
 
 # Integer layers of the grid, stacked in one (N_LAYERS, H, W) array.
 L_OBST = 0

@@ -24,8 +24,8 @@ from typing import Any
 import msgpack
 import numpy as np
 
-from swarm import msgpack_views
-from swarm.protocol import HEADERS, Rejected, bin_header
+from swarm.core import msgpack_views
+from swarm.core.wire import HEADERS, Rejected, bin_header
 
 _ARRAY = 1  # msgpack extension code: [dtype, shape, bytes]
 MAX_MEMORY_BYTES = 256 * 1024 * 1024  # one controller's memory; a DFT robot on large-maze takes ~3.2 MB

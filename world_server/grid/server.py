@@ -18,12 +18,11 @@ from pathlib import Path
 import numpy as np
 
 from agents.controllers.dispatch import controller_params
-from agents.controllers.layout import A_MARK, A_MODE, A_MOVE, A_TRAIL_OP, MARK_NONE, PERC_F_LEN, STAY, new_memory
-from swarm import protocol as proto
+from swarm.core import wire
 from swarm.engine import UNTIL, is_done
-from world_server import grid_wire, persist
-from world_server.grid import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, GridWorld
-from world_server.grid_wire import (
+from world_server import persist
+from world_server.grid import accept as grid_wire
+from world_server.grid.accept import (
     OBS_OVERHEAD,
     REFUSALS,
     accept_messages,
@@ -32,11 +31,14 @@ from world_server.grid_wire import (
     observe_rows,
     write_observations,
 )
+from world_server.grid.face import wire as proto
+from world_server.grid.face.layout import A_MARK, A_MODE, A_MOVE, A_TRAIL_OP, MARK_NONE, PERC_F_LEN, STAY, new_memory
+from world_server.grid.world import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, GridWorld
 from world_server.server import ACTIVE, JOINING, WorldServer
 
 
 class GridServer(WorldServer):
-    family = proto.FAMILY_GRID
+    family = wire.FAMILY_GRID
 
     def _make_world(self) -> None:
         self.world = GridWorld(self.scenario)
@@ -211,7 +213,7 @@ class GridServer(WorldServer):
 
     def _parsed_act(self, raw: bytes, group: str) -> int:
         msg = proto.parse_acts(raw)
-        if isinstance(msg, proto.Rejected):
+        if isinstance(msg, wire.Rejected):
             self.stats.reject(f"act: {msg.reason}")
             return 0
         if not self._current(msg.tick):
@@ -240,7 +242,7 @@ class GridServer(WorldServer):
     def _on_marks_query(self, query) -> None:
         marks = self.world.layers[L_MARK]
         grid = np.where(marks == MARK_NONE, -1, marks)
-        payload = proto.pack({"type": "marks", "tick": self.tick, "height": int(grid.shape[0]),
+        payload = wire.pack({"type": "marks", "tick": self.tick, "height": int(grid.shape[0]),
                               "width": int(grid.shape[1]), "marks": grid.ravel().tolist(),
                               "trails": self.world.trails.ravel().tolist()})  # fmt: skip
         self._reply(query, f"{self.keys.prefix}/marks/grid", payload)

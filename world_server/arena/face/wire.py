@@ -1,4 +1,4 @@
-"""The arena family of the wire protocol (keys and framing: swarm/protocol.py).
+"""The arena family of the wire protocol (keys and framing: world_server/grid/face/wire.py).
 
     obs/<group>   world -> agent process: for one tick, every agent's sensor
                   readings, each array as [dtype, shape, little-endian bytes]
@@ -10,7 +10,7 @@
                   tick t's writes at tick t + 1, as in the in-process engine
                   At the ticks after which the world saves its state (`keep` in the
                   observation), the action also carries each controller's memory
-                  (`memory`: [agent, bytes of swarm.memory_codec]); the world stores it
+                  (`memory`: [agent, bytes of swarm.core.memory_codec]); the world stores it
                   and hands it back, as a `memory` message on obs/<group> or in a
                   newcomer's welcome, when a restarted world resumes the run
     plans/<group> agent process -> world: one agent's planned path (P x 2 float64, m), once
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import msgpack
 import numpy as np
 
-from swarm.protocol import (
+from swarm.core.wire import (
     FAMILY_ARENA,
     HEADERS,
     HandBack,
@@ -55,8 +55,8 @@ MAX_PLAN_POINTS = 2000  # 32 KB: a plan message stays under the world's message 
 
 MAX_SHARED = 4 * 1024 * 1024  # bytes of shared payloads in one message
 Shared = list[tuple[int, str, bytes]]  # (agent, share, payload)
-Memories = list[tuple[int, bytes | memoryview]]  # (agent, its controller's memory, swarm.memory_codec)
-MemoryPieces = list[tuple[int, list]]  # (agent, its memory as swarm.memory_codec.pieces): sent without a blob
+Memories = list[tuple[int, bytes | memoryview]]  # (agent, its controller's memory, swarm.core.memory_codec)
+MemoryPieces = list[tuple[int, list]]  # (agent, its memory as swarm.core.memory_codec.pieces): sent without a blob
 
 
 @dataclass(frozen=True)

@@ -18,18 +18,18 @@ from pathlib import Path
 import numpy as np
 
 from agents.controllers.arena import SHARES, ShareLog
-from swarm import protocol as proto
-from swarm import protocol_arena as arena_proto
 from swarm.arena.engine import arena_summary
 from swarm.arena.scenario import controller_params
+from swarm.core import wire
 from world_server import persist
-from world_server.arena import ArenaWorld
+from world_server.arena.face import wire as arena_proto
+from world_server.arena.world import ArenaWorld
 from world_server.history import SharedHistory
 from world_server.server import ACTIVE, FREE, JOINING, LOST, WorldServer
 
 
 class ArenaServer(WorldServer):
-    family = proto.FAMILY_ARENA
+    family = wire.FAMILY_ARENA
 
     def _make_world(self) -> None:
         s = self.scenario
@@ -233,15 +233,15 @@ class ArenaServer(WorldServer):
             self.shared_history.add(self.tick - 1, share, a, payload)
             self.session.put(f"{self.keys.prefix}/{share}/{a}", payload)
             if self.recorder is not None and share == "map":
-                data = proto.unpack(payload, len(payload) + 1)
-                if not isinstance(data, proto.Rejected):
+                data = wire.unpack(payload, len(payload) + 1)
+                if not isinstance(data, wire.Rejected):
                     self.recorder.log_published_map(self.tick - 1, a, data)
 
     def _on_shared_query(self, share: str, query) -> None:
         """Every publication of every agent in the key space, one reply per agent."""
         try:
             for a, history in self.shared_history.of(share):
-                query.reply(f"{self.keys.prefix}/{share}/{a}", proto.pack({"agent": a, "updates": history}))
+                query.reply(f"{self.keys.prefix}/{share}/{a}", wire.pack({"agent": a, "updates": history}))
         finally:
             query.drop()
 

@@ -7,7 +7,7 @@ machine, make exactly the choices it would make inside the in-process engine.
 
 import numpy as np
 
-from swarm.kernels import exported, njit
+from swarm.core.kernels import exported, njit
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _TICK_MULT = np.uint64(0xD1B54A32D192ED03)

@@ -1,4 +1,4 @@
-"""Where a physical body drives within a tick (world_server/bodies.py).
+"""Where a physical body drives within a tick (world_server/grid/bodies.py).
 
 A body drives straight to the centre of its target cell when it is in that
 cell or next to it, the usual case: the straight line then stays inside free
@@ -11,7 +11,7 @@ pushed farther than that drives straight, as before.
 
 from numba import njit
 
-from swarm.wavefront import bfs_distances
+from world_server.grid.wavefront import bfs_distances
 
 WINDOW = 8  # cells each way around the target that the BFS covers
 _DR = (-1, 0, 1, 0)
