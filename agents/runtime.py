@@ -5,7 +5,8 @@ joins (the world hands out ids, so identical processes need no configuration),
 declares a liveliness token per agent, and for every observation runs the very
 step the in-process engine runs, then sends the actions on its act key.  What
 a family's controllers are and how their messages look is the subclass's:
-`GridAgentRuntime` (below) and `agents.arena_runtime.ArenaAgentRuntime`.
+`agents.grid_runtime.GridAgentRuntime` and `agents.arena_runtime.ArenaAgentRuntime`
+(`agents.runtimes.make_runtime` picks one).
 """
 
 from __future__ import annotations
@@ -14,33 +15,14 @@ import threading
 import time
 import uuid
 
-import numpy as np
-
-from agents.controllers.arena import ARENA_CONTROLLERS
-from swarm.core import kernels, wire
+from swarm.core import wire
 from swarm.core.bus import DEFAULT_ENDPOINT, open_client
 from swarm.core.errors import RunError
-from swarm.monitor import world_info
-from world_server.grid.face import wire as proto
-from world_server.grid.face.layout import controller_kind, new_memory
+from swarm.core.wire import world_info
 
 
 class JoinRefused(RunError):
     pass
-
-
-def load_step():
-    """(`envelope.answer_message`, `dispatch.answer_rows`): the ahead-of-time build's
-    when it exists (no numba in this process), else the JIT's (compiled or loaded
-    from the cache now)."""
-    built = kernels.load("answer_message"), kernels.load("answer_rows")
-    if None not in built:
-        return built
-    from agents.controllers.dispatch import answer_rows, warm_up
-    from agents.controllers.envelope import answer_message
-
-    warm_up()
-    return answer_message, answer_rows
 
 
 class AgentRuntime:
@@ -220,76 +202,3 @@ class AgentRuntime:
         for d in [*self._decls, *self.tokens.values()]:
             d.undeclare()
         self.session.close()
-
-
-class GridAgentRuntime(AgentRuntime):
-    """Grid controllers: one compiled call checks and steps the whole batch
-    (`dispatch.answer_rows`); memory per agent."""
-
-    family = wire.FAMILY_GRID
-
-    def _prepare(self, count: int) -> None:
-        self.kind = controller_kind(self.controller)
-        self.answer_message, self.answer_rows = load_step()
-        self.mem = new_memory(count)
-        self.rows = np.zeros((count, proto.ACT_ROW), dtype=np.int64)  # the action rows, reused
-        # The action message's bytes and the call's info (rows, any mark write, tick): the compiled call
-        # writes them through numpy views, the short way reads them without numpy (a slice, a memoryview).
-        self.out_bytes = bytearray(proto.ENVELOPE + count * proto.ACT_ROW * 8)
-        self.out = np.frombuffer(self.out_bytes, dtype=np.uint8)
-        info = bytearray(3 * 8)
-        self.info, self.rows_written = np.frombuffer(info, dtype=np.int64), memoryview(info).cast("q")
-        self.slot_table = np.full(0, -1, dtype=np.int64)  # agent id -> its slot (memory row), -1: not ours
-        self.seed = 0
-        self.params = np.zeros(1)
-
-    def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
-        self.seed = int(msg["seed"])  # a Python int: no numpy scalar to convert at every call
-        self.params = np.array(msg["params"], dtype=np.float64)
-        # the slot's memory: fresh, or where a resumed run's agent was saved (this one takes it over)
-        self.mem[slot] = msg.get("memory", new_memory(1)[0])
-        self.slot_table[self.slot_table == slot] = -1
-        if agent >= len(self.slot_table):
-            self.slot_table = np.concatenate([self.slot_table, np.full(agent + 1 - len(self.slot_table), -1)])
-        self.slot_table[agent] = slot
-
-    def _parse(self, data: bytes):
-        return proto.obs_blocks(data)
-
-    def _answer_raw(self, raw: bytes) -> int | None:
-        """Step every agent of ours in the observation and send the action
-        message, envelope and all from one compiled call (`envelope`); mark
-        writes ride the action rows."""
-        size = self.answer_message(self.kind, raw, self.mem, self.slot_table, self.rows,
-                                   self.params, self.seed, self.null, self.out, self.info)  # fmt: skip
-        if size == proto.NOT_PLAIN:
-            return None
-        if size < 0:
-            return 0  # a malformed observation: not answered (the world counts the miss)
-        self.act_publisher.put(self.out_bytes[:size])
-        return self.rows_written[0]
-
-    def _restore(self, memory: proto.Memory) -> None:
-        for agent, *words in memory.rows.tolist():
-            if (slot := self.slot_of.get(agent)) is not None:
-                self.mem[slot] = words
-
-    def _answer(self, obs: proto.ObsBlocks) -> int:
-        """An observation in another layout than our world's (its keys in another
-        order, say): the same step through the parsed blocks."""
-        n = self.answer_rows(self.kind, np.frombuffer(obs.ints, "<i8"), np.frombuffer(obs.pf, "<f8"), self.mem,
-                             self.slot_table, self.rows, self.params, self.seed, obs.tick, self.null)  # fmt: skip
-        if n < 0:
-            return 0  # a malformed observation: not answered (the world counts the miss)
-        self.act_publisher.put(proto.pack_actions(obs.tick, self.rows[:n]))
-        return n
-
-
-def make_runtime(run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
-                 **kw) -> AgentRuntime:  # fmt: skip
-    """The runtime of the controller's family."""
-    if controller in ARENA_CONTROLLERS:
-        from agents.arena_runtime import ArenaAgentRuntime
-
-        return ArenaAgentRuntime(run_id, controller, connect, count, **kw)
-    return GridAgentRuntime(run_id, controller, connect, count, **kw)

@@ -18,8 +18,8 @@ from swarm.cli_arena import (
     print_arena_summary,
     run_arena,
 )
-from swarm.core.errors import RecordingError, RunError, raise_interrupt
-from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, ScenarioError, bundled_scenarios, is_arena, load_scenario
+from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_interrupt
+from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, bundled_scenarios, is_arena, load_scenario
 
 CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
 FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize", "fingerprint-together")
@@ -480,7 +480,7 @@ def _scenario(args):
 
 
 def cmd_world(args) -> int:
-    from world_server.server import serve
+    from world_server.serve import serve
 
     scenario = _scenario(args)
     if args.until != "foraged" and scenario.controller == "ant":
@@ -497,7 +497,8 @@ def cmd_world(args) -> int:
 
 
 def cmd_agent(args) -> int:
-    from agents.runtime import JoinRefused, make_runtime
+    from agents.runtime import JoinRefused
+    from agents.runtimes import make_runtime
     from swarm.core.wire import ENDED
 
     try:

@@ -9,7 +9,7 @@ import sys
 
 import numpy as np
 
-from swarm.scenario import ScenarioError
+from swarm.core.errors import ScenarioError
 
 
 def _floats(n_min: int, n_max: int, what: str):

@@ -15,8 +15,9 @@ import numpy as np
 from numba import njit
 
 from agents.controllers.dispatch import controller_params, step_controller
+from swarm.core.errors import ScenarioError
 from swarm.layer_classes import K_MARKS, K_RESOURCES, K_TRAILS, class_image
-from swarm.scenario import Layout, Scenario, ScenarioError
+from swarm.scenario import Layout, Scenario
 from world_server.grid.face.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind, new_memory
 from world_server.grid.world import (
     C_DELIVERED,

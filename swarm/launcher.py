@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from agents.controllers import aot
-from agents.controllers.dispatch import warm_up
+from agents.controllers.envelope import warm_up
 from swarm.core import wire
 from swarm.core.bus import open_client
 from swarm.core.errors import RunError, raise_interrupt

@@ -17,16 +17,7 @@ import time
 
 from swarm.core import wire
 from swarm.core.bus import open_client, open_router
-
-
-def world_info(session, keys: wire.Keys, timeout: float = 2.0) -> dict | None:
-    """The world's answer on swarm/<run>/info, or None if no world answers."""
-    for reply in session.get(keys.info, timeout=timeout):
-        if reply.ok:
-            info = wire.unpack(reply.ok.payload.to_bytes())
-            if isinstance(info, dict) and info.get("type") == "info":
-                return info
-    return None
+from swarm.core.wire import world_info
 
 
 def status(connect: str, run_id: str, router_only: bool = False, timeout: float = 3.0) -> dict | None:

@@ -33,6 +33,7 @@ import math
 
 import numpy as np
 
+from swarm.arena.engine import _planner, fill_optimum
 from swarm.recording import FORMAT_VERSION, software_versions
 
 ARENA_METRICS = ("reached", "collisions", "distance", "agents_alive", "tick_ms", "rejected_messages")
@@ -53,7 +54,7 @@ def arena_meta(scenario, world, run_id: str, runtime: str) -> dict:
     recorded, when the robots that start the run are in the world (a robot
     that joins later has no start or L_o here, and no row in `swarm report`)."""
     inside = np.flatnonzero(world.in_world).tolist()
-    world.fill_optimum()
+    fill_optimum(world)
     return {"kind": "arena", "run_id": run_id, "runtime": runtime, "scenario": scenario.describe(),
             "name": scenario.name, "controller": scenario.controller, "agents": scenario.agents,
             "seed": scenario.seed, "noise": scenario.noise.level, "control_period": scenario.control_period,
@@ -177,8 +178,6 @@ class ArenaRecorder:
     def _log_optimum(self, robots) -> None:
         """The A* optimum (1 cm, 4 cm clearance: L_o) from each robot's start to its goal, for robots
         driving to one goal (not a route)."""
-        from swarm.arena.engine import _planner
-
         w, s = self.world, self.world.scenario
         routed = [g.route is not None for g in s.groups for _ in range(g.count)]
         planner = None

@@ -22,6 +22,7 @@ from urllib.parse import quote
 import numpy as np
 
 from swarm.core.errors import RecordingError
+from swarm.core.plots import plot_writer
 from swarm.recording import METRICS, STATES
 
 
@@ -132,26 +133,6 @@ def summary_from(rec: Recording) -> dict:
 
 
 # ---------------------------------------------------------------------- plots
-
-
-def plot_writer(out: Path):
-    """(pyplot, save(fig, name), the list of files saved) for plots into `out`."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    out.mkdir(parents=True, exist_ok=True)
-    written: list[Path] = []
-
-    def save(fig, name: str) -> None:
-        path = out / name
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        written.append(path)
-
-    return plt, save, written
 
 
 def write_plots(rec: Recording, out: Path) -> list[Path]:

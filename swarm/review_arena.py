@@ -75,7 +75,7 @@ def arena_summary_from(rec) -> dict:
 
 
 def write_arena_plots(rec, out: Path) -> list[Path]:
-    from swarm.review import plot_writer
+    from swarm.core.plots import plot_writer
 
     plt, save, written = plot_writer(out)
     m = rec.meta

@@ -20,20 +20,15 @@ from typing import Any
 
 import numpy as np
 
+from swarm.core.errors import ScenarioError
+from swarm.core.tables import no_unknown, section_of, typed
+
 CONTROLLER_NAMES = ("cmarking", "marking", "ant")
 MAX_AGENTS = (1 << 20) - 2  # trail ids reserve 20 bits for the agent id
 MAP_STREAM = 0x4D4150  # keeps map draws apart from any other use of the seed
 MAX_MAP_DRAWS = 200
 MIN_BASE_SHARE = 0.5
 MAP_CHARS = "#.BR"
-
-
-class ScenarioError(ValueError):
-    """A scenario that cannot be used; the message says where and what is expected."""
-
-    def __init__(self, source: str, where: str, problem: str):
-        self.source, self.where, self.problem = source, where, problem
-        super().__init__(f"{source}: {where}: {problem}")
 
 
 @dataclass(frozen=True)
@@ -250,7 +245,7 @@ def parse_scenario_text(text: str, source: str = "<string>"):
     if "controller" in data:
         kw["controller"] = typed(data, "controller", str, source)
     if has_map:
-        section = _section(data, "map", source)
+        section = section_of(data, "map", source)
         no_unknown(section, {"ascii"}, source, "[map]")
         if "ascii" not in section:
             raise ScenarioError(source, "map.ascii", "missing: a multi-line string of # . B R")
@@ -263,7 +258,7 @@ def parse_scenario_text(text: str, source: str = "<string>"):
         kw["ascii_map"] = tuple(lines)
         kw["map_first_line"] = _first_map_line(text, lines)
     else:
-        section = _section(data, "generator", source)
+        section = section_of(data, "generator", source)
         keys = {"width", "height", "obstacle_density", "resources"}
         no_unknown(section, keys, source, "[generator]")
         for key in keys:
@@ -278,15 +273,15 @@ def parse_scenario_text(text: str, source: str = "<string>"):
             resources=typed(section, "resources", int, source, "generator.resources"),
         )
     if "ant" in data:
-        section = _section(data, "ant", source)
+        section = section_of(data, "ant", source)
         no_unknown(section, set(AntParams.__dataclass_fields__), source, "[ant]")
         kw["ant"] = AntParams(**{k: float(typed(section, k, (int, float), source, f"ant.{k}")) for k in section})
     if "cmarking" in data:
-        section = _section(data, "cmarking", source)
+        section = section_of(data, "cmarking", source)
         no_unknown(section, set(CMarkingParams.__dataclass_fields__), source, "[cmarking]")
         kw["cmarking"] = CMarkingParams(**{k: typed(section, k, int, source, f"cmarking.{k}") for k in section})
     if "physics" in data:
-        section = _section(data, "physics", source)
+        section = section_of(data, "physics", source)
         no_unknown(section, set(PhysicsParams.__dataclass_fields__), source, "[physics]")
         kw["physics"] = PhysicsParams(**{
             k: typed(section, k, str, source, "physics.mode") if k == "mode"
@@ -307,32 +302,6 @@ def _first_map_line(text: str, lines: list[str]) -> int:
         if src[i].rstrip().endswith(lines[0]) and lines[0]:
             return i + 1
     return 0
-
-
-def _section(data: dict, key: str, source: str) -> dict:
-    value = data[key]
-    if not isinstance(value, dict):
-        raise ScenarioError(source, key, f"expected a [{key}] table")
-    return value
-
-
-def no_unknown(section: dict, allowed: set[str], source: str, where: str) -> None:
-    for key in section:
-        if key not in allowed:
-            raise ScenarioError(
-                source,
-                f"{where}: {key}",
-                f"unknown field; expected one of {', '.join(sorted(allowed))}",
-            )
-
-
-def typed(section: dict, key: str, kind, source: str, where: str | None = None):
-    value = section[key]
-    kinds = kind if isinstance(kind, tuple) else (kind,)
-    if isinstance(value, bool) or not isinstance(value, kinds):
-        names = " or ".join(k.__name__ for k in kinds)
-        raise ScenarioError(source, where or key, f"expected {names}, got {value!r}")
-    return value
 
 
 # ------------------------------------------------------------------ validation

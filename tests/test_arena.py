@@ -10,7 +10,8 @@ import pytest
 
 from agents.controllers.navigation.astar import Planner
 from swarm.arena.engine import ArenaEngine
-from swarm.scenario import ScenarioError, load_scenario, parse_scenario_text
+from swarm.core.errors import ScenarioError
+from swarm.scenario import load_scenario, parse_scenario_text
 from tests.arena_helpers import arena, box
 from world_server.arena.world import ArenaWorld
 

@@ -236,7 +236,8 @@ def test_actions_carry_memory_only_for_their_own_agents():
 
 
 def test_the_checkpoint_is_a_scenario_key_with_a_range():
-    from swarm.scenario import ScenarioError, parse_scenario_text
+    from swarm.core.errors import ScenarioError
+    from swarm.scenario import parse_scenario_text
     from tests.arena_helpers import box
 
     assert arena("[[group]]\ncount = 1\n").checkpoint == 50

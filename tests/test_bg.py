@@ -17,8 +17,9 @@ from agents.controllers.bg.senses import Reflex, proximity, resource_pixels, sen
 from agents.controllers.navigation.dijkstra import shortest_routes
 from swarm.arena.engine import ArenaEngine
 from swarm.arena.scenario import controller_params
+from swarm.core.errors import ScenarioError
 from swarm.core.wire import Rejected
-from swarm.scenario import ScenarioError, load_scenario
+from swarm.scenario import load_scenario
 from tests.arena_helpers import arena, box, resumed_pair, rrd_rows
 from world_server.arena.face import wire as proto
 from world_server.arena.world import ArenaWorld
@@ -730,7 +731,7 @@ def test_an_exploring_mapping_run_maps_half_an_hour_and_knows_both_ep_where_they
 
 def test_bg_experiment_maps_option_is_checked():
     from swarm.arena.bg_experiments import run_bg_experiment
-    from swarm.scenario import ScenarioError
+    from swarm.core.errors import ScenarioError
 
     with pytest.raises(ScenarioError, match="--maps"):
         run_bg_experiment("bg-tmaze", None, 2, 1, 0, None, maps=3, progress=False)

@@ -27,7 +27,8 @@ from agents.controllers.dft.fields import (
 )
 from agents.controllers.dft.robot import Interface, gaussian_2d
 from swarm.arena.engine import ArenaEngine
-from swarm.scenario import ScenarioError, load_scenario, parse_scenario_text
+from swarm.core.errors import ScenarioError
+from swarm.scenario import load_scenario, parse_scenario_text
 from tests.arena_helpers import arena, box, rrd_rows
 
 # ------------------------------------------------------------------ engine
@@ -135,7 +136,7 @@ def test_the_engines_transforms_are_scipy_fft_bit_for_bit_without_importing_it()
     from agents.controllers import aot
 
     aot.build()  # once per source version: an agent process's kernels (else it would fall back to numba)
-    child = ("import sys; from swarm import kernels; assert kernels.use_ahead_of_time(); "
+    child = ("import sys; from swarm.core import kernels; assert kernels.use_ahead_of_time(); "
              "from agents.controllers.arena import make_controller; make_controller('dft'); "
              "print(sorted({m.split('.')[0] for m in sys.modules} & {'scipy', 'numba'}))")  # fmt: skip
     out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, timeout=120)

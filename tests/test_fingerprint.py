@@ -27,7 +27,8 @@ from agents.controllers.fingerprint.align import (
 )
 from agents.controllers.fingerprint.features import FeatureParams, camera_features, fingerprint, laser_corners
 from agents.controllers.navigation.topomap import Link, MapParams, TopoMap
-from swarm.scenario import ScenarioError, load_scenario
+from swarm.core.errors import ScenarioError
+from swarm.scenario import load_scenario
 
 
 def run_cli(*args):

@@ -5,8 +5,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from swarm.core.errors import ScenarioError
 from swarm.engine import Engine
-from swarm.scenario import PhysicsParams, ScenarioError, load_scenario, parse_scenario_text
+from swarm.scenario import PhysicsParams, load_scenario, parse_scenario_text
 from world_server import persist
 from world_server.grid.bodies import Bodies
 from world_server.grid.face.layout import A_MOVE, ACT_LEN, STAY

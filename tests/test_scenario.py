@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from swarm.scenario import ScenarioError, load_scenario, parse_scenario_text
+from swarm.core.errors import ScenarioError
+from swarm.scenario import load_scenario, parse_scenario_text
 
 
 @pytest.mark.parametrize(

@@ -16,10 +16,7 @@ resolves a tick, persists and records are the hooks its subclass fills:
 
 from __future__ import annotations
 
-import functools
-import json
 import queue
-import sys
 import time
 import uuid
 from dataclasses import dataclass, field
@@ -30,7 +27,7 @@ import zenoh
 
 from swarm.core import wire
 from swarm.core.bus import open_client, open_router
-from swarm.scenario import ScenarioError
+from swarm.core.errors import ScenarioError
 
 # JOINING: welcomed, but its observation subscriber may not be routed yet; it is
 # ACTIVE once its liveliness token arrives (declared after the subscriber).
@@ -544,39 +541,5 @@ class WorldServer:
         self.session.close()
 
 
-def make_server(scenario, run_id: str, **kw) -> WorldServer:
-    """The server of the scenario's world kind."""
-    if getattr(scenario, "kind", "grid") == "arena":
-        from world_server.arena.server import ArenaServer
-
-        return ArenaServer(scenario, run_id, **kw)
-    from world_server.grid.server import GridServer
-
-    return GridServer(scenario, run_id, **kw)
-
-
 def new_run_id() -> str:
     return uuid.uuid4().hex[:8]
-
-
-def serve(scenario, run_id: str, summary_file: str | None = None, linger: float = 0.0, quiet: bool = False,
-          **kw) -> dict:  # fmt: skip
-    server = make_server(scenario, run_id, **kw)
-    log = (lambda *_: None) if quiet else functools.partial(print, file=sys.stderr, flush=True)
-    try:
-        log(f"swarm world: run {run_id!r}, {scenario.name} (seed {scenario.seed}, {scenario.controller}): "
-            f"{server.start_with} agents start it, up to {scenario.agents} may join")  # fmt: skip
-        summary = server.run()
-        log(f"swarm world: run {run_id!r} {'finished' if summary['finished'] else 'stopped'} after "
-            f"{summary['iterations']} ticks; recording: {summary['recording']}")  # fmt: skip
-        if linger > 0:
-            log(f"swarm world: serving the final state for {linger:g} s")
-        server.stop_agents("finished" if summary["finished"] else "stopped")
-        if summary_file:
-            with open(summary_file, "w") as f:
-                json.dump(summary, f)
-        end = time.monotonic() + linger
-        server.linger(lambda: time.monotonic() >= end)
-    finally:
-        server.close()
-    return summary

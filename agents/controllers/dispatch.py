@@ -33,7 +33,7 @@ from world_server.grid.face.layout import (
     PERC_F_LEN,
     STAY,
 )
-from world_server.grid.face.wire import ACT_ROW, OBS_INTS, OBS_PERCEPTION, R_ACT, R_AGENT, R_MARKED, R_MEM
+from world_server.grid.face.wire import OBS_INTS, OBS_PERCEPTION, R_ACT, R_AGENT, R_MARKED, R_MEM
 
 
 @njit(cache=True)
@@ -92,25 +92,6 @@ def answer_rows(kind, ints_flat, pf_flat, mems, slot_of, out, params, seed, tick
         row[R_MEM:] = mem
         n += 1
     return n
-
-
-def warm_up() -> None:
-    """Compile, or load from the cache, the step kernel now: an agent's first
-    observation must not wait for it (lock-step deadlines are short)."""
-    from world_server.grid.face.layout import new_action, new_memory, new_perception
-
-    pi, pf = new_perception()
-    step_controller(MARKING, pi, pf, new_memory(1)[0], new_action(), np.zeros(N_PARAMS), np.int64(0), 0, 0)
-    ints = np.frombuffer(np.zeros(OBS_INTS, np.int64).tobytes(), np.int64)  # read-only, as a message's block
-    out = np.zeros((1, ACT_ROW), np.int64)
-    answer_rows(MARKING, ints, np.frombuffer(pf.tobytes(), np.float64), new_memory(1), np.zeros(1, np.int64), out,
-                np.zeros(N_PARAMS), np.int64(0), np.int64(0), False)  # fmt: skip
-    from agents.controllers.envelope import answer_message
-    from world_server.grid.face.wire import ENVELOPE, observations
-
-    message = observations(0, np.zeros((1, OBS_INTS), np.int64), pf[None])  # bytes, as the runtime passes them
-    answer_message(MARKING, message, new_memory(1), np.zeros(1, np.int64), out, np.zeros(N_PARAMS), np.int64(0), False,
-                   np.zeros(ENVELOPE + ACT_ROW * 8, np.uint8), np.zeros(3, np.int64))  # fmt: skip
 
 
 def controller_params(scenario: Scenario) -> np.ndarray:

@@ -15,8 +15,9 @@ read past its end.
 import numpy as np
 from numba import njit
 
-from agents.controllers.dispatch import answer_rows
-from world_server.grid.face.wire import ACT_ROW, ENVELOPE, NOT_PLAIN, R_MARKED
+from agents.controllers.dispatch import answer_rows, step_controller
+from world_server.grid.face.layout import MARKING, N_PARAMS, new_action, new_memory, new_perception
+from world_server.grid.face.wire import ACT_ROW, ENVELOPE, NOT_PLAIN, OBS_INTS, R_MARKED, observations
 from world_server.grid.face.wire_bytes import (
     ACT_HEAD,
     INTS_KEY,
@@ -76,3 +77,17 @@ def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info
     at = write_key(out, at, ROWS_KEY)
     at = write_tagged(out, at, size, 0xC4, 3)  # bin 8, 16, 32
     return write_words(out, at, rows.reshape(-1).view(np.uint64), 0, got * ACT_ROW)
+
+
+def warm_up() -> None:
+    """Compile, or load from the cache, the step kernel now: an agent's first
+    observation must not wait for it (lock-step deadlines are short)."""
+    pi, pf = new_perception()
+    step_controller(MARKING, pi, pf, new_memory(1)[0], new_action(), np.zeros(N_PARAMS), np.int64(0), 0, 0)
+    ints = np.frombuffer(np.zeros(OBS_INTS, np.int64).tobytes(), np.int64)  # read-only, as a message's block
+    out = np.zeros((1, ACT_ROW), np.int64)
+    answer_rows(MARKING, ints, np.frombuffer(pf.tobytes(), np.float64), new_memory(1), np.zeros(1, np.int64), out,
+                np.zeros(N_PARAMS), np.int64(0), np.int64(0), False)  # fmt: skip
+    message = observations(0, np.zeros((1, OBS_INTS), np.int64), pf[None])  # bytes, as the runtime passes them
+    answer_message(MARKING, message, new_memory(1), np.zeros(1, np.int64), out, np.zeros(N_PARAMS), np.int64(0), False,
+                   np.zeros(ENVELOPE + ACT_ROW * 8, np.uint8), np.zeros(3, np.int64))  # fmt: skip

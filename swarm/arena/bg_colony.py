@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from swarm.arena.experiments import pool_map, write_runs
-from swarm.scenario import ScenarioError, load_scenario
+from swarm.core.errors import ScenarioError
+from swarm.scenario import load_scenario
 
 SIZES = (1, 2, 4, 8)
 REPS = 5

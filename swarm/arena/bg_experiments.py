@@ -37,7 +37,8 @@ from typing import Any
 import numpy as np
 
 from swarm.arena.experiments import pool_map, write_runs
-from swarm.scenario import ScenarioError, load_scenario
+from swarm.core.errors import ScenarioError
+from swarm.scenario import load_scenario
 
 EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze")
 SCENARIO = {"bg-survival": "bg-exp1", "bg-choice": "bg-exp2", "bg-forget": "bg-exp2", "bg-fear": "bg-exp3",

@@ -27,8 +27,8 @@ from swarm.arena.experiments import (
     write_runs,
     zmaze_pairs,
 )
+from swarm.core.errors import ScenarioError
 from swarm.experiments import _pyplot, _save
-from swarm.scenario import ScenarioError
 
 CONDITIONS = (("dft", "low"), ("dft", "high"), ("carrot", "none"), ("carrot", "low"), ("carrot", "high"))
 PAPER_F = {"zmaze": 0.97, "large-maze": 0.98}

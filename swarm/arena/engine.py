@@ -50,6 +50,16 @@ def optimal_lengths(s: ArenaScenario, starts: np.ndarray, which=None) -> list[fl
     return out
 
 
+def fill_optimum(world: ArenaWorld) -> None:
+    """L_o (A*) for every robot in the world that has none yet: once per robot,
+    its start does not change once it is in."""
+    missing = [a for a in np.flatnonzero(world.in_world).tolist() if world.optimum[a] is None]
+    if missing:
+        for a, lo in enumerate(optimal_lengths(world.scenario, world.start_pose, missing)):
+            if lo is not None:
+                world.optimum[a] = lo
+
+
 class ArenaEngine:
     def __init__(self, scenario: ArenaScenario):
         self.scenario = scenario
@@ -123,7 +133,7 @@ class ArenaEngine:
 
 def arena_summary(world: ArenaWorld, wall_seconds: float, runtime: str) -> dict[str, Any]:
     s = world.scenario
-    world.fill_optimum()
+    fill_optimum(world)
     robots = world.robot_summaries(world.optimum)
     goals = [r for r in robots if r["goal"] is not None]
     ratios = [r["path_ratio"] for r in robots if r["path_ratio"] is not None]

@@ -22,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from swarm.scenario import BUNDLED_DIR, ScenarioError
+from swarm.core.errors import ScenarioError
+from swarm.scenario import BUNDLED_DIR
 
 NOISES = ("none", "low", "high")
 SCENARIOS = ("zmaze", "large-maze")

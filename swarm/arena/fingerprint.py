@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from swarm.scenario import ScenarioError
+from swarm.core.errors import ScenarioError
 
 NOISES = ("low", "high")
 THETAS = (0.2, 0.35, 0.5, 0.65, 0.8)

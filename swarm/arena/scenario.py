@@ -30,7 +30,8 @@ from typing import Any
 import numpy as np
 
 from agents.controllers.arena import ARENA_CONTROLLERS, REQUIRES, check_table
-from swarm.scenario import ScenarioError, no_unknown, typed
+from swarm.core.errors import ScenarioError
+from swarm.core.tables import no_unknown, typed
 from world_server.arena.face.robots import (
     IR,
     MODELS,

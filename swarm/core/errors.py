@@ -15,3 +15,11 @@ def raise_interrupt(signum, frame):
     """SIGTERM handler: end like Ctrl-C, so `finally` blocks close sessions, recordings and children
     (docker stop, kill, a timeout; python as a container's PID 1 would otherwise ignore SIGTERM)."""
     raise KeyboardInterrupt
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot be used; the message says where and what is expected."""
+
+    def __init__(self, source: str, where: str, problem: str):
+        self.source, self.where, self.problem = source, where, problem
+        super().__init__(f"{source}: {where}: {problem}")

@@ -1,9 +1,12 @@
-"""Controllers' parameters from a scenario's table, one way for all of them."""
+"""Reading a scenario's TOML tables, one way for every part: typed fields, unknown ones refused in
+one line that names the file and the field, and a parameter dataclass filled from a table."""
 
 from __future__ import annotations
 
 from dataclasses import fields
 from typing import Any
+
+from swarm.core.errors import ScenarioError
 
 
 def params_from_table(cls, table: dict[str, Any] | None, section: str, ints=(), texts=(), nested=()):
@@ -21,3 +24,30 @@ def params_from_table(cls, table: dict[str, Any] | None, section: str, ints=(), 
         if k not in texts and isinstance(v, bool):  # float(True) is 1.0: a switch given for a number is a slip
             raise ValueError(f"[{section}] {k}: expected a number, got {str(v).lower()}")
     return cls(**{k: (v if k in texts else int(v) if k in ints else float(v)) for k, v in table.items()})
+
+
+def section_of(data: dict, key: str, source: str) -> dict:
+    """data[key], which must be a table."""
+    value = data[key]
+    if not isinstance(value, dict):
+        raise ScenarioError(source, key, f"expected a [{key}] table")
+    return value
+
+
+def no_unknown(section: dict, allowed: set[str], source: str, where: str) -> None:
+    for key in section:
+        if key not in allowed:
+            raise ScenarioError(
+                source,
+                f"{where}: {key}",
+                f"unknown field; expected one of {', '.join(sorted(allowed))}",
+            )
+
+
+def typed(section: dict, key: str, kind, source: str, where: str | None = None):
+    value = section[key]
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    if isinstance(value, bool) or not isinstance(value, kinds):
+        names = " or ".join(k.__name__ for k in kinds)
+        raise ScenarioError(source, where or key, f"expected {names}, got {value!r}")
+    return value

@@ -205,3 +205,13 @@ def parse_join(data: bytes) -> dict | Rejected:
     if m.get("family") not in FAMILIES:
         return Rejected("unknown controller family")
     return m
+
+
+def world_info(session, keys: Keys, timeout: float = 2.0) -> dict | None:
+    """The world's answer on swarm/<run>/info, or None if no world answers."""
+    for reply in session.get(keys.info, timeout=timeout):
+        if reply.ok:
+            info = unpack(reply.ok.payload.to_bytes())
+            if isinstance(info, dict) and info.get("type") == "info":
+                return info
+    return None

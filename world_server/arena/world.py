@@ -108,7 +108,7 @@ class ArenaWorld:
         self.finished = np.zeros(self.n, np.bool_)
         self.path_length = np.zeros(self.n)
         self.rejected = dict.fromkeys(REJECT_REASONS, 0)
-        self.optimum: list[float | None] = [None] * self.n  # L_o per robot, computed once by the summary
+        self.optimum: list[float | None] = [None] * self.n  # L_o per robot: the runner's summary fills it once
         self.start_pose = start.copy()
         self.checkpointed: dict[str, np.ndarray] | None = None  # the snapshot of the last checkpoint
         self.zones = np.zeros(self.n, np.int64)
@@ -390,17 +390,6 @@ class ArenaWorld:
         self.present[agent] = False
 
     # -------------------------------------------------------------- summary
-
-    def fill_optimum(self) -> None:
-        """L_o (A*) for every robot in the world that has none yet: once per robot,
-        its start does not change once it is in."""
-        from swarm.arena.engine import optimal_lengths
-
-        missing = [a for a in np.flatnonzero(self.in_world).tolist() if self.optimum[a] is None]
-        if missing:
-            for a, lo in enumerate(optimal_lengths(self.scenario, self.start_pose, missing)):
-                if lo is not None:
-                    self.optimum[a] = lo
 
     def robot_summaries(self, optimum: list[float | None]) -> list[dict[str, Any]]:
         """One row per robot that has been in the world."""

@@ -1,0 +1,42 @@
+"""The world process: the server of the scenario's world kind, run until the run ends."""
+
+from __future__ import annotations
+
+import functools
+import json
+import sys
+import time
+
+from world_server.arena.server import ArenaServer
+from world_server.grid.server import GridServer
+from world_server.server import WorldServer
+
+
+def make_server(scenario, run_id: str, **kw) -> WorldServer:
+    """The server of the scenario's world kind."""
+    if getattr(scenario, "kind", "grid") == "arena":
+        return ArenaServer(scenario, run_id, **kw)
+    return GridServer(scenario, run_id, **kw)
+
+
+def serve(scenario, run_id: str, summary_file: str | None = None, linger: float = 0.0, quiet: bool = False,
+          **kw) -> dict:  # fmt: skip
+    server = make_server(scenario, run_id, **kw)
+    log = (lambda *_: None) if quiet else functools.partial(print, file=sys.stderr, flush=True)
+    try:
+        log(f"swarm world: run {run_id!r}, {scenario.name} (seed {scenario.seed}, {scenario.controller}): "
+            f"{server.start_with} agents start it, up to {scenario.agents} may join")  # fmt: skip
+        summary = server.run()
+        log(f"swarm world: run {run_id!r} {'finished' if summary['finished'] else 'stopped'} after "
+            f"{summary['iterations']} ticks; recording: {summary['recording']}")  # fmt: skip
+        if linger > 0:
+            log(f"swarm world: serving the final state for {linger:g} s")
+        server.stop_agents("finished" if summary["finished"] else "stopped")
+        if summary_file:
+            with open(summary_file, "w") as f:
+                json.dump(summary, f)
+        end = time.monotonic() + linger
+        server.linger(lambda: time.monotonic() >= end)
+    finally:
+        server.close()
+    return summary
