@@ -17,8 +17,8 @@ def load_step():
     built = kernels.load("answer_message"), kernels.load("answer_rows")
     if None not in built:
         return built
-    from agents.controllers.dispatch import answer_rows
-    from agents.controllers.envelope import answer_message, warm_up
+    from agents.controllers.grid.dispatch import answer_rows
+    from agents.controllers.grid.envelope import answer_message, warm_up
 
     warm_up()
     return answer_message, answer_rows

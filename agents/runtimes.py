@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from agents.arena_runtime import ArenaAgentRuntime
-from agents.controllers.arena import ARENA_CONTROLLERS
+from agents.controllers import CONTROLLERS
 from agents.grid_runtime import GridAgentRuntime
 from agents.runtime import AgentRuntime
 from swarm.core.bus import DEFAULT_ENDPOINT
@@ -12,6 +12,6 @@ from swarm.core.bus import DEFAULT_ENDPOINT
 def make_runtime(run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
                  **kw) -> AgentRuntime:  # fmt: skip
     """The runtime of the controller's family."""
-    if controller in ARENA_CONTROLLERS:
+    if CONTROLLERS[controller].world == "arena":
         return ArenaAgentRuntime(run_id, controller, connect, count, **kw)
     return GridAgentRuntime(run_id, controller, connect, count, **kw)

@@ -8,7 +8,7 @@ import signal
 import sys
 from pathlib import Path
 
-from agents.controllers.arena import ARENA_CONTROLLERS
+from agents.controllers import CONTROLLERS as CONTROLLER_REGISTRY
 from swarm.cli_arena import (
     add_arena_run_args,
     add_sense_parser,
@@ -19,9 +19,9 @@ from swarm.cli_arena import (
     run_arena,
 )
 from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_interrupt
-from swarm.scenario import CONTROLLER_NAMES, PRESET_HELP, bundled_scenarios, is_arena, load_scenario
+from swarm.scenario import PRESET_HELP, bundled_scenarios, is_arena, load_scenario
 
-CONTROLLERS = [*CONTROLLER_NAMES, *ARENA_CONTROLLERS]
+CONTROLLERS = CONTROLLER_REGISTRY.names()
 FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize", "fingerprint-together")
 DFT_EXPERIMENTS = ("dft-case1", "dft-case2", "dft-case3", "dft-together")
 BG_EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze", "bg-colony")
@@ -60,7 +60,7 @@ def _positive(text: str) -> int:
 
 
 def _ratios(text: str) -> tuple[float, ...]:
-    from swarm.arena.bg_experiments import RATIOS
+    from swarm.experiments.girard2005.bg import RATIOS
 
     try:
         values = tuple(float(v) for v in text.split(","))
@@ -99,7 +99,7 @@ def _bg_table(settings: list[tuple[str, object]] | None) -> dict:
 
 
 def _sizes(text: str) -> tuple[int, ...]:
-    from swarm.arena.bg_colony import NEST
+    from swarm.experiments.girard2005.colony import NEST
 
     try:
         values = tuple(int(v) for v in text.split(","))
@@ -157,7 +157,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Rerun one of the paper's experiments (or the congestion study, which adds robot bodies "
         "to Table 1) and write runs.csv, summary.csv, table.md (paper beside ours) and plot.png.",
     )
-    from swarm.experiments import EXPERIMENTS
+    from swarm.experiments.simonin2007.tables import EXPERIMENTS
 
     names_help = "; ".join(f"{e.name}: {e.title.split(': ', 1)[1]}" for e in EXPERIMENTS.values())
     names_help += "; carrot: follow the carrot in zmaze and large-maze at three noise levels (DFT paper, cases 1-2)"
@@ -473,7 +473,7 @@ def _scenario(args):
     common = {"agents": args.agents, "controller": args.controller, "seed": args.seed}
     if is_arena(scenario):
         return scenario.with_overrides(**common, **arena_overrides(args))
-    if args.controller in ARENA_CONTROLLERS:
+    if args.controller is not None and CONTROLLER_REGISTRY[args.controller].world == "arena":
         raise ScenarioError("command line", "controller", f"{args.controller} drives arena robots; pick an arena "
                             "scenario (zmaze, large-maze, ...) or a grid controller")  # fmt: skip
     return scenario.with_overrides(**common, physics=args.physics, body_diameter=args.body_diameter)
@@ -541,7 +541,7 @@ def _print_any(summary: dict, as_json: bool, until: str) -> int:
 
 
 def cmd_run(args) -> int:
-    from swarm.engine import Engine
+    from swarm.engines.grid import Engine
 
     scenario = _scenario(args)
     if is_arena(scenario):
@@ -549,7 +549,7 @@ def cmd_run(args) -> int:
     engine = Engine(scenario)
     recorder = None
     if args.record:
-        from swarm.recording import Recorder, run_meta
+        from swarm.recording.grid import Recorder, run_meta
 
         meta = run_meta(scenario, engine.world, Path(args.record).stem, args.until, "in-process")
         recorder = Recorder(args.record, engine.world, meta, viewer=_viewer_url(args.viewer))
@@ -571,13 +571,13 @@ def _point_at_recording(path: str) -> None:
 
 
 def cmd_replay(args) -> int:
-    from swarm.review import replay
+    from swarm.review.report import replay
 
     return replay(args.file, web=args.web, web_port=args.port, grpc_port=args.grpc_port, bind=args.bind)
 
 
 def cmd_report(args) -> int:
-    from swarm.review import report
+    from swarm.review.report import report
 
     result = report(args.file, args.out)
     if args.json:
@@ -598,14 +598,14 @@ def cmd_experiment(args) -> int:
     if args.name == "fingerprint-together":
         if args.scenario:
             raise ScenarioError("command line", "--scenario", "fingerprint-together surveys office")
-        from swarm.arena.fingerprint_team import run_team_experiment
+        from swarm.experiments.tapus2006.team import run_team_experiment
 
         result = run_team_experiment(args.reps, args.jobs, args.seed, args.out)
         print(result["markdown"])
         print(f"wrote {result['out']}/runs.csv, table.md, plot.png")
         return 0
     if args.name in FINGERPRINT_EXPERIMENTS:
-        from swarm.arena.fingerprint import run_fingerprint_experiment
+        from swarm.experiments.tapus2006.fingerprint import run_fingerprint_experiment
 
         result = run_fingerprint_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out)
         print(result["markdown"])
@@ -613,7 +613,7 @@ def cmd_experiment(args) -> int:
                                                              ", summary.csv, plot.png"))  # fmt: skip
         return 0
     if args.name in DFT_EXPERIMENTS:
-        from swarm.arena.dft_experiments import run_dft_experiment
+        from swarm.experiments.billing2015.dft import run_dft_experiment
 
         result = run_dft_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
                                     noise=args.noise, max_ticks=args.max_steps)  # fmt: skip
@@ -627,7 +627,7 @@ def cmd_experiment(args) -> int:
         if args.scenario or args.ratios or args.maps or args.mapping:
             raise ScenarioError("command line", "--scenario/--ratios/--maps/--mapping",
                                 "bg-colony runs bg-colony, with no mapping phase; give --sizes")  # fmt: skip
-        from swarm.arena.bg_colony import run_colony_experiment
+        from swarm.experiments.girard2005.colony import run_colony_experiment
 
         result = run_colony_experiment(args.sizes, args.reps, args.jobs, args.seed, args.out)
         print(result["markdown"])
@@ -636,7 +636,7 @@ def cmd_experiment(args) -> int:
     if args.sizes:
         raise ScenarioError("command line", "--sizes", "this is for bg-colony")
     if args.name in BG_EXPERIMENTS:
-        from swarm.arena.bg_experiments import run_bg_experiment
+        from swarm.experiments.girard2005.bg import run_bg_experiment
 
         result = run_bg_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
                                    ratios=args.ratios, maps=args.maps, bg=_bg_table(args.bg),
@@ -650,7 +650,7 @@ def cmd_experiment(args) -> int:
         raise ScenarioError("command line", "--maps/--mapping",
                             "these are for bg-choice, bg-forget, bg-fear and bg-tmaze")  # fmt: skip
     if args.name == "carrot":
-        from swarm.arena.experiments import run_carrot_experiment
+        from swarm.experiments.billing2015.carrot import run_carrot_experiment
 
         result = run_carrot_experiment(args.scenario, args.reps, args.jobs, args.seed, args.out)
         print(result["markdown"])
@@ -660,7 +660,7 @@ def cmd_experiment(args) -> int:
         raise ScenarioError(
             "command line", "--scenario", f"{args.name} uses the paper's setups; --scenario is for carrot"
         )
-    from swarm.experiments import run_experiment
+    from swarm.experiments.simonin2007.tables import run_experiment
 
     result = run_experiment(args.name, args.reps, args.jobs, args.seed, args.out)
     print(result["markdown"])
@@ -670,43 +670,43 @@ def cmd_experiment(args) -> int:
 
 def cmd_bench(args) -> int:
     if args.target == "bg":
-        from swarm.bench_bg import bench_bg, format_bg_bench
+        from swarm.bench.bg import bench_bg, format_bg_bench
 
         result = bench_bg(quick=args.quick)
         print(json.dumps(result) if args.json else format_bg_bench(result))
         return 0
     if args.target == "dft":
-        from swarm.bench_dft import bench_dft, format_dft_bench
+        from swarm.bench.dft import bench_dft, format_dft_bench
 
         result = bench_dft(quick=args.quick)
         print(json.dumps(result) if args.json else format_dft_bench(result))
         return 0
     if args.target == "fingerprint":
-        from swarm.bench_fingerprint import bench_fingerprint, format_fingerprint_bench
+        from swarm.bench.fingerprint import bench_fingerprint, format_fingerprint_bench
 
         result = bench_fingerprint(quick=args.quick)
         print(json.dumps(result) if args.json else format_fingerprint_bench(result))
         return 0
     if args.target == "arena":
-        from swarm.bench_arena import bench_arena, format_arena_bench
+        from swarm.bench.arena import bench_arena, format_arena_bench
 
         result = bench_arena(quick=args.quick)
         print(json.dumps(result) if args.json else format_arena_bench(result))
         return 0
     if args.target == "recording":
-        from swarm.bench_recording import bench_recording, format_recording_bench
+        from swarm.bench.recording import bench_recording, format_recording_bench
 
         result = bench_recording(quick=args.quick)
         print(json.dumps(result) if args.json else format_recording_bench(result))
         return 0
     if args.target == "distributed":
-        from swarm.bench_distributed import bench_distributed, format_distributed_bench
+        from swarm.bench.distributed import bench_distributed, format_distributed_bench
 
         result = bench_distributed(sizes=(10, 50) if args.quick else (10, 50, 100, 200),
                                    packed=200 if args.quick else 1000, pairs=args.pairs)  # fmt: skip
         print(json.dumps(result) if args.json else format_distributed_bench(result))
         return 0
-    from swarm.bench import bench_engine, format_engine_bench
+    from swarm.bench.engine import bench_engine, format_engine_bench
 
     result = bench_engine(quick=args.quick)
     print(json.dumps(result) if args.json else format_engine_bench(result))

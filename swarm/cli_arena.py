@@ -54,12 +54,12 @@ def arena_world_args(args) -> list[str]:
 def run_arena(args, scenario, viewer: str | None = None) -> int:
     from pathlib import Path
 
-    from swarm.arena.engine import ArenaEngine
+    from swarm.engines.arena import ArenaEngine
 
     engine = ArenaEngine(scenario)
     recorder = None
     if getattr(args, "record", None):
-        from swarm.recording_arena import ArenaRecorder
+        from swarm.recording.arena import ArenaRecorder
 
         meta = {"run_id": Path(args.record).stem, "runtime": "in-process"}
         recorder = ArenaRecorder(args.record, engine.world, meta, viewer=viewer, controllers=engine.controllers)

@@ -24,11 +24,12 @@ import time
 from pathlib import Path
 
 from agents.controllers import aot
-from agents.controllers.envelope import warm_up
+from agents.controllers.grid.envelope import warm_up
 from swarm.core import wire
 from swarm.core.bus import open_client
 from swarm.core.errors import RunError, raise_interrupt
-from swarm.scenario import PhysicsParams, is_arena, load_scenario
+from swarm.scenario import is_arena, load_scenario
+from world_server.grid.scenario import PhysicsParams
 from world_server.grid.world import GridWorld
 
 
@@ -93,7 +94,7 @@ def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = 
     warm_up()  # once here, so N agents starting together find the kernels in the cache,
     scenario = load_scenario(scenario_ref)
     if arena or is_arena(scenario):  # the ray pass and A* (arena agents plan with it)
-        from swarm.arena.engine import ArenaEngine
+        from swarm.engines.arena import ArenaEngine
 
         ArenaEngine(scenario if is_arena(scenario) else load_scenario("zmaze")).step(1)
     if is_arena(scenario):
@@ -101,7 +102,7 @@ def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = 
     scenario = scenario.with_overrides(agents=2)
     GridWorld(scenario).warm_up()  # and so does the world
     if engine:
-        from swarm.engine import Engine
+        from swarm.engines.grid import Engine
 
         Engine(scenario).step(2)
     if builder is not None and builder.wait() != 0:

@@ -1,6 +1,6 @@
 """Small arena scenarios for the tests."""
 
-from swarm.arena.scenario import parse_arena_text
+from swarm.scenario import parse_arena_text
 
 BOX = """
 kind = "arena"
@@ -45,7 +45,7 @@ def resumed_pair(scenario, ticks: int):
     snapshots (through JSON) after the first `ticks`, then runs the rest.  Equal if resume is exact."""
     import json
 
-    from swarm.arena.engine import ArenaEngine
+    from swarm.engines.arena import ArenaEngine
 
     a = ArenaEngine(scenario)
     a.step(ticks)

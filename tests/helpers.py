@@ -2,8 +2,9 @@
 
 import numpy as np
 
-from swarm.scenario import Scenario, parse_scenario_text
+from swarm.scenario import parse_scenario_text
 from world_server.grid.face.layout import MARK_NONE
+from world_server.grid.scenario import Scenario
 from world_server.grid.world import L_BFS, L_MARK, L_OBST
 
 

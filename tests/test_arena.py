@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from agents.controllers.navigation.astar import Planner
-from swarm.arena.engine import ArenaEngine
 from swarm.core.errors import ScenarioError
+from swarm.engines.arena import ArenaEngine
 from swarm.scenario import load_scenario, parse_scenario_text
 from tests.arena_helpers import arena, box
 from world_server.arena.world import ArenaWorld
@@ -151,7 +151,7 @@ def test_drawn_starts_follow_the_seed_and_keep_their_clearance():
     a = parse_scenario_text(text, "t.toml").start_poses()
     assert np.array_equal(a, parse_scenario_text(text, "t.toml").start_poses())
     assert not np.array_equal(a, parse_scenario_text(text.replace("kind", "seed = 9\nkind"), "t.toml").start_poses())
-    from swarm.arena.scenario import clearance_at
+    from world_server.arena.scenario import clearance_at
 
     s = parse_scenario_text(text, "t.toml")
     assert (clearance_at(a[:, :2], s.wall_rects(), s.wall_segments()) >= 0.037 + 0.05).all()
@@ -170,7 +170,7 @@ def test_astar_finds_the_straight_line_and_respects_clearance():
     wide = np.array([[0.45, 0.0, 0.55, 0.40], [0.45, 0.60, 0.55, 1.0]])
     length, path = Planner((1.0, 1.0), wide, np.zeros((0, 4)), 0.01, 0.04).plan((0.1, 0.9), (0.9, 0.9))
     assert math.isfinite(length) and length > 0.8
-    from swarm.arena.scenario import clearance_at
+    from world_server.arena.scenario import clearance_at
 
     # clearance is counted between cell centres, as in the original code: within half a cell of 4 cm
     assert clearance_at(path, wide, np.zeros((0, 4))).min() >= 0.04 - 0.005
@@ -220,7 +220,7 @@ def test_cli_runs_and_senses_an_arena():
 
 
 def test_carrot_experiment_writes_its_table(tmp_path):
-    from swarm.arena.experiments import run_carrot_experiment
+    from swarm.experiments.billing2015.carrot import run_carrot_experiment
 
     result = run_carrot_experiment("zmaze", 3, 2, 0, tmp_path, progress=False)
     assert result["runs"] == 9  # 3 pairs x none / low / high
@@ -231,8 +231,8 @@ def test_carrot_experiment_writes_its_table(tmp_path):
 
 
 def test_large_maze_pairs_follow_the_seed_and_keep_40_mm_from_walls():
-    from swarm.arena.experiments import random_pairs
-    from swarm.arena.scenario import clearance_at
+    from swarm.experiments.billing2015.carrot import random_pairs
+    from world_server.arena.scenario import clearance_at
 
     a, b = random_pairs("large-maze", 5, 7), random_pairs("large-maze", 5, 7)
     assert a == b and a != random_pairs("large-maze", 5, 8)
@@ -263,7 +263,7 @@ def test_an_arena_recording_reads_back_to_the_printed_summary(tmp_path):
 def test_the_arena_recording_holds_walls_robots_headings_and_the_plan(tmp_path):
     from rerun.chunk import RrdReader
 
-    from swarm.recording_arena import ArenaRecorder
+    from swarm.recording.arena import ArenaRecorder
 
     s = load_scenario("zmaze").with_overrides(max_ticks=50)
     engine = ArenaEngine(s)
@@ -278,7 +278,7 @@ def test_the_arena_recording_holds_walls_robots_headings_and_the_plan(tmp_path):
 
 
 def test_more_robots_than_goals_get_a_drawn_goal_each():
-    from swarm.arena.scenario import clearance_at
+    from world_server.arena.scenario import clearance_at
 
     s = load_scenario("zmaze").with_overrides(agents=5, seed=3)
     goals = np.array(s.goals())
@@ -341,8 +341,8 @@ def test_an_agent_process_steps_its_controller_without_numba_exactly_as_in_proce
 
     from agents.controllers import aot
     from agents.controllers.arena import as_action
-    from swarm.arena.engine import ArenaEngine
-    from swarm.arena.scenario import controller_params
+    from swarm.engines.arena import ArenaEngine
+    from world_server.arena.scenario import controller_params
 
     aot.build()
     s = load_scenario(ref).with_overrides(controller=controller, agents=1, max_ticks=1000)

@@ -4,10 +4,10 @@ to the in-process engine pose for pose, bad traffic counted and refused."""
 import numpy as np
 import pytest
 
-from swarm.arena.engine import ArenaEngine
 from swarm.core import wire
 from swarm.core.bus import open_client
-from swarm.review import read_recording, summary_from
+from swarm.engines.arena import ArenaEngine
+from swarm.review.report import read_recording, summary_from
 from swarm.scenario import load_scenario, parse_scenario_text
 from tests.arena_helpers import box
 from tests.distributed import ServerThread, free_endpoint, run_world, start_agents, stop

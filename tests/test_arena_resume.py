@@ -12,13 +12,13 @@ from hypothesis import strategies as st
 
 from agents.arena_runtime import give_back
 from agents.controllers.arena import make_controller
-from swarm.arena.engine import ArenaEngine
-from swarm.arena.scenario import controller_params
 from swarm.core import memory_codec, msgpack_views
 from swarm.core.wire import Rejected, pack
+from swarm.engines.arena import ArenaEngine
 from swarm.scenario import load_scenario
 from tests.arena_helpers import arena
 from world_server.arena.face import wire as arena_proto
+from world_server.arena.scenario import controller_params
 from world_server.arena.world import ArenaWorld
 
 CROWD = arena('[[group]]\ncount = 12\ncontroller = "wander"\n', w=0.8, h=0.8, max_ticks=100_000)

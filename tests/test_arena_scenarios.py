@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from swarm.arena.engine import ArenaEngine
+from swarm.engines.arena import ArenaEngine
 from swarm.scenario import bundled_scenarios, is_arena, load_scenario
 from tests.arena_helpers import arena
 from world_server.arena.face.robots import ZONE_KINDS

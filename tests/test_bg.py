@@ -10,18 +10,18 @@ import math
 import numpy as np
 import pytest
 
-from agents.controllers.bg import BgController
+from agents.controllers.bg.controller import BgController
 from agents.controllers.bg.places import ANGLES, DIRECTIONS, Navigator, NavParams, _explore_channel
 from agents.controllers.bg.saliences import Drives, plan_vector, saliences
 from agents.controllers.bg.senses import Reflex, proximity, resource_pixels, sense, to_allocentric
 from agents.controllers.navigation.dijkstra import shortest_routes
-from swarm.arena.engine import ArenaEngine
-from swarm.arena.scenario import controller_params
 from swarm.core.errors import ScenarioError
 from swarm.core.wire import Rejected
+from swarm.engines.arena import ArenaEngine
 from swarm.scenario import load_scenario
 from tests.arena_helpers import arena, box, resumed_pair, rrd_rows
 from world_server.arena.face import wire as proto
+from world_server.arena.scenario import controller_params
 from world_server.arena.world import ArenaWorld
 
 FOOD = (
@@ -488,7 +488,7 @@ def test_snapshot_and_restore_continue_bit_for_bit():
 
 def test_a_bad_bg_table_is_one_clear_line():
     text = box(FOOD.format(extra="", x=1.2, y=0.5) + '[bg]\nsaliences = "hunger"\n', w=3.0, h=2.0, robot="animat")
-    from swarm.arena.scenario import parse_arena_text
+    from swarm.scenario import parse_arena_text
 
     with pytest.raises(ScenarioError) as e:
         parse_arena_text(text, "bad.toml")
@@ -514,7 +514,7 @@ def test_lockstep_bg_equals_in_process_bit_for_bit():
 
 
 def test_a_recording_holds_the_metabolism_the_channels_and_the_map(tmp_path):
-    from swarm.recording_arena import ArenaRecorder
+    from swarm.recording.arena import ArenaRecorder
 
     s = load_scenario("bg-exp1").with_overrides(max_ticks=80)
     engine = ArenaEngine(s)
@@ -531,7 +531,7 @@ def test_a_recording_holds_the_metabolism_the_channels_and_the_map(tmp_path):
 def test_an_animat_put_down_on_a_loaded_map_localizes_itself_before_it_plans():
     """Experiments 2 and 3 load a map that another animat made: the test's animat must plan from where it
     is, not from where the mapping animat stopped (that cost a test its first ~30 s, in the wrong way)."""
-    from swarm.arena.bg_experiments import _with
+    from swarm.experiments.girard2005.bg import _with
 
     maker = ArenaEngine(load_scenario("bg-exp1").with_overrides(max_ticks=600))
     maker.step(600)
@@ -581,7 +581,7 @@ def test_the_plan_cache_key_and_the_selection_sum_are_numpys_to_the_bit():
 def test_with_learn_map_off_an_animat_localizes_on_a_loaded_map_and_leaves_it_as_it_is():
     """`learn_map = false`: the belief follows the animat's views over the loaded map, which gains no node or
     link and whose nodes stay where they were (until stop 37 the belief froze after the first fix)."""
-    from swarm.arena.bg_experiments import _with
+    from swarm.experiments.girard2005.bg import _with
 
     maker = ArenaEngine(load_scenario("bg-exp1").with_overrides(max_ticks=1200))
     maker.step(1200)
@@ -603,7 +603,7 @@ def test_with_learn_map_off_an_animat_localizes_on_a_loaded_map_and_leaves_it_as
 
 
 def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):
-    from swarm.arena.bg_experiments import run_bg_experiment
+    from swarm.experiments.girard2005.bg import run_bg_experiment
 
     result = run_bg_experiment("bg-tmaze", None, 2, 2, 0, tmp_path, ratios=(1.0,), progress=False)
     assert result["runs"] == 2
@@ -619,7 +619,7 @@ def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):
 
 
 def test_bg_experiment_tests_share_maps_across_conditions():
-    from swarm.arena.bg_experiments import _tests
+    from swarm.experiments.girard2005.bg import _tests
 
     maps = {"bg-exp3": [{"id": 0}, {"id": 1}]}
     jobs = _tests("bg-fear", 4, 10, maps)
@@ -646,7 +646,7 @@ def test_a_test_goes_on_mapping_a_hungry_map_and_takes_an_explored_one_as_it_is(
     """A hungry mapping run leaves the way between resources, which a test extends; an exploring one covers
     the floor, and a test only localizes on it (a node it made would be a leaf whose routes lead back).  The
     command line's --bg learn_map overrides either."""
-    from swarm.arena.bg_experiments import _tests
+    from swarm.experiments.girard2005.bg import _tests
 
     maps = {"bg-exp3": [{}]}
     assert all(j[5]["learn_map"] for j in _tests("bg-fear", 2, 0, maps))
@@ -661,7 +661,7 @@ def test_a_test_goes_on_mapping_a_hungry_map_and_takes_an_explored_one_as_it_is(
 
 
 def test_bg_choice_runs_the_papers_control_of_ten_tests_without_ep2():
-    from swarm.arena.bg_experiments import _tests
+    from swarm.experiments.girard2005.bg import _tests
 
     jobs = _tests("bg-choice", 15, 0, {"bg-exp2": [{}]})
     control = [j for j in jobs if j[1] == "no Ep2"]
@@ -671,7 +671,7 @@ def test_bg_choice_runs_the_papers_control_of_ten_tests_without_ep2():
 
 
 def test_a_control_table_counts_each_choice_and_the_time_to_reload():
-    from swarm.arena.bg_experiments import _control_summary, direct_seconds
+    from swarm.experiments.girard2005.bg import _control_summary, direct_seconds
 
     tests = [("Ep1", 40.0), ("Ep1", 60.0), ("Ep2", 90.0), ("none", None)]
     rows = [{"condition": "0.1, no DA", "chose": c, "seconds": t} for c, t in tests]
@@ -684,7 +684,7 @@ def test_a_control_table_counts_each_choice_and_the_time_to_reload():
 
 
 def test_the_fear_table_says_what_fear_takes_away_from_ep1_at_each_level():
-    from swarm.arena.bg_experiments import _fear_effect
+    from swarm.experiments.girard2005.bg import _fear_effect
 
     rows = [{"condition": 0.1, "chose": c} for c in ("Ep1", "Ep1", "Ep2")]
     rows += [{"condition": 0.5, "chose": c} for c in ("Ep2", "none", "Ep1")]
@@ -695,7 +695,7 @@ def test_the_fear_table_says_what_fear_takes_away_from_ep1_at_each_level():
 
 
 def test_a_choice_table_says_how_many_of_neither_died():
-    from swarm.arena.bg_experiments import PAPER_FEAR, _choice_summary
+    from swarm.experiments.girard2005.bg import PAPER_FEAR, _choice_summary
 
     rows = [{"condition": 0.1, "chose": c, "died": d} for c, d in [("Ep1", False), ("none", True), ("none", False)]]
     rows += [{"condition": 0.5, "chose": "Ep2", "died": False}]
@@ -714,7 +714,7 @@ def test_an_exploring_mapping_run_maps_half_an_hour_and_knows_both_ep_where_they
     """bg-fear's mapping (MAPPING_MODES["explore"]): W_plan 0, at least 30 min.  At this seed the hungry
     mapping animat knew only Ep2 (docs/bg.md, stop 40); the exploring one knows both, on nodes within 1.5 m
     of each (positions by odometry from the start)."""
-    from swarm.arena.bg_experiments import MAPPING, build_map
+    from swarm.experiments.girard2005.bg import MAPPING, build_map
     from swarm.scenario import load_scenario
 
     assert MAPPING["bg-fear"] == "explore" and MAPPING["bg-choice"] == "hungry"
@@ -730,8 +730,8 @@ def test_an_exploring_mapping_run_maps_half_an_hour_and_knows_both_ep_where_they
 
 
 def test_bg_experiment_maps_option_is_checked():
-    from swarm.arena.bg_experiments import run_bg_experiment
     from swarm.core.errors import ScenarioError
+    from swarm.experiments.girard2005.bg import run_bg_experiment
 
     with pytest.raises(ScenarioError, match="--maps"):
         run_bg_experiment("bg-tmaze", None, 2, 1, 0, None, maps=3, progress=False)
@@ -746,8 +746,8 @@ def test_bg_experiment_maps_option_is_checked():
 def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     import argparse
 
-    from swarm.arena.bg_experiments import _tests, _with, run_bg_experiment
     from swarm.cli import _bg_setting, _bg_table
+    from swarm.experiments.girard2005.bg import _tests, _with, run_bg_experiment
 
     table = _bg_table([_bg_setting("usable_threshold=0.5"), _bg_setting("navigation.anchor=0.2")])
     assert table == {"usable_threshold": 0.5, "navigation": {"anchor": 0.2}}

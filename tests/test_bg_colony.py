@@ -11,9 +11,9 @@ from agents.controllers.arena import deliver
 from agents.controllers.bg.colony import ColonyMap
 from agents.controllers.bg.places import Navigator, NavParams
 from agents.controllers.bg.senses import RESOURCES
-from swarm.arena.bg_colony import colony_scenario
-from swarm.arena.engine import ArenaEngine
 from swarm.core.wire import pack
+from swarm.engines.arena import ArenaEngine
+from swarm.experiments.girard2005.colony import colony_scenario
 from tests.arena_helpers import MapSharer, resumed_pair
 
 
@@ -105,7 +105,7 @@ def test_lockstep_colony_equals_in_process_bit_for_bit(processes, per_process):
 
 
 def test_the_colony_experiment_writes_its_table(tmp_path):
-    from swarm.arena.bg_colony import run_colony_experiment
+    from swarm.experiments.girard2005.colony import run_colony_experiment
 
     result = run_colony_experiment((1, 2), 2, 2, 0, tmp_path, progress=False, max_ticks=120)
     assert result["runs"] == 6  # one alone twice, two with and without sharing twice each
@@ -116,9 +116,9 @@ def test_the_colony_experiment_writes_its_table(tmp_path):
 
 
 def test_the_nest_holds_eight_animats_clear_of_walls_and_of_each_other():
-    from swarm.arena.bg_colony import NEST
-    from swarm.arena.scenario import clearance_at
+    from swarm.experiments.girard2005.colony import NEST
     from swarm.scenario import load_scenario
+    from world_server.arena.scenario import clearance_at
 
     s = colony_scenario(8, True, 0)
     xy = np.array(NEST)

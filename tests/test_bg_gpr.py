@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from agents.controllers.bg import BgParams
+from agents.controllers.bg.controller import BgParams
 from agents.controllers.bg.gpr import (
     EP,
     BasalGanglia,

@@ -24,7 +24,7 @@ def test_help_lists_the_commands():
 
 
 def test_run_json_has_the_summary_keys_and_matches_the_engine():
-    from swarm.engine import Engine
+    from swarm.engines.grid import Engine
     from swarm.scenario import load_scenario
 
     out = json.loads(swarm("run", "setup2", "--agents", "3", "--seed", "12", "--json").stdout)

@@ -1,10 +1,9 @@
-"""c-marking's rules on hand-made perceptions (agents/controllers/cmarking.py)."""
+"""c-marking's rules on hand-made perceptions (agents/controllers/grid/cmarking.py)."""
 
 import numpy as np
 
-from agents.controllers.cmarking import new_trail_id
-from agents.controllers.dispatch import controller_params, step_controller
-from swarm.scenario import Scenario
+from agents.controllers.grid.cmarking import new_trail_id
+from agents.controllers.grid.dispatch import controller_params, step_controller
 from world_server.grid.face.layout import (
     A_LOAD,
     A_MARK,
@@ -37,6 +36,7 @@ from world_server.grid.face.layout import (
     new_memory,
     new_perception,
 )
+from world_server.grid.scenario import Scenario
 
 N, E, S, W = 0, 1, 2, 3
 PARAMS = controller_params(Scenario("rules", "test", controller="cmarking"))

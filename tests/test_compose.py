@@ -89,7 +89,7 @@ def test_compose_up_swarm_runs_to_the_end_and_records(compose):
     recordings = sorted((ROOT / "runs").glob(f"{run_id}-*.rrd"))
     assert len(recordings) == 1
     try:
-        from swarm.review import read_recording, summary_from
+        from swarm.review.report import read_recording, summary_from
 
         summary = summary_from(read_recording(recordings[0]))
         assert (summary["iterations"], summary["delivered"], summary["agents_peak"]) == (2367, 6000, 3)

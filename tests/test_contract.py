@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from agents.controllers.dispatch import controller_params, step_controller
-from swarm.arena.engine import ArenaEngine
-from swarm.engine import Engine
+from agents.controllers.grid.dispatch import controller_params, step_controller
+from swarm.engines.arena import ArenaEngine
+from swarm.engines.grid import Engine
+from swarm.engines.stepper import step_world
 from swarm.scenario import load_scenario
-from swarm.stepper import step_world
 from world_server.arena.world import ArenaWorld
 from world_server.contract import World
 from world_server.grid.face.layout import controller_kind, new_memory

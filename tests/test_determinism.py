@@ -4,8 +4,8 @@ other seeds differ; decisions do not depend on the order agents are stepped."""
 import numpy as np
 import pytest
 
-from agents.controllers.dispatch import step_controller
-from swarm.engine import Engine
+from agents.controllers.grid.dispatch import step_controller
+from swarm.engines.grid import Engine
 from swarm.scenario import load_scenario
 from world_server.grid.face.layout import controller_kind, new_perception
 

@@ -26,8 +26,8 @@ from agents.controllers.dft.fields import (
     kernel_image,
 )
 from agents.controllers.dft.robot import Interface, gaussian_2d
-from swarm.arena.engine import ArenaEngine
 from swarm.core.errors import ScenarioError
+from swarm.engines.arena import ArenaEngine
 from swarm.scenario import load_scenario, parse_scenario_text
 from tests.arena_helpers import arena, box, rrd_rows
 
@@ -370,7 +370,7 @@ def test_snapshot_and_restore_continue_bit_for_bit():
     state = json.loads(json.dumps(engine.controllers[0].snapshot(), default=lambda a: a.tolist()))
     perceptions = [engine.world.perceive_all()[0] for _ in range(1)]
     twin = DftController()
-    from swarm.arena.scenario import controller_params
+    from world_server.arena.scenario import controller_params
 
     twin.reset(s.seed, 0, controller_params(s, 0))
     twin.restore(state)
@@ -428,7 +428,7 @@ def test_lockstep_dft_equals_in_process_bit_for_bit():
 
 
 def test_a_recording_holds_the_fields_the_intentions_and_the_optimum(tmp_path):
-    from swarm.recording_arena import ArenaRecorder
+    from swarm.recording.arena import ArenaRecorder
 
     s = load_scenario("zmaze").with_overrides(controller="dft", max_ticks=60)
     engine = ArenaEngine(s)
@@ -488,7 +488,7 @@ def test_malformed_context_is_refused_whole():
 
 
 def test_lockstep_sharing_dft_robots_equal_in_process_bit_for_bit():
-    from swarm.arena.dft_experiments import together_scenario
+    from swarm.experiments.billing2015.dft import together_scenario
     from tests.distributed import run_world
 
     scenario = together_scenario("scout-sensed", 40, 500, "low", 3, 280)
@@ -505,7 +505,7 @@ def test_lockstep_sharing_dft_robots_equal_in_process_bit_for_bit():
 
 
 def test_runs_are_classified_by_the_route_they_took():
-    from swarm.arena.dft_experiments import classify
+    from swarm.experiments.billing2015.dft import classify
 
     assert classify(np.array([0.6, 0.65, 0.72, 0.8, 0.6])) == "north"
     assert classify(np.array([0.6, 0.55, 0.5, 0.3, 0.6])) == "south"
@@ -514,7 +514,7 @@ def test_runs_are_classified_by_the_route_they_took():
 
 
 def test_case_tables_put_the_papers_f_beside_ours(tmp_path):
-    from swarm.arena.dft_experiments import run_dft_experiment, summarise_pairs
+    from swarm.experiments.billing2015.dft import run_dft_experiment, summarise_pairs
 
     rows = [{"scenario": "zmaze", "controller": c, "noise": n, "pair": k, "reached": True, "ticks_to_goal": 300 + k,
              "path_ratio": (1.1 if c == "dft" else 1.0) + 0.01 * k, "collisions": 0}
@@ -528,7 +528,7 @@ def test_case_tables_put_the_papers_f_beside_ours(tmp_path):
 
 
 def test_the_swarm_summary_measures_how_much_earlier_robot_0_replans():
-    from swarm.arena.dft_experiments import replan_tick, summarise_together
+    from swarm.experiments.billing2015.dft import replan_tick, summarise_together
 
     def row(c, k, route, south, turn):
         return {"condition": c, "run": k, "route": route, "south_tick": south, "turn_tick": turn, "reached": True,

@@ -8,7 +8,7 @@ import pytest
 
 from swarm.core import wire
 from swarm.core.bus import open_client
-from swarm.engine import Engine
+from swarm.engines.grid import Engine
 from swarm.scenario import load_scenario
 from tests.distributed import ServerThread, free_endpoint, run_world, start_agents, stop
 from world_server.grid.face import wire as proto

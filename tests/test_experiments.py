@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from swarm import paper
-from swarm.experiments import CONGESTION_AGENTS, CONGESTION_CAP, EXPERIMENTS, RunSpec, plan, run_one
+from swarm.experiments.simonin2007 import paper
+from swarm.experiments.simonin2007.tables import CONGESTION_AGENTS, CONGESTION_CAP, EXPERIMENTS, RunSpec, plan, run_one
 
 
 def test_congestion_plans_ideal_and_physical_runs_under_one_cap():

@@ -173,7 +173,7 @@ def test_the_side_by_side_kernel_equals_the_node_by_node_one_cell_for_cell():
 
 
 def test_the_probability_calibration_recovers_a_known_logistic():
-    from swarm.arena.fingerprint import fit_logistic
+    from swarm.experiments.tapus2006.fingerprint import fit_logistic
 
     rng = np.random.default_rng(3)
     d = rng.uniform(0, 1.0, 20000)  # classes about equally common, as the fit weighs them
@@ -337,14 +337,14 @@ def test_a_link_keeps_the_mean_of_the_displacements_it_was_driven_with():
 
 @cache
 def mapping_tour():
-    from swarm.arena.fingerprint import drive_tour, tour_scenario
+    from swarm.experiments.tapus2006.fingerprint import drive_tour, tour_scenario
 
     s = tour_scenario("office", "mapping", "low", 0)
     return s, drive_tour(s)
 
 
 def test_the_mapping_tour_takes_about_500_fingerprints_and_maps_every_place_it_passes():
-    from swarm.arena.fingerprint import judge_map, places
+    from swarm.experiments.tapus2006.fingerprint import judge_map, places
 
     s, run = mapping_tour()
     judged = judge_map(run, places(s))
@@ -356,7 +356,7 @@ def test_the_mapping_tour_takes_about_500_fingerprints_and_maps_every_place_it_p
 
 
 def test_a_room_revisit_counts_as_closed_when_it_joins_the_nodes_made_before():
-    from swarm.arena.fingerprint import first_use, room_revisits
+    from swarm.experiments.tapus2006.fingerprint import first_use, room_revisits
 
     place = np.array([0, 0, 0, 1, 1, 1, 0, 0, 0, 1])  # room 0, corridor 1, room 0 again
     rooms = np.array([True, False])
@@ -370,7 +370,7 @@ def test_a_room_revisit_counts_as_closed_when_it_joins_the_nodes_made_before():
 
 
 def test_localization_on_the_second_tour_beats_matching_alone_and_chance():
-    from swarm.arena.fingerprint import localize_job
+    from swarm.experiments.tapus2006.fingerprint import localize_job
 
     row = localize_job(("office", "low", 0, "localize"))
     assert row["fingerprints"] >= 1000 and row["on_map"] >= 0.95 * row["fingerprints"]  # it stays on the map
@@ -380,9 +380,9 @@ def test_localization_on_the_second_tour_beats_matching_alone_and_chance():
 
 
 def test_a_restored_localizing_controller_goes_on_exactly_as_the_one_it_was_taken_from():
-    from swarm.arena.engine import ArenaEngine
-    from swarm.arena.fingerprint import tour_scenario
-    from swarm.arena.scenario import controller_params
+    from swarm.engines.arena import ArenaEngine
+    from swarm.experiments.tapus2006.fingerprint import tour_scenario
+    from world_server.arena.scenario import controller_params
 
     s = tour_scenario("office", "localize", "low", 1000)
     params = controller_params(s, 0)
@@ -403,9 +403,9 @@ def test_a_restored_localizing_controller_goes_on_exactly_as_the_one_it_was_take
 
 
 def test_a_restored_controller_goes_on_exactly_as_the_one_it_was_taken_from():
-    from swarm.arena.engine import ArenaEngine
-    from swarm.arena.fingerprint import tour_scenario
-    from swarm.arena.scenario import controller_params
+    from swarm.engines.arena import ArenaEngine
+    from swarm.experiments.tapus2006.fingerprint import tour_scenario
+    from world_server.arena.scenario import controller_params
 
     s = tour_scenario("office", "mapping", "low", 0)
     a = ArenaEngine(s)
@@ -425,8 +425,8 @@ def test_a_restored_controller_goes_on_exactly_as_the_one_it_was_taken_from():
 
 
 def test_localize_mode_needs_a_map_and_says_so():
-    from swarm.arena.engine import ArenaEngine
-    from swarm.arena.fingerprint import tour_scenario
+    from swarm.engines.arena import ArenaEngine
+    from swarm.experiments.tapus2006.fingerprint import tour_scenario
 
     with pytest.raises(ValueError, match="needs a map"):
         ArenaEngine(tour_scenario("office", "mapping", "low", 0, {"mode": "localize"}))
@@ -463,9 +463,9 @@ def test_swarm_run_office_with_the_fingerprint_controller_prints_its_map():
 
 
 def test_the_recording_holds_the_map_as_graph_nodes_and_edges(tmp_path):
-    from swarm.arena.engine import ArenaEngine
-    from swarm.arena.fingerprint import tour_scenario
-    from swarm.recording_arena import ArenaRecorder
+    from swarm.engines.arena import ArenaEngine
+    from swarm.experiments.tapus2006.fingerprint import tour_scenario
+    from swarm.recording.arena import ArenaRecorder
 
     s = tour_scenario("office", "mapping", "low", 0)
     engine = ArenaEngine(s)
@@ -481,7 +481,7 @@ def test_the_recording_holds_the_map_as_graph_nodes_and_edges(tmp_path):
 
 def test_the_matching_probability_is_calibrated_as_the_defaults_say():
     """`swarm experiment fingerprint-calibrate` fits the defaults of AlignParams."""
-    from swarm.arena.fingerprint import calibration_pairs, fit_logistic
+    from swarm.experiments.tapus2006.fingerprint import calibration_pairs, fit_logistic
 
     d, same = calibration_pairs("office", "low", 0)
     centre, width = fit_logistic(d, same)
@@ -560,10 +560,10 @@ def test_shared_items_on_the_wire_are_checked():
 
 @pytest.mark.parametrize(("processes", "per_process"), [(2, 1), (1, 2)])
 def test_mapping_together_lockstep_equals_in_process(processes, per_process, tmp_path):
-    from swarm.arena.engine import ArenaEngine
-    from swarm.arena.fingerprint_team import team_scenario
     from swarm.core import wire
     from swarm.core.bus import open_client
+    from swarm.engines.arena import ArenaEngine
+    from swarm.experiments.tapus2006.team import team_scenario
     from tests.distributed import run_world
 
     scenario = team_scenario(2, "low", 0).with_overrides(max_ticks=400)

@@ -4,9 +4,9 @@ the base has a strictly lower marked neighbour (so descent never gets stuck)."""
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from swarm.engine import Engine
-from swarm.scenario import Generator, Scenario
+from swarm.engines.grid import Engine
 from tests.helpers import lemma41_violations
+from world_server.grid.scenario import Generator, Scenario
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])

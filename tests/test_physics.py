@@ -6,11 +6,12 @@ import numpy as np
 import pytest
 
 from swarm.core.errors import ScenarioError
-from swarm.engine import Engine
-from swarm.scenario import PhysicsParams, load_scenario, parse_scenario_text
+from swarm.engines.grid import Engine
+from swarm.scenario import load_scenario, parse_scenario_text
 from world_server import persist
 from world_server.grid.bodies import Bodies
 from world_server.grid.face.layout import A_MOVE, ACT_LEN, STAY
+from world_server.grid.scenario import PhysicsParams
 from world_server.grid.world import GridWorld
 
 N, E, S, W = 0, 1, 2, 3

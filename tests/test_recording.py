@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from swarm.engine import Engine
-from swarm.recording import STATES, Recorder, agent_states, run_meta
-from swarm.review import RecordingError, read_recording, summary_from
+from swarm.engines.grid import Engine
+from swarm.recording.grid import STATES, Recorder, agent_states, run_meta
+from swarm.review.report import RecordingError, read_recording, summary_from
 from swarm.scenario import load_scenario
 from tests.distributed import free_endpoint
 
@@ -194,7 +194,7 @@ def test_recording_files_stay_small(tmp_path):
 def test_the_live_viewer_stream_carries_the_same_run(tmp_path):
     """--viewer URL streams to a rerun gRPC server (here one that saves what it
     gets, as a compose viewer service would show it) besides the file."""
-    from swarm.review import rerun_binary
+    from swarm.review.report import rerun_binary
 
     port = int(free_endpoint().rsplit(":", 1)[1])
     live = tmp_path / "live.rrd"

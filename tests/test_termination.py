@@ -4,7 +4,7 @@ iterations, setup 2 within 12,000 / n, for n agents."""
 
 import pytest
 
-from swarm.engine import Engine
+from swarm.engines.grid import Engine
 from swarm.scenario import load_scenario
 
 BOUND = {"setup1": 600_000, "setup2": 12_000}

@@ -2,7 +2,7 @@
 
 import pytest
 
-from swarm.engine import Engine
+from swarm.engines.grid import Engine
 from swarm.scenario import load_scenario
 from tests.helpers import ascii_scenario, marks_equal_bfs, maze_rows
 from world_server.grid.world import L_MARK

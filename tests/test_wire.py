@@ -3,7 +3,7 @@ by reason and changes nothing, and the agent's batch step equals the engine's.""
 
 import numpy as np
 
-from agents.controllers.dispatch import answer_rows, controller_params, step_controller
+from agents.controllers.grid.dispatch import answer_rows, controller_params, step_controller
 from swarm.core import wire
 from swarm.scenario import load_scenario
 from world_server.grid.accept import (
@@ -120,7 +120,7 @@ def test_the_batch_answer_equals_the_engine_step_agent_by_agent():
 
 
 def _answer(message: bytes, kind, params, count=5):
-    from agents.controllers.envelope import answer_message
+    from agents.controllers.grid.envelope import answer_message
 
     mems, rows = new_memory(count), np.zeros((count, proto.ACT_ROW), np.int64)
     out, info = np.zeros(proto.ENVELOPE + count * proto.ACT_ROW * 8, np.uint8), np.zeros(3, np.int64)
@@ -130,7 +130,7 @@ def _answer(message: bytes, kind, params, count=5):
 
 
 def test_the_compiled_envelope_writes_the_action_message_byte_for_byte():
-    """The agent's one-call answer (agents/controllers/envelope.py) equals parse, step and pack_actions."""
+    """The agent's one-call answer (agents/controllers/grid/envelope.py) equals parse, step and pack_actions."""
     scenario, w = _world(agents=5, seed=9)
     kind, params = controller_kind(scenario.controller), controller_params(scenario)
     ints, pf = np.zeros((5, proto.OBS_INTS), np.int64), np.zeros((5, 5))

@@ -3,7 +3,7 @@ erase merges, min-merged marks, rejected moves, unloads only at the base."""
 
 import numpy as np
 
-from swarm.engine import Engine
+from swarm.engines.grid import Engine
 from tests.helpers import ascii_scenario
 from world_server.grid.face.layout import (
     A_LOAD,

@@ -2,7 +2,7 @@
 
 The engines, the world process, persistence and the recorder need exactly this
 of a world; `GridWorld` and `ArenaWorld` both keep it, and
-`swarm.stepper.step_world` runs either one from it alone (tests/test_contract.py
+`swarm.engines.stepper.step_world` runs either one from it alone (tests/test_contract.py
 runs the grid that way and gets the compiled engine's run, tick for tick).
 """
 

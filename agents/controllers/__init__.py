@@ -1,5 +1,13 @@
-"""Grid controllers: `layout` (the contract), one module per controller, and
-`dispatch.step_controller`, the one compiled step both runtimes call.
+"""The controllers: one folder each (or one folder per compiled family: grid/), and the registry
+that finds them.
 
-Nothing is imported here, so `world_server.grid.face.layout` loads without numba
-(agent processes run an ahead-of-time build of the step: `aot`)."""
+A folder declares `CONTROLLERS`, its entries (swarm.core.registry.ControllerSpec: name, world
+kind, factory, parameter table, sensors, shared key space, kernels, what it records), as plain
+data: reading the registry imports no controller and no numba.  The command line, the scenario
+loader, the recorder, the ahead-of-time build and the docs read it, so adding a controller is
+adding its folder.  `navigation/` is a library the arena controllers share, not a controller.
+"""
+
+from swarm.core.registry import ControllerSpec, Registry
+
+CONTROLLERS: Registry[ControllerSpec] = Registry("controller", "agents.controllers", "CONTROLLERS")

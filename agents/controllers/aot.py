@@ -21,15 +21,15 @@ import shutil
 import tempfile
 from pathlib import Path
 
+from agents.controllers import CONTROLLERS
 from swarm.core.kernels import EXPORTS, built
 from swarm.core.kernels import ahead_of_time_dir as build_dir
 from swarm.core.kernels import ahead_of_time_module as module_name
 
-# Modules whose kernels agent processes call (swarm.core.kernels.exported).
-KERNEL_MODULES = ("swarm.core.rng", "agents.controllers.navigation.astar", "agents.controllers.navigation.dijkstra",
-                  "agents.controllers.bg.gpr", "agents.controllers.bg.senses", "agents.controllers.bg.saliences",
-                  "agents.controllers.bg.places",
-                  "agents.controllers.fingerprint.align", "agents.controllers.dft.fields")  # fmt: skip
+
+def kernel_modules() -> list[str]:
+    """Modules whose kernels agent processes call (swarm.core.kernels.exported): every controller's."""
+    return sorted({module for spec in CONTROLLERS for module in spec.kernels})
 
 
 def signature():
@@ -60,10 +60,10 @@ def build() -> Path:
         return done
     from numba.pycc import CC
 
-    from agents.controllers.dispatch import answer_rows
-    from agents.controllers.envelope import answer_message
+    from agents.controllers.grid.dispatch import answer_rows
+    from agents.controllers.grid.envelope import answer_message
 
-    for module in KERNEL_MODULES:  # they declare their kernels on import
+    for module in kernel_modules():  # they declare their kernels on import
         importlib.import_module(module)
 
     out = build_dir()

@@ -15,39 +15,13 @@ process holds K.
 from __future__ import annotations
 
 import hashlib
-import importlib
 from typing import Any, Protocol
 
 import numpy as np
 
-REGISTRY = {
-    "carrot": "agents.controllers.carrot:CarrotController",
-    "wander": "agents.controllers.wander:WanderController",
-    "fingerprint": "agents.controllers.fingerprint:FingerprintController",
-    "dft": "agents.controllers.dft:DftController",
-    "bg": "agents.controllers.bg:BgController",
-}
-ARENA_CONTROLLERS = tuple(REGISTRY)
-# Each controller's own scenario table, checked when a scenario is loaded (a callable raising ValueError).
-TABLES = {
-    "carrot": "agents.controllers.carrot:CarrotParams.from_table",
-    "wander": "agents.controllers.wander.controller:WanderParams.from_table",
-    "fingerprint": "agents.controllers.fingerprint.controller:check_table",
-    "dft": "agents.controllers.dft.controller:check_table",
-    "bg": "agents.controllers.bg.controller:check_table",
-}
-# Controllers that write a shared key space (swarm/<run>/<share>/<agent>), and which: what one robot
-# publishes at tick t every other robot of the same share receives before it steps tick t + 1.
-SHARES = {"fingerprint": "map", "dft": "context", "bg": "map"}
+from agents.controllers import CONTROLLERS
+
 MAX_SHARE_BYTES = 4 * 1024 * 1024
-# What a controller needs its robot to sense (checked when a scenario is loaded).
-REQUIRES = {
-    "carrot": ("position", "compass"),
-    "wander": (),
-    "fingerprint": ("camera", "laser", "odometry", "compass"),
-    "dft": ("position", "compass", "ir"),
-    "bg": ("camera", "sonar", "odometry", "compass"),
-}
 
 
 class ArenaController(Protocol):
@@ -79,18 +53,9 @@ def as_action(step_result) -> np.ndarray:
     return a if len(a) == 3 else np.full(3, np.nan)
 
 
-def check_table(name: str, table: dict[str, Any]) -> None:
-    """Raise ValueError (one line, naming the field) if `table` is not a valid [name] table."""
-    module, attr = TABLES[name].split(":")
-    target: Any = importlib.import_module(module)
-    for part in attr.split("."):
-        target = getattr(target, part)
-    target(table)
-
-
 def make_controller(name: str) -> ArenaController:
-    module, cls = REGISTRY[name].split(":")
-    return getattr(importlib.import_module(module), cls)()
+    """A fresh controller of the registry's entry `name` (agents.controllers.CONTROLLERS)."""
+    return CONTROLLERS[name].make()
 
 
 def publications(controllers, agents) -> list[tuple[int, str, bytes]]:

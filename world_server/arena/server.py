@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.controllers.arena import SHARES, ShareLog
-from swarm.arena.engine import arena_summary
-from swarm.arena.scenario import controller_params
+from agents.controllers.arena import ShareLog
 from swarm.core import wire
+from swarm.engines.arena import arena_summary
 from world_server import persist
 from world_server.arena.face import wire as arena_proto
+from world_server.arena.scenario import controller_params
 from world_server.arena.world import ArenaWorld
 from world_server.history import SharedHistory
 from world_server.server import ACTIVE, FREE, JOINING, LOST, WorldServer
@@ -98,7 +98,8 @@ class ArenaServer(WorldServer):
 
     def _declare_shared(self, put) -> list:
         out = [self.session.declare_subscriber(self.keys.plans, lambda s: put(("plan", s)))]
-        for share in sorted({SHARES[c] for c in set(self.controllers.tolist()) if c in SHARES}):
+        shares = {self.scenario.share_of(c) for c in set(self.controllers.tolist())} - {None}
+        for share in sorted(shares):
             out.append(self.session.declare_queryable(f"{self.keys.prefix}/{share}/**",
                                                       lambda q, share=share: put(("shared?", (share, q)))))  # fmt: skip
         return out
@@ -119,7 +120,7 @@ class ArenaServer(WorldServer):
             self.recorder.log_plan(plan.tick, plan.agent, plan.path)
 
     def _open_recorder(self, path, viewer: str | None):
-        from swarm.recording_arena import ArenaRecorder
+        from swarm.recording.arena import ArenaRecorder
 
         return ArenaRecorder(path, self.world, {"run_id": self.keys.run, "runtime": self.mode}, viewer=viewer)
 
@@ -216,7 +217,7 @@ class ArenaServer(WorldServer):
         for a, share, payload in msg.shared:
             if not (0 <= a < len(self.slots)) or self.group_of.get(a) != group or a not in named:
                 self.stats.reject("shared: names an agent of another process")
-            elif share != SHARES.get(str(self.controllers[a])):
+            elif share != self.scenario.share_of(str(self.controllers[a])):
                 self.stats.reject("shared: not this controller's key space")
             elif not self.acted[a]:
                 self.stats.reject("shared: its agent's action was refused")

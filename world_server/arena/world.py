@@ -14,11 +14,11 @@ from typing import Any
 
 import numpy as np
 
-from swarm.arena.scenario import ArenaScenario
 from world_server.arena.drive import DiffDrive
 from world_server.arena.face.robots import ZONE_KINDS
 from world_server.arena.metabolism import ACTS, Metabolism
 from world_server.arena.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
+from world_server.arena.scenario import ArenaScenario
 from world_server.arena.sensors import Suite
 from world_server.arena.wheels import (
     ACTION_LEN,

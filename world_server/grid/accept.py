@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from agents.controllers.moves import update_value
 from swarm.core.wire import MAX_MESSAGE_BYTES
 from world_server.grid.face.layout import (
     A_DEPOSIT,
@@ -30,6 +29,7 @@ from world_server.grid.face.layout import (
     STAY,
     TRAIL_ERASE,
 )
+from world_server.grid.face.marks import update_value
 from world_server.grid.face.wire import ACT_ROW, NOT_PLAIN, OBS_INTS, OBS_PERCEPTION, R_ACT, R_AGENT, R_MARKED, R_MEM
 from world_server.grid.face.wire_bytes import (
     ACT_HEAD,
@@ -61,7 +61,7 @@ UNKNOWN, FOREIGN, SECOND, OUT_OF_RANGE, LOW_MARK = range(5)
 def mark_floors(ints, agents, floors):
     """floors[agents[i]]: the lowest mark the agent of observation row i may
     write on its cell this tick, against which its action row's mark is
-    checked: UPDATE-VALUE (`moves.update_value`, the controllers' own) on the
+    checked: UPDATE-VALUE (`face.marks.update_value`, the controllers' own) on the
     perception the world has just sent it."""
     for i in range(len(agents)):
         floors[agents[i]] = update_value(ints[i, OBS_PERCEPTION:])

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.controllers.dispatch import controller_params
+from agents.controllers.grid.dispatch import controller_params
 from swarm.core import wire
-from swarm.engine import UNTIL, is_done
+from swarm.engines.grid import UNTIL, is_done
 from world_server import persist
 from world_server.grid import accept as grid_wire
 from world_server.grid.accept import (
@@ -93,7 +93,7 @@ class GridServer(WorldServer):
         return True
 
     def _open_recorder(self, path: Path, viewer: str | None):
-        from swarm.recording import Recorder, run_meta
+        from swarm.recording.grid import Recorder, run_meta
 
         meta = run_meta(self.scenario, self.world, self.keys.run, self.until, self.mode)
         meta["resumed_at"] = self.tick if self.resumed else None

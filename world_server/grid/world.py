@@ -20,7 +20,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from swarm.scenario import Layout, PhysicsParams, Scenario
 from world_server.grid.bodies import Bodies
 from world_server.grid.face.layout import (
     A_DEPOSIT,
@@ -51,6 +50,7 @@ from world_server.grid.face.layout import (
     TRAIL_PAINT,
     new_perception,
 )
+from world_server.grid.scenario import Layout, PhysicsParams, Scenario
 from world_server.grid.steering import waypoints
 from world_server.persist import ARRAYS as PERSISTED
 

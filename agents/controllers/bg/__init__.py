@@ -3,6 +3,21 @@
 (senses.py), its saliences (saliences.py) and its map (places.py, on the
 shared topological map)."""
 
-from agents.controllers.bg.controller import BgController, BgParams
+from swarm.core.registry import ControllerSpec
 
-__all__ = ["BgController", "BgParams"]
+CONTROLLERS = ControllerSpec(
+    name="bg",
+    world="arena",
+    description="the basal-ganglia animat that survives on two resources (Girard et al. 2005)",
+    factory="agents.controllers.bg.controller:BgController",
+    table="agents.controllers.bg.controller:check_table",
+    requires=("camera", "sonar", "odometry", "compass"),
+    shares="map",
+    kernels=(
+        "agents.controllers.bg.gpr",
+        "agents.controllers.bg.senses",
+        "agents.controllers.bg.saliences",
+        "agents.controllers.bg.places",
+        "agents.controllers.navigation.dijkstra",
+    ),
+)

@@ -1,6 +1,14 @@
 """`carrot`: the DFT paper's baseline (Appendix B): A* on the map the robot is
 given, then follow the carrot from the noisy position sensor and the compass."""
 
-from agents.controllers.carrot.controller import CarrotController, CarrotParams
+from swarm.core.registry import ControllerSpec
 
-__all__ = ["CarrotController", "CarrotParams"]
+CONTROLLERS = ControllerSpec(
+    name="carrot",
+    world="arena",
+    description="A* on the given map, then follow the carrot (the DFT paper's baseline)",
+    factory="agents.controllers.carrot.controller:CarrotController",
+    table="agents.controllers.carrot.controller:CarrotParams.from_table",
+    requires=("position", "compass"),
+    kernels=("agents.controllers.navigation.astar",),
+)

@@ -3,6 +3,15 @@ Lowe & Sandamirskaya 2015): an architecture declared as fields and couplings
 (architecture.py), one engine that steps any such table (fields.py), and the
 e-puck's faces to it (robot.py)."""
 
-from agents.controllers.dft.controller import DftController, DftParams
+from swarm.core.registry import ControllerSpec
 
-__all__ = ["DftController", "DftParams"]
+CONTROLLERS = ControllerSpec(
+    name="dft",
+    world="arena",
+    description="planning and acting with dynamic neural fields (Billing et al. 2015)",
+    factory="agents.controllers.dft.controller:DftController",
+    table="agents.controllers.dft.controller:check_table",
+    requires=("position", "compass", "ir"),
+    shares="context",
+    kernels=("agents.controllers.dft.fields", "agents.controllers.navigation.astar"),
+)

@@ -3,6 +3,15 @@ places (Tapus, Battaglia & Siegwart 2006): features from the camera and the
 laser, circular global alignment with uncertainty, a topological map of mean
 fingerprints with Markov localization (agents.controllers.navigation.topomap)."""
 
-from agents.controllers.fingerprint.controller import FingerprintController, FingerprintParams
+from swarm.core.registry import ControllerSpec
 
-__all__ = ["FingerprintController", "FingerprintParams"]
+CONTROLLERS = ControllerSpec(
+    name="fingerprint",
+    world="arena",
+    description="topological mapping and localization with fingerprints of places (Tapus et al. 2006)",
+    factory="agents.controllers.fingerprint.controller:FingerprintController",
+    table="agents.controllers.fingerprint.controller:check_table",
+    requires=("camera", "laser", "odometry", "compass"),
+    shares="map",
+    kernels=("agents.controllers.fingerprint.align", "agents.controllers.navigation.astar"),
+)

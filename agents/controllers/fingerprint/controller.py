@@ -105,11 +105,11 @@ class FingerprintController:
             self.map = TopoMap(self.signatures, map_params)
             self.grid = None
         if self.p.drive == "route":
-            from agents.controllers.carrot import CarrotController
+            from agents.controllers.carrot.controller import CarrotController
 
             self.driver = CarrotController()
         else:
-            from agents.controllers.wander import WanderController
+            from agents.controllers.wander.controller import WanderController
 
             self.driver = WanderController()
         self.driver.reset(seed, agent, params)

@@ -1,6 +1,12 @@
 """`wander`: a reactive explorer for any robot model - drive ahead, turn away
 from what the range sensors see in front, and now and then turn at random."""
 
-from agents.controllers.wander.controller import WanderController, WanderParams
+from swarm.core.registry import ControllerSpec
 
-__all__ = ["WanderController", "WanderParams"]
+CONTROLLERS = ControllerSpec(
+    name="wander",
+    world="arena",
+    description="a reactive explorer: drive ahead, turn away from what is in front, now and then at random",
+    factory="agents.controllers.wander.controller:WanderController",
+    table="agents.controllers.wander.controller:WanderParams.from_table",
+)

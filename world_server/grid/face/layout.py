@@ -96,7 +96,7 @@ N_MODES = len(MODE_NAMES)
 MARKING = 0
 CMARKING = 1
 ANT = 2
-CONTROLLERS: dict[str, int] = {"marking": MARKING, "cmarking": CMARKING, "ant": ANT}
+CONTROLLERS: dict[str, int] = {"cmarking": CMARKING, "marking": MARKING, "ant": ANT}
 N_PARAMS = 4  # length of the controllers' float parameter vector
 
 

@@ -26,7 +26,7 @@ from swarm.core.wire import (
 )
 from world_server.grid.face.layout import ACT_LEN, MEM_LEN, PERC_F_LEN, PERC_LEN, new_memory
 
-NOT_PLAIN = -2  # agents.controllers.envelope: not a plain observation, the Python parser takes it
+NOT_PLAIN = -2  # agents.controllers.grid.envelope: not a plain observation, the Python parser takes it
 ENVELOPE = 64  # bytes of a grid action message besides its rows
 OBS_PERCEPTION = 2  # an observation row: agent, cell, then the integer perception
 OBS_INTS = OBS_PERCEPTION + PERC_LEN

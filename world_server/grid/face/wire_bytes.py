@@ -1,6 +1,6 @@
 """Compiled reading and writing of the grid's msgpack messages where their
 bytes lie: both ends' one-call envelopes (the agent's answer,
-`agents/controllers/envelope.py`, and the world's acceptance of actions,
+`agents/controllers/grid/envelope.py`, and the world's acceptance of actions,
 `world_server/grid/accept.py`) read and write the same fixed layout that
 `world_server.grid.face.wire` packs.  Every read is bounds-checked: a short or lying
 buffer gives -1, never a read past its end.

@@ -1,0 +1,141 @@
+"""`swarm bench recording`: what recording costs, in both runtimes.
+
+In-process (`swarm run --record`): setup 1 to completion over several seeds,
+ticks/s without and with the recording, and the file's bytes per tick.
+Distributed (`swarm up`, lock-step, where recording is on by default): runs
+with and without, alternated, same seed (the runs are equal tick for tick).
+"""
+
+from __future__ import annotations
+
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+from swarm.engines.grid import Engine
+from swarm.launcher import swarm_up
+from swarm.recording.grid import Recorder, run_meta
+from swarm.scenario import load_scenario
+from world_server.server import new_run_id
+
+
+def _recorder(engine: Engine, path: Path, runtime: str = "in-process") -> Recorder:
+    return Recorder(path, engine.world, run_meta(engine.scenario, engine.world, path.stem, "foraged", runtime))
+
+
+def _warm_up(tmp: Path) -> None:
+    """Compile (or load) both engine loops and import rerun before timing anything."""
+    scenario = load_scenario("setup2").with_overrides(agents=2, seed=0)
+    Engine(scenario).step(10)
+    engine = Engine(scenario)
+    recorder = _recorder(engine, tmp / "warm.rrd", "warm")
+    engine.run(max_iterations=10, recorder=recorder)
+    recorder.close()
+
+
+def _in_process(agents: int, seeds: range, tmp: Path) -> dict:
+    """Whole runs timed in three parts (opening the file, the run, closing it),
+    so the table shows what a recording costs per run besides what it costs per tick."""
+    ticks = plain = opening = running = closing = size = 0.0
+    for seed in seeds:
+        scenario = load_scenario("setup1").with_overrides(agents=agents, seed=seed)
+        engine = Engine(scenario)
+        started = time.perf_counter()
+        ticks += engine.run().iterations
+        plain += time.perf_counter() - started
+        engine = Engine(scenario)
+        path = tmp / f"inproc-{agents}-{seed}.rrd"
+        started = time.perf_counter()
+        recorder = _recorder(engine, path)
+        opened = time.perf_counter()
+        summary = engine.run(recorder=recorder).summary
+        ran = time.perf_counter()
+        recorder.close(summary)
+        closed = time.perf_counter()
+        opening, running, closing = opening + opened - started, running + ran - opened, closing + closed - ran
+        size += path.stat().st_size
+    recorded = opening + running + closing
+    per_run = 1000 / len(seeds)
+    return {"runtime": "in-process", "agents": agents, "runs": len(seeds), "ticks": int(ticks),
+            "ticks_per_second": round(ticks / plain), "recorded_ticks_per_second": round(ticks / recorded),
+            "cost": round(1 - plain / recorded, 3), "bytes_per_tick": round(size / ticks),
+            "mb_per_run": round(size / len(seeds) / 1e6, 2), "plain_ms_per_run": round(plain * per_run, 1),
+            "open_ms_per_run": round(opening * per_run, 1), "recorded_run_ms_per_run": round(running * per_run, 1),
+            "close_ms_per_run": round(closing * per_run, 1),
+            "drained_close_ms_per_run": _close_floor(agents, seeds, tmp)}  # fmt: skip
+
+
+def _close_floor(agents: int, seeds: range, tmp: Path) -> float:
+    """ms to close the file of a recorded run once every tick has long reached rerun
+    (its data flushed, then 0.2 s idle): what no change on our side can save."""
+    total = 0.0
+    for seed in seeds:
+        scenario = load_scenario("setup1").with_overrides(agents=agents, seed=seed)
+        engine = Engine(scenario)
+        path = tmp / f"floor-{agents}-{seed}.rrd"
+        recorder = _recorder(engine, path)
+        summary = engine.run(recorder=recorder).summary
+        recorder.flush()
+        recorder.rec.flush()
+        time.sleep(0.2)
+        started = time.perf_counter()
+        recorder.close(summary)
+        total += time.perf_counter() - started
+    return round(total * 1000 / len(seeds), 1)
+
+
+def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int) -> dict:
+    """`pairs` runs each way, alternated (plain, recorded, plain, ...), same seed:
+    the median ticks/s of each, since one lock-step run over zenoh moves by a
+    few percent on its own."""
+    rates: dict[bool, list[float]] = {False: [], True: []}
+    size = ticks = 0
+    for _ in range(pairs):
+        for record in (False, True):
+            run_id = f"benchrec{new_run_id()}"
+            path = tmp / f"{run_id}.rrd"
+            s = swarm_up("setup1", agents, "cmarking", 1, run_id, f"tcp/127.0.0.1:{port + record}", deadline=10.0,
+                         progress=False, per_process=per_process, record=str(path) if record else None)  # fmt: skip
+            rates[record].append(s["ticks_per_second"])
+            if record:
+                size, ticks = path.stat().st_size, s["iterations"]
+    plain, recorded = statistics.median(rates[False]), statistics.median(rates[True])
+    return {"runtime": "distributed", "agents": agents, "per_process": per_process, "runs": pairs, "ticks": ticks,
+            "ticks_per_second": round(plain, 2), "recorded_ticks_per_second": round(recorded, 2),
+            "cost": round(1 - recorded / plain, 3), "bytes_per_tick": round(size / max(ticks, 1)),
+            "mb_per_run": round(size / 1e6, 2)}  # fmt: skip
+
+
+def bench_recording(quick: bool = False, port: int = 7650) -> dict:
+    seeds = range(1, 3 if quick else 6)
+    with tempfile.TemporaryDirectory(prefix="swarm-bench-rec-") as tmp:
+        _warm_up(Path(tmp))
+        rows = [_in_process(n, seeds, Path(tmp)) for n in (20, 160)]
+        pairs = 1 if quick else 3
+        rows += [_distributed(20, 1, Path(tmp), port, pairs), _distributed(160, 10, Path(tmp), port + 2, pairs)]
+    return {"benchmark": "recording", "scenario": "setup1", "runs": rows}
+
+
+def format_recording_bench(result: dict) -> str:
+    header = f"{'runtime':>12}{'agents':>7}{'ticks/s':>10}{'recorded':>10}{'cost':>7}{'B/tick':>8}{'MB/run':>8}"
+    lines = ["Recording cost, setup1 to completion (cost = share of ticks/s lost to recording)", "", header]
+    for r in result["runs"]:
+        lines.append(f"{r['runtime']:>12}{r['agents']:>7}{r['ticks_per_second']:>10}"
+                     f"{r['recorded_ticks_per_second']:>10}{r['cost']:>7.0%}{r['bytes_per_tick']:>8}"
+                     f"{r['mb_per_run']:>8}")  # fmt: skip
+    lines += ["", "In-process, per run (ms): the plain run, then the recorded one in its three parts", "",
+              f"{'agents':>7}{'plain':>8}{'open':>8}{'run':>8}{'close':>8}{'20% budget':>12}"
+              f"{'close, drained':>16}"]  # fmt: skip
+    for r in result["runs"]:
+        if r["runtime"] == "in-process":
+            budget = r["plain_ms_per_run"] / 4  # recorded <= plain / 0.8, so extra <= plain / 4
+            lines.append(f"{r['agents']:>7}{r['plain_ms_per_run']:>8}{r['open_ms_per_run']:>8}"
+                         f"{r['recorded_run_ms_per_run']:>8}{r['close_ms_per_run']:>8}{budget:>12.1f}"
+                         f"{r['drained_close_ms_per_run']:>16}")  # fmt: skip
+    lines += [
+        "",
+        "close, drained: closing the file after all its data reached rerun and 0.2 s passed;",
+        "rerun writes the file's footer (chunk index) and frees its buffers then, whatever we do before.",
+    ]
+    return "\n".join(lines)

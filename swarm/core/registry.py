@@ -1,0 +1,110 @@
+"""One registry per kind of part, each entry describing itself (ARGoS registers every plugin with
+its own documentation; VMAS finds scenarios by name).
+
+A part's folder declares its entry as plain data: names, numbers and "module:attribute"
+references that are imported only when asked for.  Reading a registry therefore loads no
+controller, kernel or numba: an agent process can look its controller up for the price of a few
+small modules.  A registry finds its entries by importing every subpackage of one package and
+reading one attribute of it (an entry, or a tuple of entries), so adding a part is adding its
+folder.  The registries themselves live in the layer of their parts (agents.controllers.CONTROLLERS).
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any, Generic, Protocol, TypeVar
+
+
+def resolve(reference: str) -> Any:
+    """The object a "package.module:attribute.attribute" reference names (imported now)."""
+    module, _, attr = reference.partition(":")
+    target: Any = importlib.import_module(module)
+    for part in attr.split(".") if attr else ():
+        target = getattr(target, part)
+    return target
+
+
+class UnknownPart(ValueError):
+    """A name no entry of the registry has; the message lists the ones it has."""
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    """Everything the project needs to know of one controller, in its own folder.
+
+    `factory`: an arena controller's class ("module:Class", made with no arguments: the face in
+    agents/controllers/arena.py), or a grid controller's compiled kind code ("module:CONSTANT").
+    `table`: a callable that raises ValueError in one line for a bad [name] table of a scenario.
+    `requires`: the sensors its robot must carry.  `shares`: the key space it writes
+    (swarm/<run>/<share>/<agent>), if any.  `kernels`: modules whose `exported` kernels the
+    agents' ahead-of-time build must compile.  `records`: "module:Class" of the log that shows
+    what explains its choices in a recording, built with the controllers it watches."""
+
+    name: str
+    world: str  # the world kind it drives in: "grid" or "arena"
+    description: str  # one line, for `swarm --help` and the docs
+    factory: str
+    table: str | None = None
+    requires: tuple[str, ...] = ()
+    shares: str | None = None
+    kernels: tuple[str, ...] = ()
+    records: str | None = None
+
+    def make(self) -> Any:
+        """A fresh controller (arena), or the kind code of the compiled step (grid)."""
+        target = resolve(self.factory)
+        return target() if callable(target) else target
+
+    def check_table(self, table: dict[str, Any]) -> None:
+        """Raise ValueError (one line, naming the field) if `table` is not a valid [name] table."""
+        if self.table is not None:
+            resolve(self.table)(table)
+
+
+class Entry(Protocol):
+    name: str
+
+
+E = TypeVar("E", bound=Entry)
+
+
+class Registry(Generic[E]):
+    """The entries of one kind of part, found in the subpackages of `package` (each declares
+    `attribute`: an entry or a tuple of entries), in name order."""
+
+    def __init__(self, what: str, package: str, attribute: str):
+        self.what, self.package, self.attribute = what, package, attribute
+        self._entries: dict[str, E] | None = None
+
+    def _found(self) -> dict[str, E]:
+        if self._entries is None:
+            found: dict[str, E] = {}
+            root = importlib.import_module(self.package)
+            for info in pkgutil.iter_modules(root.__path__, f"{self.package}."):
+                if not info.ispkg:
+                    continue
+                declared = getattr(importlib.import_module(info.name), self.attribute, ())
+                for entry in declared if isinstance(declared, tuple) else (declared,):
+                    if entry.name in found:
+                        raise RuntimeError(f"two {self.what}s named {entry.name!r}: {info.name} and another")
+                    found[entry.name] = entry
+            self._entries = dict(sorted(found.items()))
+        return self._entries
+
+    def __getitem__(self, name: str) -> E:
+        entries = self._found()
+        if name not in entries:
+            raise UnknownPart(f"unknown {self.what} {name!r}; expected one of {', '.join(entries)}")
+        return entries[name]
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._found()
+
+    def __iter__(self) -> Iterator[E]:
+        return iter(self._found().values())
+
+    def names(self, where: Callable[[E], bool] = lambda _: True) -> tuple[str, ...]:
+        return tuple(e.name for e in self if where(e))

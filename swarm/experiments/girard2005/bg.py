@@ -1,0 +1,530 @@
+"""`swarm experiment bg-survival | bg-choice | bg-forget | bg-fear | bg-tmaze`:
+the experiments of Girard et al. (2005) with the bg animat.
+
+- bg-survival (exp. 1, Table 1): condition A (taxon + topological) against B
+  (taxon only) in bg-exp1, each run until death or 4 h; medians, ranges and a
+  Mann-Whitney U test (the paper's Table 1 caption swaps A and B; its text
+  is right: A uses the map).
+- bg-choice (exp. 2.1, Table 2): a map built without Ep2, then Ep2 appears;
+  which Ep the animat reloads at first, for W_plan 0.65 / 0.55 / 0.45; and
+  the paper's control, ten tests in which Ep2 does not appear.
+- bg-forget (exp. 2.2): a map built with Ep2, then Ep2 is gone; the time to
+  forget it (the time to reload at Ep1 less the most direct path's).
+- bg-fear (exp. 3.1, Table 3): F = 0.2 and Ep 0.1 or 0.5; Ep1 behind the
+  dangerous area or the far Ep2; Fisher's exact test; and the paper's
+  control, the same tests without the dangerous area (where "the animat
+  systematically chooses the closest resource").
+- bg-tmaze (exp. 3.2, Table 4): the T-maze with branch ratios 1, 1.5, 2;
+  which branch the animat enters first.
+
+Experiments 2 and 3 give the animat "a previously built map": a mapping run
+(the animat lives up to `MAPPING_SECONDS` there, hungry, so it meets the
+resources; for bg-fear exploring, not planning: `MAPPING`), saved, and
+loaded by a test.  By default test k of every
+condition loads map k, made with seed + k: the conditions are compared on
+the same maps, and a table is not hostage to one mapping run (`maps=1` is
+one map for every test).  docs/bg.md says every choice.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from swarm.core.errors import ScenarioError
+from swarm.experiments.billing2015.carrot import pool_map, write_runs
+from swarm.scenario import load_scenario
+
+EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze")
+SCENARIO = {"bg-survival": "bg-exp1", "bg-choice": "bg-exp2", "bg-forget": "bg-exp2", "bg-fear": "bg-exp3",
+            "bg-tmaze": "tmaze"}  # fmt: skip
+REPS = {"bg-survival": 10, "bg-choice": 15, "bg-forget": 15, "bg-fear": 20, "bg-tmaze": 15}
+MAPPING_SECONDS = 7200.0  # the mapping phase of experiments 2 and 3: at most two hours of the animat's life ...
+MAPPING_LEVELS = (0.5, 0.5)  # E, Ep during mapping: needs enough to seek both resources and reload there ...
+MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping animat must live to map
+
+
+# How a mapping animat maps, and how a test uses its map (docs/bg.md, Experiments): "hungry" lives as in
+# experiment 1, planning back to the resources it found, and a test goes on mapping from it (the map is the way
+# between resources, not the floor); "explore" does not plan (W_plan 0: the "first phase of random exploration and
+# map building" of experiment 1) and maps at least half an hour, so that its map covers the floor, and a test
+# takes that map as it is (it localizes on it and learns where resources are, but makes no node: a node made in
+# a test is a leaf whose routes lead back the way it came) and explores only where the map has a hole (Expl "to
+# explore unmapped areas": known_explore 0; on a map that covers the floor a full-height Expl is noise).
+# Experiment 3.1 needs maps that know both Ep ("the animat systematically chooses the closest resource"): on
+# bg-exp3 the hungry animat planned back to the first Ep it found and knew both on 1 map of 20, the exploring one
+# on 18.
+@dataclasses.dataclass(frozen=True)
+class MappingMode:
+    changes: dict[str, Any]  # [bg] fields of the mapping run
+    least_seconds: float  # the mapping run goes on at least this long
+    tests: dict[str, Any]  # [bg] fields of a test: whether it goes on mapping (learn_map), ... (--bg overrides them)
+    text: str  # what the table's head says of it
+
+
+MAPPING_MODES = {
+    "hungry": MappingMode({}, 0.0, {"learn_map": True}, ").  A test goes on mapping from the map it loads"),
+    "explore": MappingMode({"w_plan": 0.0}, 1800.0, {"learn_map": False, "navigation": {"known_explore": 0.0}},
+                           ", W_plan 0: exploring, not planning, for at least 30 min).  A test takes the map as it "
+                           "is: it localizes on it and learns where resources are, but makes no node, and explores "
+                           "only where the map has a hole"),
+}  # fmt: skip
+MAPPING = {"bg-choice": "hungry", "bg-forget": "hungry", "bg-fear": "explore", "bg-tmaze": "hungry"}
+TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep by then counts as "none"
+W_PLANS = (0.65, 0.55, 0.45)
+FEAR_EP = (0.1, 0.5)
+RATIOS = (1.0, 1.5, 2.0)
+# The paper's numbers, to print beside ours.
+PAPER_SURVIVAL = {"A": (14431.5, 2531, 17274), "B": (4908.0, 2518, 8831), "U": 15}
+PAPER_CHOICE = {0.65: (13, 2), 0.55: (7, 8), 0.45: (2, 13)}
+PAPER_FORGET = (178.0, 78.0, 300.0)  # mean, sd, max seconds
+PAPER_FEAR = {0.1: (13, 7), 0.5: (2, 18)}
+PAPER_TMAZE = {1.0: (3, 12), 1.5: (4, 11), 2.0: (8, 7)}
+# The paper's controls (no numbers given, only what happened): their conditions, tests and words.
+CHOICE_CONTROL, CHOICE_CONTROL_TESTS = "no Ep2", 10
+CHOICE_CONTROL_TEXT = ("ten tests in which Ep2 is not added: \"it goes directly to Ep1 and activates the ReloadEp "
+                       "action\"; W_plan 0.65")  # fmt: skip
+FEAR_CONTROL = {ep: f"{ep}, no DA" for ep in FEAR_EP}
+FEAR_CONTROL_TEXT = ("\"When the Dangerous Area is absent, the animat systematically chooses the closest resource "
+                     "(Ep1)\"; here the same maps and tests with the dangerous area gone and F = 0")  # fmt: skip
+JUNCTION = (3.1, 4.3)  # T-maze: the stem's walls (x): beyond the first, the left branch; beyond the second, the right
+
+
+def _with(s, bg: dict[str, Any] | None = None, metabolism: dict[str, Any] | None = None,
+          seed: int | None = None, absent: tuple[str, ...] = (), max_ticks: int | None = None):  # fmt: skip
+    """A scenario changed for one run: [bg] fields (and [bg.navigation] ones), metabolism fields, resources
+    taken away."""
+    params = dict(s.controller_params)
+    params["bg"] = _merged(params.get("bg", {}), bg or {})
+    obstacles = tuple(dataclasses.replace(o, appear=10**9) if o.name in absent else o for o in s.obstacles)
+    m = dataclasses.replace(s.metabolism, **(metabolism or {}))
+    out = dataclasses.replace(s, controller_params=params, obstacles=obstacles, metabolism=m,
+                              seed=s.seed if seed is None else seed,
+                              max_ticks=s.max_ticks if max_ticks is None else max_ticks)  # fmt: skip
+    return out
+
+
+def _merged(table: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
+    """A [bg] table with `changes` over it; their navigation fields go into its [bg.navigation] table."""
+    out = {**table, **changes}
+    if "navigation" in changes:
+        out["navigation"] = {**table.get("navigation", {}), **changes["navigation"]}
+    return out
+
+
+# ------------------------------------------------------------------ runs
+
+
+def run_survival(job: tuple) -> dict:
+    """One animat in bg-exp1 until it dies or 4 h pass: (condition, run, seed, [bg] changes)."""
+    from swarm.engines.arena import ArenaEngine
+
+    condition, run, seed, changes = job
+    s = _with(load_scenario("bg-exp1"), bg=_merged(changes, {"planning": condition == "A"}), seed=seed)
+    summary = ArenaEngine(s).run()
+    r = summary["robots"][0]
+    return {"condition": condition, "run": run, "seed": seed, "survival_seconds": r["survival_seconds"],
+            "died": not r["alive"], "reload_e_seconds": r["reloads"]["ReloadE"] * s.control_period,
+            "reload_ep_seconds": r["reloads"]["ReloadEp"] * s.control_period, "idle_acts": r["idle_acts"],
+            "distance": r["distance"], "nodes": (r.get("map") or {}).get("nodes"),
+            "wall_seconds": summary["wall_seconds"]}  # fmt: skip
+
+
+def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] | None = None,
+              mode: str = "hungry") -> dict:  # fmt: skip
+    """The mapping phase: the animat lives in `name` (as MAPPING_MODES[mode] says) until it has been at every
+    resource there and its map holds every kind (a node that learned it), or MAPPING_SECONDS pass; its map as
+    plain data."""
+    from swarm.engines.arena import ArenaEngine
+
+    s = load_scenario(name)
+    ticks = int(MAPPING_SECONDS / s.control_period)
+    levels = {
+        "energy": MAPPING_LEVELS[0],
+        "potential": MAPPING_LEVELS[1],
+        "lifetime": MAPPING_LIFETIME,
+        "danger_rate": 0.0,
+    }  # mapping is learning the floor, not surviving it
+    # mapping explores as in exp. 1 (exp. 3's saliences barely explore), and maps (a test may not)
+    how = MAPPING_MODES[mode]
+    bg = _merged(bg or {}, {"saliences": "survival", "learn_map": True, **how.changes})
+    s = _with(s, bg=bg, metabolism={**levels, "stop_at": "death"}, seed=seed, absent=absent, max_ticks=ticks)
+    kinds = {"ingesting": "Ep", "digesting": "E", "dangerous": "DA"}
+    present = [o for o in s.obstacles if o.zone is not None and o.name not in absent]
+    engine = ArenaEngine(s)
+    nav, visited = engine.controllers[0].nav, set()
+    while not engine.world.done():
+        engine.step(1)
+        xy = engine.world.pose[0, :2]
+        visited |= {o.name for o in present if math.hypot(xy[0] - o.centre[0], xy[1] - o.centre[1]) <= o.reach}
+        if (
+            engine.world.tick % 40 == 0
+            and engine.world.tick * s.control_period >= how.least_seconds
+            and len(visited) == len(present)
+            and all(len(nav.assoc[kinds[o.zone]]) and nav.assoc[kinds[o.zone]].max() > 0.5 for o in present)
+        ):
+            break  # been at every resource (the harness's ground truth) and the map holds every kind
+    data = engine.controllers[0].map_data()
+    data["mapped_seconds"] = engine.world.tick * s.control_period
+    data["visited"] = sorted(visited)
+    return data
+
+
+def run_test(job: tuple) -> dict:
+    """One test of experiments 2 and 3 on a loaded map: (experiment, label, run, seed, scenario, bg, metabolism,
+    absent, map index, map)."""
+    from swarm.engines.arena import ArenaEngine
+
+    experiment, label, run, seed, name, bg, metabolism, absent, map_index, map_data = job
+    s = load_scenario(name)
+    s = _with(s, bg={**bg, "map": map_data}, metabolism=metabolism, seed=seed, absent=absent,
+              max_ticks=int(TEST_SECONDS / s.control_period))  # fmt: skip
+    engine = ArenaEngine(s)
+    first_branch = None
+    while not engine.world.done():
+        engine.step(1)
+        x = float(engine.world.pose[0, 0])
+        if first_branch is None and experiment == "bg-tmaze" and float(engine.world.pose[0, 1]) > 3.1:
+            first_branch = "left" if x < JUNCTION[0] else "right" if x > JUNCTION[1] else None
+    r = engine.summary()["robots"][0]
+    seconds = r["ingest_tick"] * s.control_period if r["ingest_tick"] is not None else None
+    return {"experiment": experiment, "condition": label, "run": run, "seed": seed, "map": map_index,
+            "chose": r["ingested"] or "none", "died": not r["alive"],
+            "branch": first_branch or "", "seconds": seconds, "distance": r["distance"],
+            "wall_seconds": engine.wall_seconds}  # fmt: skip
+
+
+# --------------------------------------------------------------- summaries
+
+
+def _survival_summary(rows: list[dict]) -> tuple[list[dict], str]:
+    from scipy.stats import mannwhitneyu
+
+    a = np.array([r["survival_seconds"] for r in rows if r["condition"] == "A"])
+    b = np.array([r["survival_seconds"] for r in rows if r["condition"] == "B"])
+    summary, lines = [], []
+    for cond, x in (("A", a), ("B", b)):
+        paper = PAPER_SURVIVAL[cond]
+        summary.append({"condition": cond, "runs": len(x), "median_s": float(np.median(x)), "min_s": float(x.min()),
+                        "max_s": float(x.max()), "alive_at_cap": int(sum(not r["died"] for r in rows
+                                                                          if r["condition"] == cond)),
+                        "paper_median_s": paper[0], "paper_min_s": paper[1], "paper_max_s": paper[2]})  # fmt: skip
+        lines.append(f"| {cond} | {len(x)} | {np.median(x):.1f} | {x.min():.0f} : {x.max():.0f} | {paper[0]} | "
+                     f"{paper[1]} : {paper[2]} | {np.median(x) / paper[0]:.2f} |")  # fmt: skip
+    test = mannwhitneyu(a, b, alternative="two-sided")
+    u = min(test.statistic, len(a) * len(b) - test.statistic)
+    md = ("| condition | runs | median (s) | range (s) | paper median | paper range | ours / paper |\n"
+          "|---|---|---|---|---|---|---|\n" + "\n".join(lines) +
+          f"\n\nMann-Whitney U = {u:.1f}, p = {test.pvalue:.3g} (two-sided); the paper: U = {PAPER_SURVIVAL['U']}, "
+          f"p < 0.01.  A is taxon + topological navigation, B taxon only (the paper's text; its Table 1 caption "
+          f"swaps them).\n")  # fmt: skip
+    summary.append({"condition": "U test", "u": u, "p": test.pvalue, "paper_u": PAPER_SURVIVAL["U"]})
+    return summary, md
+
+
+def _tally(rows: list[dict], options: tuple[str, str], field: str = "chose") -> tuple[int, int, int]:
+    """How many tests chose each of the two options, and how many neither."""
+    n1 = sum(r[field] == options[0] for r in rows)
+    n2 = sum(r[field] == options[1] for r in rows)
+    return n1, n2, len(rows) - n1 - n2
+
+
+def _choice_summary(rows: list[dict], paper: dict, header: str, options: tuple[str, str], field: str = "chose",
+                    fisher: bool = False) -> tuple[list[dict], str]:  # fmt: skip
+    summary, lines, counts = [], [], []
+    for cond, (p1, p2) in paper.items():
+        sel = [r for r in rows if r["condition"] == cond]
+        n1, n2, other = _tally(sel, options, field)
+        died = sum(bool(r.get("died")) for r in sel if r[field] not in options)  # the dangerous area's drain
+        counts.append((n1, n2, other))
+        summary.append({"condition": cond, "runs": len(sel), options[0]: n1, options[1]: n2, "neither": other,
+                        "neither_died": died, f"paper_{options[0]}": p1, f"paper_{options[1]}": p2})  # fmt: skip
+        lines.append(f"| {cond} | {n1} | {n2} | {other}{f' ({died} died)' if died else ''} | {p1} | {p2} |")
+    md = (f"| {header} | {options[0]} | {options[1]} | neither | paper {options[0]} | paper {options[1]} |\n"
+          "|---|---|---|---|---|---|\n" + "\n".join(lines) + "\n")  # fmt: skip
+    if any(s["neither_died"] for s in summary):
+        md += "\nDied: E ran out before any reload (the dangerous area drains E: docs/bg.md, Metabolism).\n"
+    if fisher:
+        from scipy.stats import fisher_exact
+
+        p = fisher_exact([[n1, n2] for n1, n2, _ in counts]).pvalue
+        p_not = fisher_exact([[n1, n2 + other] for n1, n2, other in counts]).pvalue
+        md += (f"\nFisher's exact test: p = {p:.3g} on ({options[0]}, {options[1]}), the paper's (p < 0.01); "
+               f"p = {p_not:.3g} on ({options[0]}, not {options[0]}).\n")  # fmt: skip
+        summary.append({"condition": "Fisher", "p": p, f"p_{options[0]}_or_not": p_not})
+    return summary, md
+
+
+def _control_summary(rows: list[dict], conditions: list[str], header: str, paper: str,
+                     direct: float) -> tuple[list[dict], str]:  # fmt: skip
+    """The paper's control tests beside its words (it gives no numbers): Ep1, Ep2, neither and the median
+    time to reload, against `direct`, the seconds the most direct path to Ep1 takes."""
+    summary, lines = [], []
+    for cond in conditions:
+        sel = [r for r in rows if r["condition"] == cond]
+        n1, n2, other = _tally(sel, ("Ep1", "Ep2"))
+        times = [r["seconds"] for r in sel if r["seconds"] is not None]
+        median = float(np.median(times)) if times else math.nan
+        summary.append({"condition": cond, "control": True, "runs": len(sel), "Ep1": n1, "Ep2": n2,
+                        "neither": other, "median_s": median, "direct_s": direct})  # fmt: skip
+        lines.append(f"| {cond} | {n1} | {n2} | {other} | {median:.0f} |")
+    md = (f"\nControl (the paper: {paper}):\n\n| {header} | Ep1 | Ep2 | neither | median time to reload (s) |\n"
+          "|---|---|---|---|---|\n" + "\n".join(lines) +
+          f"\n\nThe most direct path to Ep1 takes {direct:.0f} s (A* from the start into its reach, "
+          "at 0.4 m/s).\n")  # fmt: skip
+    return summary, md
+
+
+def _fear_effect(rows: list[dict]) -> str:
+    """Ep1 with the dangerous area against without it, per level of Ep, on the same maps and seeds: what fear
+    takes away (the paper: much at Ep 0.5, where its animat chose Ep1 in 2 of 20; little at 0.1, 13 of 20)."""
+
+    def ep1(condition) -> int:
+        return _tally([r for r in rows if r["condition"] == condition], ("Ep1", "Ep2"))[0]
+
+    parts = [f"Ep {ep}: {ep1(ep)} / {ep1(control)}" for ep, control in FEAR_CONTROL.items()]
+    return ("\nWhat fear takes away: tests at Ep1 with the dangerous area / without it (the same maps and seeds): "
+            + "; ".join(parts) + ".  The paper's animat chose Ep1 in 13 of 20 at Ep 0.1 and 2 of 20 at 0.5, and "
+            "\"systematically\" without the dangerous area.\n")  # fmt: skip
+
+
+def _forget_summary(rows: list[dict], direct: float) -> tuple[list[dict], str]:
+    times = np.array([r["seconds"] - direct for r in rows if r["chose"] == "Ep1" and r["seconds"] is not None])
+    n = len(rows)
+    mean, sd, top = (float(times.mean()), float(times.std(ddof=1)) if len(times) > 1 else 0.0, float(times.max())) \
+        if len(times) else (math.nan, math.nan, math.nan)  # fmt: skip
+    pm, ps, px = PAPER_FORGET
+    md = (f"| tests | reached Ep1 | mean (s) | sd (s) | max (s) | paper mean | paper sd | paper max |\n"
+          f"|---|---|---|---|---|---|---|---|\n| {n} | {len(times)} | {mean:.0f} | {sd:.0f} | {top:.0f} | {pm:.0f} | "
+          f"{ps:.0f} | {px:.0f} |\n\nTime to forget = time to reload at Ep1 less the most direct path's "
+          f"({direct:.0f} s here: start, Ep2's reach, Ep1's reach at 0.4 m/s; the paper's was 46 s).\n")  # fmt: skip
+    return [{"tests": n, "reached_ep1": len(times), "mean_s": mean, "sd_s": sd, "max_s": top, "direct_s": direct,
+             "paper_mean_s": pm, "paper_sd_s": ps, "paper_max_s": px}], md  # fmt: skip
+
+
+def direct_seconds(name: str, stops: tuple[str, ...] = ("Ep2", "Ep1")) -> float:
+    """The most direct path from the start through the reach of each of `stops` in turn (A*), at the animat's
+    top speed: bg-forget's is start, Ep2, Ep1; a control's, start to Ep1."""
+    from swarm.engines.arena import _planner
+
+    s = load_scenario(name)
+    planner = _planner(s.size, s.walls)
+    res = {o.name: o for o in s.obstacles}
+    here, metres = tuple(s.groups[0].starts[0][:2]), 0.0
+    for k, stop in enumerate(stops):  # into each reach but the last, on from its centre
+        leg = planner.plan(here, res[stop].centre)[0] - res[stop].reach
+        metres += leg + (res[stop].reach if k < len(stops) - 1 else 0.0)
+        here = res[stop].centre
+    return metres / s.groups[0].robot.max_speed
+
+
+# ------------------------------------------------------------------ plots
+
+
+def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) -> None:
+    from swarm.experiments.simonin2007.tables import _pyplot, _save
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    if experiment == "bg-survival":
+        for k, cond in enumerate(("A", "B")):
+            x = [r["survival_seconds"] / 3600 for r in rows if r["condition"] == cond]
+            ax.scatter(np.full(len(x), k) + np.linspace(-0.15, 0.15, len(x)), x, alpha=0.7)
+            ax.plot([k - 0.3, k + 0.3], [np.median(x)] * 2, "k-")
+            ax.plot([k - 0.3, k + 0.3], [PAPER_SURVIVAL[cond][0] / 3600] * 2, "r--")
+        ax.set_xticks([0, 1], ["A: taxon + map", "B: taxon only"])
+        ax.set_ylabel("survival (h); black: our median, red: the paper's")
+    elif experiment == "bg-forget":
+        x = [r["seconds"] for r in rows if r["seconds"] is not None]
+        ax.hist(x, bins=10)
+        ax.set_xlabel("seconds to reload at Ep1")
+    else:
+        rows_ = [r for r in summary if isinstance(r.get("runs"), int) and not r.get("control")]
+        controls = [r for r in summary if r.get("control")]  # the paper's controls, on the right (no numbers)
+        keys = [k for k in rows_[0] if k not in ("condition", "runs", "neither", "neither_died")
+                and not k.startswith("paper")]  # fmt: skip
+        x = np.arange(len(rows_) + len(controls))
+        for k, key in enumerate(keys):
+            bars = ax.bar(x + (k - 0.5) * 0.35, [r[key] for r in rows_ + controls], 0.35, label=f"ours: {key}")
+            for bar in bars[len(rows_) :]:
+                bar.set_hatch("//")
+            ax.plot(x[: len(rows_)] + (k - 0.5) * 0.35, [r[f"paper_{key}"] for r in rows_], "k_", markersize=20)
+        ax.set_xticks(x, [str(r["condition"]) for r in rows_ + controls])
+        ax.set_ylabel("tests (bars ours, black ticks the paper;\nhatched: the control)")
+        ax.legend()
+    ax.set_title(experiment)
+    _save(fig, path)
+
+
+# ------------------------------------------------------------------ entry
+
+
+def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
+                      out: Path | None, ratios: tuple[float, ...] | None = None, maps: int | None = None,
+                      progress: bool = True, bg: dict[str, Any] | None = None,
+                      mapping: str | None = None) -> dict:  # fmt: skip
+    """Run one experiment; `maps` mapping runs per scenario for experiments 2 and 3 (default: one per test),
+    made as `mapping` says (MAPPING_MODES; default MAPPING[experiment]); `bg` changes the [bg] table of every
+    run (mapping runs included)."""
+    from agents.controllers.bg.controller import check_table
+
+    changes = dict(bg or {})
+    try:
+        base = load_scenario("tmaze-1" if experiment == "bg-tmaze" else SCENARIO[experiment])
+        check_table(_merged(base.controller_params.get("bg", {}), changes))
+    except ValueError as e:
+        raise ScenarioError("command line", "--bg", str(e)) from None
+    expected = SCENARIO[experiment]
+    if scenario not in (None, expected) and not (experiment == "bg-tmaze" and scenario.startswith("tmaze")):
+        raise ScenarioError("command line", "--scenario", f"{experiment} runs on {expected} (the paper's)")
+    reps = REPS[experiment] if reps is None else reps
+    if reps < 2:
+        raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
+    maps = reps if maps is None else maps
+    if experiment == "bg-survival" and maps != reps:
+        raise ScenarioError("command line", "--maps", "bg-survival has no mapping phase (condition A maps as it lives)")
+    if not 1 <= maps <= reps:
+        raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
+    if experiment == "bg-survival" and mapping is not None:
+        raise ScenarioError("command line", "--mapping", "bg-survival has no mapping phase (A maps as it lives)")
+    mapping = MAPPING.get(experiment, "hungry") if mapping is None else mapping
+    if mapping not in MAPPING_MODES:
+        raise ScenarioError("command line", "--mapping", f"one of {', '.join(MAPPING_MODES)}, not {mapping!r}")
+    out = Path(out) if out is not None else Path("results") / experiment
+    out.mkdir(parents=True, exist_ok=True)
+    if experiment == "bg-survival":
+        work = [(c, k, seed + k, changes) for c in ("A", "B") for k in range(reps)]
+        rows = pool_map(work, run_survival, jobs, experiment, progress)
+        rows.sort(key=lambda r: (r["condition"], r["run"]))
+        summary, md = _survival_summary(rows)
+        title = (
+            f"# Experiment 1 (Girard et al. 2005): survival with and without the map\n\n{reps} runs per "
+            f"condition, at most 4 h; seed {seed}.\n\n"
+        )
+    else:
+        made = _maps(experiment, maps, seed, ratios, jobs, progress, changes, mapping)
+        (out / "maps.json").write_text(json.dumps(made))
+        work = _tests(experiment, reps, seed, made, changes, mapping)
+        rows = pool_map(work, run_test, jobs, experiment, progress)
+        rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
+        summary, md, title = _test_summary(experiment, rows, reps, seed, made, mapping)
+    write_runs(out, "runs.csv", list(rows[0]), rows, summary)
+    _plot(experiment, rows, summary, out / "plot.png")
+    if changes:
+        title += f"[bg] changed in every run: {json.dumps(changes)}.\n\n"
+    text = title + md
+    (out / "table.md").write_text(text)
+    return {"name": experiment, "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
+
+
+def _mapped(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
+    """The scenarios an experiment maps, each with the resources absent while mapping."""
+    if experiment in ("bg-choice", "bg-forget"):
+        return {"bg-exp2": ("Ep2",) if experiment == "bg-choice" else ()}
+    if experiment == "bg-fear":
+        return {"bg-exp3": ()}
+    return {f"tmaze-{ratio:g}": () for ratio in ratios or RATIOS}
+
+
+def _build_map_job(job: tuple) -> dict:
+    name, k, seed, absent, changes, mode = job
+    return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes, mode)}
+
+
+def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None, progress: bool,
+          changes: dict[str, Any] | None = None, mode: str = "hungry") -> dict[str, list[dict]]:  # fmt: skip
+    """`count` maps per scenario, map k from a mapping run with seed + k (in parallel)."""
+    mapped = _mapped(experiment, ratios)
+    work = [(name, k, seed + k, absent, changes or {}, mode) for name, absent in mapped.items() for k in range(count)]
+    made = {(m["scenario"], m["index"]): m["data"]
+            for m in pool_map(work, _build_map_job, jobs, f"{experiment} mapping", progress)}  # fmt: skip
+    return {name: [made[name, k] for k in range(count)] for name in mapped}
+
+
+def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
+           changes: dict[str, Any] | None = None, mapping: str = "hungry") -> list[tuple]:  # fmt: skip
+    """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions).  A test's
+    [bg]: what its mapping mode gives a test (MAPPING_MODES: learn_map, known_explore), under the command line's
+    changes, under its condition's."""
+    base = _merged(MAPPING_MODES[mapping].tests, changes or {})
+
+    def job(label, k: int, name: str, bg: dict, metabolism: dict, absent: tuple[str, ...]) -> tuple:
+        m = k % len(maps[name])
+        return (experiment, label, k, seed + k, name, _merged(base, bg), metabolism, absent, m, maps[name][m])
+
+    if experiment == "bg-choice":
+        return [job(w, k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)] + [
+            job(CHOICE_CONTROL, k, "bg-exp2", {"w_plan": W_PLANS[0], "w_taxon": 0.55}, {}, ("Ep2",))
+            for k in range(min(reps, CHOICE_CONTROL_TESTS))
+        ]
+    if experiment == "bg-forget":
+        return [job("Ep2 gone", k, "bg-exp2", {}, {}, ("Ep2",)) for k in range(reps)]
+    if experiment == "bg-fear":
+        return [job(ep, k, "bg-exp3", {}, {"potential": ep}, ()) for ep in FEAR_EP for k in range(reps)] + [
+            job(FEAR_CONTROL[ep], k, "bg-exp3", {"fear": 0.0}, {"potential": ep}, ("DA",))
+            for ep in FEAR_EP
+            for k in range(reps)
+        ]
+    return [job(float(name.split("-")[1]), k, name, {}, {}, ()) for name in maps for k in range(reps)]
+
+
+def _maps_line(made: list[dict]) -> str:
+    """What the maps of one scenario hold: nodes, mapping time, resources been at, nodes holding each kind."""
+
+    def spread(values) -> str:
+        lo, mid, hi = min(values), float(np.median(values)), max(values)
+        return f"{lo:.0f}" if lo == hi else f"median {mid:.0f} ({lo:.0f} : {hi:.0f})"
+
+    visited = sorted({v for m in made for v in m["visited"]})
+    kinds = sorted({r for m in made for r in m["assoc"]})
+    holding = {r: spread([sum(w > 0.5 for w in m["assoc"].get(r, [])) for m in made]) for r in kinds}
+    return (f"{len(made)} map{'s' if len(made) > 1 else ''}, {spread([len(m['map']['nodes']) for m in made])} nodes "
+            f"after {spread([m['mapped_seconds'] / 60 for m in made])} min; been at "
+            + ", ".join(f"{v} {sum(v in m['visited'] for m in made)}" for v in visited)
+            + "; nodes holding " + ", ".join(f"{r} {h}" for r, h in holding.items()))  # fmt: skip
+
+
+def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int, maps: dict[str, list[dict]],
+                  mapping: str = "hungry") -> tuple[list[dict], str, str]:  # fmt: skip
+    held = "; ".join(f"{name}: {_maps_line(made)}" for name, made in maps.items())
+    n = len(next(iter(maps.values())))
+    head = (
+        f"{reps} tests per condition; seed {seed}; "
+        + (
+            "every test on the map of one mapping run"
+            if n == 1
+            else "test k of every condition on the map of mapping run k (seed + k)"
+            if n == reps
+            else f"test k of every condition on the map of mapping run k mod {n} (seed + k mod {n})"
+        )
+        + f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full "
+        f"E lasting 4 h, the saliences of exp. 1) until it has been at every resource and its map holds every kind, "
+        f'or {MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}"{MAPPING_MODES[mapping].text}.\n\n'
+    )
+    if experiment == "bg-choice":
+        summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
+        control, md_control = _control_summary(
+            rows, [CHOICE_CONTROL], "test", CHOICE_CONTROL_TEXT, direct_seconds("bg-exp2", ("Ep1",))
+        )
+        summary, md = summary + control, md + md_control
+        title = "# Experiment 2.1 (Girard et al. 2005): a new resource, planning against taxon\n\n" + head
+    elif experiment == "bg-forget":
+        summary, md = _forget_summary(rows, direct_seconds("bg-exp2"))
+        title = "# Experiment 2.2 (Girard et al. 2005): forgetting an exhausted resource\n\n" + head
+    elif experiment == "bg-fear":
+        summary, md = _choice_summary(rows, PAPER_FEAR, "Ep at start", ("Ep1", "Ep2"), fisher=True)
+        control, md_control = _control_summary(
+            rows, list(FEAR_CONTROL.values()), "Ep at start", FEAR_CONTROL_TEXT, direct_seconds("bg-exp3", ("Ep1",))
+        )
+        summary, md = summary + control, md + md_control + _fear_effect(rows)
+        title = "# Experiment 3.1 (Girard et al. 2005): fear against the need for Ep (F = 0.2)\n\n" + head
+    else:
+        paper = {r: PAPER_TMAZE[r] for r in sorted({row["condition"] for row in rows})}
+        summary, md = _choice_summary(rows, paper, "ratio", ("left", "right"), field="branch")
+        title = "# Experiment 3.2 (Girard et al. 2005): the T-maze, first branch entered\n\n" + head
+    return summary, md, title

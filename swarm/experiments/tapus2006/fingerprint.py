@@ -1,0 +1,511 @@
+"""`swarm experiment fingerprint-calibrate | fingerprint-map | fingerprint-localize`:
+Tapus, Battaglia & Siegwart (2006), section 3, on the `office` floor.
+
+- calibrate: fingerprints of the mapping tour, every pair labelled same place
+  (same ground-truth place zone) or not; a logistic fit of the label on the
+  alignment cost per character gives the matching probability's centre and
+  width (the defaults of AlignParams come from this command);
+- map: the ~76 m mapping tour, a fingerprint every 15 cm (~500), the map's
+  nodes against the floor's 20 ground-truth places, and the node count as
+  theta varies (the paper: 20 nodes);
+- localize: the map of the mapping tour, then the ~253 m localization tour
+  (~1770 fingerprints, every one on the mapped floor, as the paper's robot
+  stayed on its map): the share of fingerprints placed at the right node
+  by matching alone (paper 81%) and by the Markov filter (paper 100%: ours
+  on the map's odometric grid, and over the links alone beside it), and the
+  rank of the right node among the matches when matching alone misses
+  (paper: 2nd or 3rd); then the same on the `localize-off-map` tour, which
+  also enters the eight rooms the mapping tour did not (our addition: what
+  leaving the map costs).
+
+Both at the sensors' specified noise ("low") and with it doubled ("high").
+Ground truth (the robot's true pose, the place zones) is read by this module
+only, to judge the maps; the controller never sees it.  A node's place is
+the place where most of its fingerprints were taken (for the map against
+the floor's places).  A fingerprint of the second tour is localized right
+when its node holds a mapping fingerprint taken where the nearest one was
+(within TOLERANCE more); fingerprints farther than OFF_MAP from every
+mapping fingerprint (off the mapped floor) are left out of the shares
+(their count is reported).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import multiprocessing as mp
+import os
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from swarm.core.errors import ScenarioError
+
+NOISES = ("low", "high")
+THETAS = (0.2, 0.35, 0.5, 0.65, 0.8)
+PAPER_NODES, PAPER_MATCH, PAPER_MARKOV = 20, 0.81, 1.00
+LOCALIZE_TOURS = ("localize", "localize-off-map")  # on the mapped floor (the paper's case), and leaving it
+OFF_MAP = 1.0  # a fingerprint taken farther than this from every mapping fingerprint is off the mapped floor
+TOLERANCE = 0.5  # nodes whose mapping fingerprints lie this much farther than the nearest count as right too
+
+
+def places(scenario) -> list[tuple[str, tuple[float, float, float, float]]]:
+    return [(z.name, z.coords) for z in scenario.zones if z.kind == "place" and z.shape == "rect"]
+
+
+def place_of(xy: np.ndarray, zones: list) -> int:
+    """The place zone holding xy, else the nearest one (door openings lie between zones)."""
+    best, where = math.inf, -1
+    for k, (_, (x0, y0, x1, y1)) in enumerate(zones):
+        dx = max(x0 - xy[0], 0.0, xy[0] - x1)
+        dy = max(y0 - xy[1], 0.0, xy[1] - y1)
+        d = math.hypot(dx, dy)
+        if d < best:
+            best, where = d, k
+    return where
+
+
+def tour_scenario(name: str, route: str, noise: str, seed: int, table: dict | None = None):
+    from swarm.scenario import load_scenario
+
+    s = load_scenario(name)
+    if route not in s.routes:
+        raise ScenarioError(name, "routes", f"no route {route!r}; the fingerprint experiments need "
+                            "'mapping', 'localize' and 'localize-off-map' routes")  # fmt: skip
+    first = s.routes[route][0]
+    nxt = s.routes[route][1] if len(s.routes[route]) > 1 else (first[0] + 1, first[1])
+    heading = math.atan2(nxt[1] - first[1], nxt[0] - first[0])
+    g = replace(s.groups[0], count=1, controller="fingerprint", route=route, starts=((*first, heading),),
+                goals=None, draw_goals=False)  # fmt: skip
+    tables = dict(s.controller_params)
+    tables["fingerprint"] = {**tables.get("fingerprint", {}), **(table or {})}
+    s = replace(s, groups=(g,), controller_params=tables)
+    return s.with_overrides(noise=noise, seed=seed)
+
+
+def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000) -> dict[str, Any]:
+    """Run one fingerprint robot along its route; per fingerprint the true pose,
+    the node it joined or believed, the node matched best, and the likelihoods."""
+    from swarm.engines.arena import ArenaEngine
+    from world_server.arena.scenario import controller_params
+
+    engine = ArenaEngine(s)
+    c = engine.controllers[0]
+    if topomap is not None:
+        params = controller_params(s, 0)
+        params["fingerprint"] = {**params.get("fingerprint", {}), "mode": "localize"}
+        params["topomap"] = topomap
+        c.reset(s.seed, 0, params)
+    truth, likelihoods, prints = [], [], []
+    while not c.finished and engine.tick < max_ticks:
+        before = engine.world.pose[0].copy()
+        seen = len(c.log)
+        engine.step(1)
+        if len(c.log) > seen:
+            truth.append(before)
+            likelihoods.append(np.asarray(c.map.likelihood, np.float64).copy())
+            prints.append(c.current)
+    log = np.array(c.log, np.int64).reshape(-1, 5)
+    resolve = np.vectorize(c.map.resolve, otypes=[np.int64])  # a node folded later stands for the one it joined
+    believed, matched, by_links = (resolve(log[:, k]) if len(log) else log[:, k] for k in (1, 2, 4))
+    return {"ticks": engine.tick, "truth": np.array(truth).reshape(-1, 3), "believed": believed,
+            "matched": matched, "believed_links": by_links, "size": c.map.size, "likelihoods": likelihoods,
+            "map": c.map_data(),
+            "closures": c.map.closures, "fingerprints": prints, "finished": c.finished,
+            "wall_seconds": engine.wall_seconds}  # fmt: skip
+
+
+def node_places(run: dict, zones: list) -> np.ndarray:
+    """Each node's place: where most of the fingerprints that joined it were taken."""
+    k = len(run["map"]["nodes"])
+    counts = np.zeros((k, len(zones)), np.int64)
+    for xy, node in zip(run["truth"][:, :2], run["believed"], strict=True):
+        counts[node, place_of(xy, zones)] += 1
+    return counts.argmax(axis=1)
+
+
+def judge_map(run: dict, zones: list) -> dict[str, Any]:
+    labels = node_places(run, zones)
+    truth = np.array([place_of(xy, zones) for xy in run["truth"][:, :2]])
+    visited = set(truth.tolist())
+    pure = np.mean(labels[run["believed"]] == truth) if len(truth) else math.nan
+    live = np.setdiff1d(np.arange(len(labels)), [a for a, _ in run["map"].get("folded", [])])
+    per_place = np.bincount(labels[live], minlength=len(zones))
+    rooms = np.array([name.startswith("room") for name, _ in zones], np.bool_)
+    first = first_use(run["believed"])
+    revisits, closed = room_revisits(truth, first, rooms)
+    return {"fingerprints": len(truth), "nodes": run["size"], "places_visited": len(visited),
+            "places_with_node": int(sum(per_place[p] > 0 for p in visited)),
+            "nodes_per_place": round(run["size"] / max(len(visited), 1), 2), "purity": round(float(pure), 4),
+            "links": len(run["map"]["links"]), "closures": run["closures"], "room_revisits": revisits,
+            "room_revisits_closed": closed,
+            "corridor_seen_again_on_old_node": round(ground_seen_again(run["truth"][:, :2], first, truth, ~rooms),
+                                                     4)}  # fmt: skip
+
+
+def first_use(believed: np.ndarray) -> np.ndarray:
+    """Per fingerprint, the index of the first fingerprint that joined its node (when the node was made)."""
+    first: dict[int, int] = {}
+    return np.array([first.setdefault(int(b), i) for i, b in enumerate(believed)], np.int64)
+
+
+def room_revisits(place: np.ndarray, first: np.ndarray, rooms: np.ndarray, least: int = 3) -> tuple[int, int]:
+    """Loops closed where the paper counts them, in rooms: (visits to a room seen on an earlier visit,
+    those whose fingerprints mostly joined nodes made before the visit began; `first`: first_use).
+    A visit is a run of at least `least` fingerprints in one place."""
+    seen, revisits, closed, i = set(), 0, 0, 0
+    while i < len(place):
+        j = i
+        while j < len(place) and place[j] == place[i]:
+            j += 1
+        if j - i >= least and rooms[place[i]]:
+            if place[i] in seen:
+                revisits += 1
+                closed += int(np.mean(first[i:j] < i) >= 0.5)
+            seen.add(int(place[i]))
+        i = j
+    return revisits, closed
+
+
+def ground_seen_again(xy: np.ndarray, first: np.ndarray, place: np.ndarray, where: np.ndarray, near: float = 0.3,
+                      lag: int = 20) -> float:  # fmt: skip
+    """Of the fingerprints taken within `near` of one taken at least `lag` fingerprints (3 m) earlier, in
+    the places marked in `where`, the share that joined a node made before that earlier one's time came
+    round again (a node older than `lag` fingerprints): the corridor, where a place zone is 8 m long and
+    "a visit" means little, seen again is judged by position."""
+    again = old = 0
+    for i in range(lag + 1, len(xy)):
+        if not where[place[i]] or np.hypot(*(xy[: i - lag] - xy[i]).T).min() > near:
+            continue
+        again += 1
+        old += int(first[i] < i - lag)
+    return old / again if again else math.nan
+
+
+# ------------------------------------------------------------------ jobs
+
+
+def map_job(job: tuple) -> dict:
+    name, noise, seed, theta, route = job
+    s = tour_scenario(name, route, noise, seed, {"theta": theta})
+    run = drive_tour(s)
+    return {"scenario": name, "route": route, "noise": noise, "seed": seed, "theta": theta, "ticks": run["ticks"],
+            **judge_map(run, places(s)), "wall_seconds": round(run["wall_seconds"], 2)}  # fmt: skip
+
+
+def right_nodes(mapped: dict, xy: np.ndarray) -> set[int] | None:
+    """The nodes that stand for where `xy` is: those holding a mapping fingerprint
+    taken within TOLERANCE of the nearest one; None off the mapped floor (no
+    mapping fingerprint within OFF_MAP)."""
+    d = np.hypot(*(mapped["truth"][:, :2] - xy).T)
+    if not len(d) or d.min() > OFF_MAP:
+        return None
+    return set(mapped["believed"][d <= d.min() + TOLERANCE].tolist())
+
+
+def localize_job(job: tuple) -> dict:
+    name, noise, seed, route = job
+    s = tour_scenario(name, "mapping", noise, seed)
+    mapped = drive_tour(s)
+    k = mapped["size"]
+    loc = drive_tour(tour_scenario(name, route, noise, seed + 1000), topomap=mapped["map"])
+    by_match, by_markov, by_links, ranks, chance, off = [], [], [], [], [], 0
+    for xy, matched, believed, linked, like in zip(loc["truth"][:, :2], loc["matched"], loc["believed"],
+                                                   loc["believed_links"], loc["likelihoods"], strict=True):  # fmt: skip
+        right = right_nodes(mapped, xy)
+        if right is None:
+            off += 1
+            continue
+        by_match.append(int(matched) in right)
+        by_markov.append(int(believed) in right)
+        by_links.append(int(linked) in right)
+        chance.append(len(right) / k)
+        if not by_match[-1]:  # where the right node comes among the matches
+            order = np.argsort(-like, kind="stable")
+            ranks.append(int(np.flatnonzero(np.isin(order, list(right)))[0]) + 1)
+    ranks = np.array(ranks, np.int64)
+    return {"scenario": name, "route": route, "noise": noise, "seed": seed, "map_nodes": k,
+            "fingerprints": len(loc["matched"]),
+            "on_map": len(by_match), "off_map": off, "match_correct": round(float(np.mean(by_match)), 4),
+            "markov_correct": round(float(np.mean(by_markov)), 4),
+            "links_markov_correct": round(float(np.mean(by_links)), 4), "chance": round(float(np.mean(chance)), 4),
+            "missed_rank2": int((ranks == 2).sum()), "missed_rank3": int((ranks == 3).sum()),
+            "missed_rank_over3": int((ranks > 3).sum()), "ticks": loc["ticks"], "finished": loc["finished"],
+            "wall_seconds": round(mapped["wall_seconds"] + loc["wall_seconds"], 2)}  # fmt: skip
+
+
+def calibration_pairs(name: str, noise: str, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """(cost per character, same place) of every pair of the mapping tour's fingerprints."""
+    from agents.controllers.fingerprint.align import Matcher, paper_length
+
+    s = tour_scenario(name, "mapping", noise, seed)
+    zones = places(s)
+    run = drive_tour(s)
+    prints = run["fingerprints"]
+    where = [place_of(xy, zones) for xy in run["truth"][:, :2]]
+    m = Matcher()
+    d, same = [], []
+    for i in range(len(prints)):
+        for j in range(i + 1, len(prints)):
+            cost = m.cost(prints[i].codes, prints[j].codes)
+            d.append(cost / max(paper_length(prints[i].codes), paper_length(prints[j].codes)))
+            same.append(where[i] == where[j])
+    return np.array(d), np.array(same, bool)
+
+
+def fit_logistic(d: np.ndarray, same: np.ndarray) -> tuple[float, float]:
+    """(centre, width) of P(same | d) = 1 / (1 + exp((d - centre) / width)), classes weighted equally."""
+    from scipy.optimize import minimize
+
+    w = np.where(same, 0.5 / max(same.sum(), 1), 0.5 / max((~same).sum(), 1))
+
+    def loss(x):
+        centre, log_width = x
+        z = np.clip((d - centre) / math.exp(log_width), -50, 50)
+        p = 1.0 / (1.0 + np.exp(z))
+        return -np.sum(w * np.where(same, np.log(p + 1e-12), np.log(1 - p + 1e-12)))
+
+    res = minimize(loss, x0=[float(np.median(d)), math.log(0.05)], method="Nelder-Mead")
+    return float(res.x[0]), float(math.exp(res.x[1]))
+
+
+# --------------------------------------------------------------- reports
+
+
+def _pool(fn, work: list, jobs: int | None, desc: str, progress: bool) -> list[dict]:
+    from tqdm import tqdm
+
+    rows = []
+    bar = tqdm(total=len(work), desc=desc, unit="run", disable=not progress)
+    if len(work) == 1 or jobs == 1:
+        for job in work:
+            rows.append(fn(job))
+            bar.update()
+    else:
+        with mp.get_context("spawn").Pool(min(jobs or os.cpu_count() or 1, len(work))) as pool:
+            for row in pool.imap_unordered(fn, work):
+                rows.append(row)
+                bar.update()
+    bar.close()
+    return rows
+
+
+def _write_csv(path: Path, rows: list[dict]) -> None:
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+
+
+def _mean(rows: list[dict], key: str) -> float:
+    return float(np.mean([r[key] for r in rows])) if rows else math.nan
+
+
+def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
+                               out: Path | None, progress: bool = True) -> dict:  # fmt: skip
+    name = scenario or "office"
+    reps = reps or 3
+    out = Path(out) if out is not None else Path("results") / which
+    out.mkdir(parents=True, exist_ok=True)
+    if which == "fingerprint-calibrate":
+        return _calibrate(name, seed, out)
+    if which == "fingerprint-map":
+        work = [(name, noise, seed + r, theta, "mapping") for noise in NOISES for r in range(reps) for theta in THETAS]
+        work += [(name, noise, seed + r, 0.5, route) for route in LOCALIZE_TOURS for noise in NOISES
+                 for r in range(reps)]  # loops  # fmt: skip
+        rows = _pool(map_job, work, jobs, which, progress)
+        rows.sort(key=lambda r: (("mapping", *LOCALIZE_TOURS).index(r["route"]), NOISES.index(r["noise"]), r["theta"],
+                                 r["seed"]))  # fmt: skip
+        md = _map_table(rows, name, reps, seed)
+        plot_map(rows, name, seed, out / "plot.png")
+    elif which == "fingerprint-localize":
+        work = [(name, noise, seed + r, route) for route in LOCALIZE_TOURS for noise in NOISES for r in range(reps)]
+        rows = _pool(localize_job, work, jobs, which, progress)
+        rows.sort(key=lambda r: (LOCALIZE_TOURS.index(r["route"]), NOISES.index(r["noise"]), r["seed"]))
+        md = _localize_table(rows, name, reps, seed)
+        plot_localize(rows, out / "plot.png")
+    else:
+        raise ValueError(f"unknown fingerprint experiment {which!r}")
+    _write_csv(out / "runs.csv", rows)
+    (out / "table.md").write_text(md)
+    tours = ("mapping",) if which == "fingerprint-map" else LOCALIZE_TOURS
+    summary = [{"route": t, "noise": n,
+                **{k: round(_mean([r for r in rows if r["noise"] == n and r["route"] == t and
+                                   (which != "fingerprint-map" or r["theta"] == 0.5)], k), 4)
+                   for k in rows[0] if isinstance(rows[0][k], (int, float)) and k != "seed"}}
+               for t in tours for n in NOISES]  # fmt: skip
+    _write_csv(out / "summary.csv", summary)
+    return {"name": which, "out": str(out), "runs": len(rows), "rows": rows, "summary": summary, "markdown": md}
+
+
+def _revisits(rows: list[dict]) -> str:
+    n = _mean(rows, "room_revisits")
+    return f"{_mean(rows, 'room_revisits_closed'):.1f} / {n:.1f}" if n > 0 else "–"
+
+
+def _share(x: float) -> str:
+    return "–" if math.isnan(x) else f"{x:.1%}"
+
+
+def _map_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
+    tour = [r for r in rows if r["route"] == "mapping"]
+    lines = [f"# Fingerprint mapping (Tapus et al. 2006), `{name}`\n",
+             f"{reps} runs per noise level and theta (seeds {seed}..{seed + reps - 1}).  The mapping tour passes "
+             f"{tour[0]['places_visited']} of the floor's places.\n",
+             "| tour | noise | theta | fingerprints | nodes | paper | places with a node | nodes per place | "
+             "purity | loops closed | room revisits closed | corridor seen again: on an old node |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
+    for route in ("mapping", *LOCALIZE_TOURS):
+        for noise in NOISES:
+            for theta in THETAS:
+                sel = [r for r in rows if r["route"] == route and r["noise"] == noise and r["theta"] == theta]
+                if not sel:
+                    continue
+                paper = PAPER_NODES if theta == 0.5 and route == "mapping" else ""
+                lines.append(f"| {route} | {noise} | {theta} | {_mean(sel, 'fingerprints'):.0f} | "
+                             f"{_mean(sel, 'nodes'):.1f} | {paper} | {_mean(sel, 'places_with_node'):.1f} / "
+                             f"{sel[0]['places_visited']} | {_mean(sel, 'nodes_per_place'):.2f} | "
+                             f"{_mean(sel, 'purity'):.3f} | {_mean(sel, 'closures'):.1f} | {_revisits(sel)} | "
+                             f"{_share(_mean(sel, 'corridor_seen_again_on_old_node'))} |")  # fmt: skip
+    lines.append("\nPurity: the share of fingerprints whose node's place (where most of its fingerprints were "
+                 "taken) is where they were taken.  The localization tours (~255 m) enter rooms two and three times "
+                 "(`localize` the mapping tour's eight, `localize-off-map` all sixteen): mapped with one, a place "
+                 "seen again should join its node (a loop closed), not add one.  Room revisits closed: visits (3 "
+                 "fingerprints or more) to a room seen on an earlier visit whose fingerprints mostly joined nodes "
+                 "made before the visit (the paper's loops: its robot closed them all).  Corridor seen again: of "
+                 "the fingerprints taken within 0.3 m of one taken 3 m of travel or more earlier, the share that "
+                 "joined a node made before then.  The "
+                 "paper's theta is not given (\"determined experimentally\"); ours is 0.5, the calibrated "
+                 "probability's even odds.")  # fmt: skip
+    return "\n".join(lines) + "\n"
+
+
+def _localize_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
+    lines = [
+        f"# Fingerprint localization (Tapus et al. 2006), `{name}`\n",
+        f"Map from the mapping tour, then a localization tour; {reps} runs per tour and noise level "
+        f"(seeds {seed}..{seed + reps - 1}).\n",
+        "| tour | noise | map nodes | fingerprints (on the map) | matching alone | paper | Markov filter | paper | "
+        "links only | chance | misses by matching: right node 2nd / 3rd / lower |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for route in LOCALIZE_TOURS:
+        for noise in NOISES:
+            sel = [r for r in rows if r["noise"] == noise and r["route"] == route]
+            if not sel:
+                continue
+            m, k = _mean(sel, "match_correct"), _mean(sel, "markov_correct")
+            lines.append(f"| {route} | {noise} | {_mean(sel, 'map_nodes'):.1f} | {_mean(sel, 'fingerprints'):.0f} "
+                         f"({_mean(sel, 'on_map'):.0f}) | {m:.1%} | {PAPER_MATCH:.0%} ({m - PAPER_MATCH:+.1%}) | "
+                         f"{k:.1%} | {PAPER_MARKOV:.0%} ({k - PAPER_MARKOV:+.1%}) | "
+                         f"{_mean(sel, 'links_markov_correct'):.1%} | {_mean(sel, 'chance'):.1%} | "
+                         f"{_mean(sel, 'missed_rank2'):.0f} / {_mean(sel, 'missed_rank3'):.0f} / "
+                         f"{_mean(sel, 'missed_rank_over3'):.0f} |")  # fmt: skip
+    lines.append(f"\nRight: the node holds a mapping fingerprint taken where the nearest one was (within "
+                 f"{TOLERANCE} m more); fingerprints farther than {OFF_MAP} m from every mapping fingerprint (the "
+                 "rooms the mapping tour did not enter) are left out.  Markov filter: the belief on the map's "
+                 "odometric grid (the controller's default); links only: the same likelihoods through the "
+                 "link-only motion model.  The paper's robot stayed on its map (`localize`); "
+                 "`localize-off-map` also enters the eight rooms the mapping tour did not.  Chance: a node "
+                 "drawn at random.  The paper's floor and tours are not available; ours are in "
+                 "docs/fingerprint.md.")  # fmt: skip
+    return "\n".join(lines) + "\n"
+
+
+def _calibrate(name: str, seed: int, out: Path) -> dict:
+    rows, fits = [], []
+    for noise in NOISES:
+        d, same = calibration_pairs(name, noise, seed)
+        centre, width = fit_logistic(d, same)
+        fits.append((noise, centre, width, int(same.sum()), int((~same).sum())))
+        rows.append({"noise": noise, "centre": round(centre, 4), "width": round(width, 4),
+                     "same_pairs": int(same.sum()), "different_pairs": int((~same).sum()),
+                     "same_d_median": round(float(np.median(d[same])), 4),
+                     "different_d_median": round(float(np.median(d[~same])), 4)})  # fmt: skip
+    _write_csv(out / "runs.csv", rows)
+    md = ["# Calibrating P(match) on `" + name + "` (mapping tour, every pair of fingerprints)\n",
+          "| noise | centre | width | same-place pairs | different-place pairs | median d, same | "
+          "median d, different |",
+          "|---|---|---|---|---|---|---|"]  # fmt: skip
+    md += [f"| {r['noise']} | {r['centre']} | {r['width']} | {r['same_pairs']} | {r['different_pairs']} | "
+           f"{r['same_d_median']} | {r['different_d_median']} |" for r in rows]  # fmt: skip
+    md.append(
+        "\nd: alignment cost per character of the longer fingerprint.  "
+        "P(match) = 1 / (1 + exp((d - centre) / width)), fitted by weighted logistic regression."
+    )
+    text = "\n".join(md) + "\n"
+    (out / "table.md").write_text(text)
+    return {"name": "fingerprint-calibrate", "out": str(out), "runs": len(rows), "rows": rows, "markdown": text}
+
+
+def plot_map(rows: list[dict], name: str, seed: int, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(15, 5), gridspec_kw={"width_ratios": [1, 2.2]})
+    for noise in NOISES:
+        means = [_mean([r for r in rows if r["route"] == "mapping" and r["noise"] == noise and r["theta"] == t],
+                       "nodes") for t in THETAS]  # fmt: skip
+        axes[0].plot(THETAS, means, "o-", label=f"noise {noise}")
+    axes[0].axhline(PAPER_NODES, color="grey", ls="--", label="paper (its floor)")
+    axes[0].set(xlabel="theta", ylabel="nodes", title="nodes as theta varies")
+    axes[0].legend()
+    s = tour_scenario(name, "mapping", "low", seed)
+    run = drive_tour(s)
+    draw_map(axes[1], s, run)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def draw_map(ax, s, run: dict) -> None:
+    """The map over the floor plan: each node at the mean true position of its
+    fingerprints (display only), links between them, the tour."""
+    for wall in s.walls:
+        c = wall.coords
+        if wall.shape == "rect":
+            ax.add_patch(__import__("matplotlib.patches", fromlist=["Rectangle"]).Rectangle(
+                (c[0], c[1]), c[2] - c[0], c[3] - c[1], color=np.array(wall.colour) / 255))  # fmt: skip
+        else:
+            ax.plot([c[0], c[2]], [c[1], c[3]], color=np.array(wall.colour) / 255)
+    xy, nodes = run["truth"][:, :2], run["believed"]
+    ax.plot(xy[:, 0], xy[:, 1], color="#bbb", lw=0.8, zorder=1)
+    live = [i for i in range(len(run["map"]["nodes"])) if (nodes == i).any()]  # folded nodes hold none
+    centres = {i: xy[nodes == i].mean(axis=0) for i in live}
+    k = len(live)
+    for a, b, *_ in run["map"]["links"]:
+        if a in centres and b in centres:
+            ax.plot([centres[a][0], centres[b][0]], [centres[a][1], centres[b][1]], color="#36c", lw=1.2, zorder=2)
+    ax.scatter([c[0] for c in centres.values()], [c[1] for c in centres.values()], s=40, color="#c33", zorder=3)
+    ax.set(aspect="equal", xlim=(0, s.size[0]), ylim=(0, s.size[1]),
+           title=f"{k} nodes over the floor plan (noise {s.noise.level}, theta 0.5)")  # fmt: skip
+
+
+def plot_localize(rows: list[dict], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 5.2))
+    groups = [(route, n) for route in LOCALIZE_TOURS for n in NOISES]
+    x = np.arange(len(groups))
+    bars = (("match_correct", "matching alone"), ("links_markov_correct", "Markov, links only"),
+            ("markov_correct", "Markov filter (grid)"))  # fmt: skip
+    for i, (key, label) in enumerate(bars):
+        ax.bar(x + (i - 1) * 0.27, [_mean([r for r in rows if (r["route"], r["noise"]) == g], key) for g in groups],
+               0.27, label=label)  # fmt: skip
+    ax.axhline(PAPER_MATCH, color="C0", ls="--", lw=1, label="paper, matching (81%)")
+    ax.axhline(PAPER_MARKOV, color="C2", ls="--", lw=1, label="paper, Markov (100%)")
+    ax.plot(x, [_mean([r for r in rows if (r["route"], r["noise"]) == g], "chance") for g in groups], "k_", ms=30,
+            label="chance")  # fmt: skip
+    ax.set(xticks=x, xticklabels=[f"{route}\nnoise {n}" for route, n in groups], ylim=(0, 1.05),
+           ylabel="share at the right place", title="localization on the second tour")  # fmt: skip
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3, fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

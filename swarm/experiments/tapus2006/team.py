@@ -1,0 +1,185 @@
+"""`swarm experiment fingerprint-together`: N fingerprint robots map one floor
+together over the `map` key space (issue 14, item 6).
+
+The floor is split into N stretches of the corridor; robot k drives its
+stretch west to east and enters every room whose door is on it, north then
+south (a survey: N = 1 drives all 16 rooms).  Every robot publishes its map's
+changes each tick and merges the others' (agents.controllers.navigation.mapshare).
+Robot 0's merged map covers the floor when each of the floor's 20 places has
+a node in it, a node's place being where most of the fingerprints behind it
+were taken (by whichever robot made it; ground truth, for judging only).
+Reported per N: ticks (and simulated seconds) until robot 0's map covers the
+floor, the mean distance each robot had driven by then, robot 0's node count
+at the end against a lone robot's, how many of its nodes came from others
+and how many of the others' nodes it merged into its own, and how many
+places it knows but never visited.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from swarm.experiments.tapus2006.fingerprint import _pool, _write_csv, place_of, places
+
+TEAMS = (1, 2, 4, 8)
+FLOOR = 32.0
+DOORS = [4 * j + 2.0 for j in range(8)]  # every room's door, north and south of the corridor
+
+
+def survey_route(x0: float, x1: float) -> list[list[float]]:
+    """Along the corridor from x0 to x1, into every room whose door lies in [x0, x1), north then south."""
+    route = [[x0, 6.0]]
+    for x in DOORS:
+        if x0 <= x < x1 or (x1 >= FLOOR - 1 and x0 <= x):
+            route += [[x, 6.7], [x, 7.6], [x, 9.4], [x, 7.6], [x, 6.7],
+                      [x, 5.3], [x, 4.4], [x, 2.6], [x, 4.4], [x, 5.3]]  # fmt: skip
+    route.append([x1, 6.0])
+    return route
+
+
+def team_toml(robots: int, base: str = "office") -> str:
+    """The office floor with `robots` fingerprint scouts, robot k surveying the k-th stretch."""
+    from swarm.scenario import BUNDLED_DIR
+
+    text = (BUNDLED_DIR / f"{base}.toml").read_text()
+    text = re.sub(r"\n\[\[group\]\]\n(?:(?!\[)[^\n]+\n)+", "\n", text, count=1)  # the file's one robot
+    routes, groups = [], []
+    for k in range(robots):
+        x0 = 0.8 if k == 0 else FLOOR * k / robots + 0.8
+        x1 = FLOOR - 0.8 if k == robots - 1 else FLOOR * (k + 1) / robots - 0.8
+        routes.append(f"survey_{k} = {survey_route(x0, x1)}")
+        groups.append(f'[[group]]\ncount = 1\ncontroller = "fingerprint"\nstart = [{x0}, 6.0, 0.0]\n'
+                      f'route = "survey_{k}"\n')  # fmt: skip
+    text = text.replace("[routes]\n", "[routes]\n" + "\n".join(routes) + "\n", 1)
+    return text.rstrip("\n") + "\n\n" + "\n".join(groups)
+
+
+def team_scenario(robots: int, noise: str, seed: int):
+    from swarm.scenario import parse_arena_text
+
+    s = parse_arena_text(team_toml(robots), f"office, {robots} surveyors", "office-team")
+    return s.with_overrides(noise=noise, seed=seed)
+
+
+def team_job(job: tuple) -> dict:
+    from swarm.engines.arena import ArenaEngine
+
+    robots, noise, seed = job
+    s = team_scenario(robots, noise, seed)
+    zones = places(s)
+    engine = ArenaEngine(s)
+    cs = engine.controllers
+    counts = [dict() for _ in cs]  # per robot: its node -> place -> fingerprints
+    covered_tick, covered_distance = None, None
+    while not all(c.finished for c in cs) and engine.tick < 40_000:
+        before = engine.world.pose[:, :2].copy()
+        seen = [len(c.log) for c in cs]
+        engine.step(1)
+        for k, c in enumerate(cs):
+            if len(c.log) > seen[k]:
+                node_counts = counts[k].setdefault(c.believed, {})
+                p = place_of(before[k], zones)
+                node_counts[p] = node_counts.get(p, 0) + 1
+        if covered_tick is None and len(known_places(cs[0], counts)) == len(zones):
+            covered_tick = engine.tick
+            covered_distance = float(np.mean(engine.world.path_length))
+    mine = set()
+    for node_counts in counts[0].values():
+        mine |= set(node_counts)
+    known = known_places(cs[0], counts)
+    lead = cs[0].summary()["map"]
+    return {"robots": robots, "noise": noise, "seed": seed, "ticks": engine.tick,
+            "covered_tick": covered_tick if covered_tick is not None else "",
+            "covered_seconds": round(covered_tick * s.control_period, 1) if covered_tick is not None else "",
+            "covered_distance": round(covered_distance, 2) if covered_distance is not None else "",
+            "places": len(zones), "places_known": len(known), "known_not_visited": len(known - mine),
+            "nodes": lead["nodes"], "from_others": lead["from_others"], "merged_with_ours": lead["merged_with_ours"],
+            "own_fingerprints": lead["fingerprints"], "rejected_shared": engine.refused_shared,
+            "wall_seconds": round(engine.wall_seconds, 2)}  # fmt: skip
+
+
+def known_places(lead, counts: list[dict]) -> set[int]:
+    """Places of robot 0's nodes: its own by its fingerprints, copies by their maker's."""
+    out = set()
+    own: dict[int, dict] = {}  # robot 0's fingerprints by the node they stand in now (folds resolved)
+    for node, tally in counts[0].items():
+        mine = own.setdefault(lead.map.resolve(node), {})
+        for p, n in tally.items():
+            mine[p] = mine.get(p, 0) + n
+    counts = [own, *counts[1:]]
+    for i in range(len(lead.map.nodes)):
+        if i in lead.map.folded:
+            continue
+        robot, node = lead.shared.origin.get(i, (0, i))
+        tally = dict(counts[robot].get(node, {}))
+        if robot != 0:  # a copy robot 0 has since observed at: its own fingerprints count too
+            for p, n in counts[0].get(i, {}).items():
+                tally[p] = tally.get(p, 0) + n
+        if tally:
+            out.add(max(tally, key=tally.get))
+    return out
+
+
+def run_team_experiment(reps: int | None, jobs: int | None, seed: int, out: Path | None, progress: bool = True,
+                        teams: tuple[int, ...] = TEAMS) -> dict:  # fmt: skip
+    reps = reps or 1
+    out = Path(out) if out is not None else Path("results") / "fingerprint-together"
+    out.mkdir(parents=True, exist_ok=True)
+    work = [(n, "low", seed + r) for n in sorted(teams, reverse=True) for r in range(reps)]
+    rows = _pool(team_job, work, jobs, "fingerprint-together", progress)
+    rows.sort(key=lambda r: (r["robots"], r["seed"]))
+    _write_csv(out / "runs.csv", rows)
+    md = _table(rows, reps, seed)
+    (out / "table.md").write_text(md)
+    plot(rows, out / "plot.png")
+    return {"name": "fingerprint-together", "out": str(out), "runs": len(rows), "rows": rows, "markdown": md}
+
+
+def _mean(sel: list[dict], key: str) -> float:
+    values = [float(r[key]) for r in sel if r[key] != ""]
+    return float(np.mean(values)) if values else math.nan
+
+
+def _table(rows: list[dict], reps: int, seed: int) -> str:
+    lone = _mean([r for r in rows if r["robots"] == 1], "nodes")
+    lines = ["# Mapping together (fingerprints of places, `office`, noise low)\n",
+             f"{reps} run(s) per team size (seeds {seed}..{seed + reps - 1}); robot k surveys the k-th stretch of the "
+             "corridor and its rooms; robot 0's merged map is judged.\n",
+             "| robots | covered after (ticks) | (s simulated) | distance per robot (m) | places known | "
+             "known, never visited | nodes | a lone robot's | from others | merged into ours |",
+             "|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
+    for n in sorted({r["robots"] for r in rows}):
+        sel = [r for r in rows if r["robots"] == n]
+        covered = sum(r["covered_tick"] != "" for r in sel)
+        lines.append(f"| {n} | {_mean(sel, 'covered_tick'):.0f} ({covered}/{len(sel)} covered) | "
+                     f"{_mean(sel, 'covered_seconds'):.1f} | {_mean(sel, 'covered_distance'):.1f} | "
+                     f"{_mean(sel, 'places_known'):.1f} / {sel[0]['places']} | {_mean(sel, 'known_not_visited'):.1f} | "
+                     f"{_mean(sel, 'nodes'):.1f} | {lone:.1f} | {_mean(sel, 'from_others'):.1f} | "
+                     f"{_mean(sel, 'merged_with_ours'):.1f} |")  # fmt: skip
+    lines.append("\nThe paper maps with one robot; this is our extension (docs/fingerprint.md).")
+    return "\n".join(lines) + "\n"
+
+
+def plot(rows: list[dict], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ns = sorted({r["robots"] for r in rows})
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    axes[0].plot(ns, [_mean([r for r in rows if r["robots"] == n], "covered_seconds") for n in ns], "o-")
+    axes[0].set(xscale="log", xticks=ns, xticklabels=ns, xlabel="robots", ylabel="s simulated",
+                title="until robot 0's map covers the floor")  # fmt: skip
+    axes[1].plot(ns, [_mean([r for r in rows if r["robots"] == n], "nodes") for n in ns], "o-", label="robot 0's nodes")
+    axes[1].plot(ns, [_mean([r for r in rows if r["robots"] == n], "from_others") for n in ns], "s--",
+                 label="of them from others")  # fmt: skip
+    axes[1].set(xscale="log", xticks=ns, xticklabels=ns, xlabel="robots", title="robot 0's merged map")
+    axes[1].legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

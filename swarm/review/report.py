@@ -1,0 +1,230 @@
+"""Reading recordings back: `swarm report` and `swarm replay`.
+
+Everything comes out of the .rrd through rerun's own reader
+(`rerun.chunk.RrdReader`); there is no side file.  The summary is rebuilt from
+the recorded time series and the run's metadata, so it checks what the
+recording holds rather than repeating what the run said.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from urllib.parse import quote
+
+import numpy as np
+
+from swarm.core.errors import RecordingError
+from swarm.core.plots import plot_writer
+from swarm.recording.grid import METRICS, STATES
+
+
+@dataclass
+class Recording:
+    path: Path
+    meta: dict
+    printed: dict | None  # the summary the run printed, if the run ended
+    series: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)  # name -> (ticks, values)
+
+    def values(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        return self.series.get(name, (np.zeros(0, np.int64), np.zeros(0)))
+
+    def last(self, name: str, default: float = 0.0) -> float:
+        values = self.values(name)[1]
+        return float(values[-1]) if len(values) else default
+
+
+def read_recording(path: str | Path) -> Recording:
+    path = Path(path)
+    if not path.is_file():
+        raise RecordingError(f"{path}: no such file (recordings land in runs/<run-id>.rrd)")
+    from rerun.chunk import RrdReader
+
+    meta = printed = None
+    parts: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # rerun warns before it fails on a cut file; we explain below
+            chunks = list(RrdReader(path).stream())
+        for chunk in chunks:
+            entity = chunk.entity_path.lstrip("/")
+            if entity == "run/meta" and chunk.is_static:
+                meta = json.loads(_any_value(chunk, "meta"))
+            elif entity == "run/summary" and chunk.is_static:
+                printed = json.loads(_any_value(chunk, "summary"))
+            elif entity.startswith("metrics/") and not chunk.is_static:
+                batch = chunk.to_record_batch()
+                ticks = batch.column("tick").to_numpy()
+                values = batch.column("Scalars:scalars")
+                if entity.startswith("metrics/robots/"):  # one scalar per robot and tick: (T, n)
+                    values = np.array([np.asarray(v.as_py(), np.float64) for v in values])
+                else:
+                    values = values.flatten().to_numpy()
+                parts.setdefault(entity.removeprefix("metrics/"), []).append((ticks, values))
+            elif entity == "world/robots" and not chunk.is_static:
+                batch = chunk.to_record_batch()
+                ticks = batch.column("tick").to_numpy()
+                xy = np.array([np.asarray(v.as_py(), np.float64) for v in batch.column("Points2D:positions")])
+                parts.setdefault("positions", []).append((ticks, xy * [1.0, -1.0]))  # logged north up
+    except Exception as exc:  # rerun raises its own types for broken files
+        raise RecordingError(f"{path}: damaged or not a rerun recording ({exc}). If the run was killed, "
+                             "the file may be cut short; rerun it to get a complete recording.") from None  # fmt: skip
+    if meta is None:
+        raise RecordingError(f"{path}: not a swarm recording (no run/meta); was it written by `swarm run --record` "
+                             "or `swarm up`?")  # fmt: skip
+    series = {}
+    for name, chunks in parts.items():
+        ticks = np.concatenate([t for t, _ in chunks])
+        values = np.concatenate([v for _, v in chunks])
+        order = np.argsort(ticks, kind="stable")
+        series[name] = (ticks[order], values[order])
+    rec = Recording(path, meta, printed, series)
+    if printed is None:
+        ticks = rec.values("reached" if meta.get("kind") == "arena" else "delivered")[0]
+        upto = f"ticks 0..{int(ticks[-1])}" if len(ticks) else "no ticks"
+        raise RecordingError(f"{path}: truncated: it holds {upto} but no end-of-run record (the run was "
+                             "killed or is still going, or the file was cut).")  # fmt: skip
+    return rec
+
+
+def _any_value(chunk, column: str) -> str:
+    return chunk.to_record_batch().column(column).flatten()[0].as_py()
+
+
+# -------------------------------------------------------------------- summary
+
+
+def summary_from(rec: Recording) -> dict:
+    """The run summary (keys of `swarm run --json`, plus the distributed ones
+    when the run was distributed), rebuilt from the recorded series."""
+    m = rec.meta
+    if m.get("kind") == "arena":
+        from swarm.review.arena import arena_summary_from
+
+        return arena_summary_from(rec)
+    ticks = rec.values("delivered")[0]
+    delivered = int(rec.last("delivered"))
+    optimal = int(rec.last("optimal_cells"))
+    foraged, converged = delivered >= m["total"], optimal == m["reachable_cells"]
+    finished = {"foraged": foraged, "converged": converged, "both": foraged and converged}[m["until"]]
+    summary = {
+        "scenario": m["name"], "controller": m["controller"], "agents": m["agents"], "seed": m["seed"],
+        "until": m["until"], "iterations": int(ticks[-1]) + 1 if len(ticks) else 0, "finished": finished,
+        "delivered": delivered, "total": m["total"], "in_transit": int(rec.last("in_transit")),
+        "apf_optimal": converged, "optimal_cells": optimal, "explored_cells": int(rec.last("explored_cells")),
+        "reachable_cells": m["reachable_cells"], "grid": m["grid"], "physics": m["physics"],
+    }  # fmt: skip
+    if m["runtime"] != "in-process":
+        tick_ms = rec.values("tick_ms")[1]
+        summary.update({
+            "run_id": m["run_id"], "mode": m["runtime"], "rejected_messages": int(rec.last("rejected_messages")),
+            "agents_peak": int(rec.values("agents_alive")[1].max(initial=0)),
+            "tick_ms_p50": round(float(np.percentile(tick_ms, 50)), 3) if len(tick_ms) else 0.0,
+            "tick_ms_p99": round(float(np.percentile(tick_ms, 99)), 3) if len(tick_ms) else 0.0,
+        })  # fmt: skip
+    return summary
+
+
+# ---------------------------------------------------------------------- plots
+
+
+def write_plots(rec: Recording, out: Path) -> list[Path]:
+    if rec.meta.get("kind") == "arena":
+        from swarm.review.arena import write_arena_plots
+
+        return write_arena_plots(rec, out)
+    plt, save, written = plot_writer(out)
+    title = f"{rec.meta['name']}: {rec.meta['controller']} x{rec.meta['agents']}, seed {rec.meta['seed']}"
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    ax.plot(*rec.values("delivered"), label="delivered")
+    ax.axhline(rec.meta["total"], color="grey", linestyle="--", label="total")
+    ax.set(xlabel="tick", ylabel="units", title=f"Delivered — {title}")
+    ax.legend()
+    save(fig, "delivered.png")
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    ax.plot(*rec.values("optimal_share"))
+    ax.set(xlabel="tick", ylabel="share", ylim=(0, 1.02), title="Cells whose mark equals the BFS distance")
+    save(fig, "optimal_share.png")
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    ticks = rec.values(f"agents/{STATES[0]}")[0]
+    present = [s for s in STATES if s != "absent"]  # empty slots are not agents
+    counts = [rec.values(f"agents/{s}")[1] for s in present]
+    ax.stackplot(ticks, *counts, labels=present)
+    ax.set(xlabel="tick", ylabel="agents", title="Agents per state")
+    ax.legend(loc="upper right", fontsize="small")
+    save(fig, "agent_states.png")
+    return written
+
+
+def report(path: str | Path, out: str | Path | None = None) -> dict:
+    rec = read_recording(path)
+    summary = summary_from(rec)
+    out = Path(out) if out is not None else Path(path).with_suffix("")
+    plots = write_plots(rec, out)
+    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    return {"summary": summary, "plots": [str(p) for p in plots], "out": str(out),
+            "metrics": sorted(n for n in rec.series if n in METRICS)}  # fmt: skip
+
+
+# --------------------------------------------------------------------- replay
+
+
+def rerun_binary() -> str:
+    """The viewer that ships with rerun-sdk (next to this Python), else on PATH."""
+    local = Path(sys.executable).parent / "rerun"
+    found = str(local) if local.exists() else shutil.which("rerun")
+    if not found:
+        raise RecordingError("the rerun viewer is not installed: run `make install` (it comes with rerun-sdk)")
+    return found
+
+
+def web_url(web_port: int, grpc_port: int, host: str = "127.0.0.1") -> str:
+    return f"http://{host}:{web_port}/?url={quote(f'rerun+http://{host}:{grpc_port}/proxy', safe='')}"
+
+
+def replay_command(path: Path, web: bool, web_port: int, grpc_port: int, bind: str) -> list[str]:
+    if web:
+        return [rerun_binary(), "--serve-web", "--bind", bind, "--web-viewer-port", str(web_port),
+                "--port", str(grpc_port), str(path)]  # fmt: skip
+    return [rerun_binary(), str(path)]
+
+
+def replay(path: str | Path, web: bool = False, web_port: int = 9090, grpc_port: int = 9876,
+           bind: str = "127.0.0.1") -> int:  # fmt: skip
+    path = Path(path)
+    read_recording(path)  # a clear error now beats a blank viewer
+    if not web and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        raise RecordingError("no display here for the native viewer: use `swarm replay FILE --web` and open the URL")
+    cmd = replay_command(path, web, web_port, grpc_port, bind)
+    # Its own process group: the `rerun` launcher starts the viewer binary as a child, and
+    # Ctrl-C or SIGTERM (a test, docker stop) must end both.
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    previous = signal.signal(signal.SIGTERM, _interrupt)
+    if web:
+        print(f"serving {path} — open {web_url(web_port, grpc_port)}  (Ctrl-C to stop)", flush=True)
+    try:
+        return proc.wait()
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGTERM)
+            try:
+                proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
