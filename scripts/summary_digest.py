@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 # Keys (JSON) and columns (CSV) that measure the machine, not the model.
-VOLATILE = re.compile(r"(^|_)(wall|per_second|elapsed|run_id|rrd|path|out|host|pid|compile|rss|tick_ms)($|_)|^seconds$")
+VOLATILE = re.compile(r"(^|_)(wall|per_second|elapsed|run_id|compile|rss|tick_ms)($|_)|^seconds$")
 
 SWARM = [sys.executable, "-m", "swarm"]
 OUTPUTS = "runs.csv summary.csv table.md"
@@ -54,6 +54,14 @@ JOBS: dict[str, tuple[str, str]] = {
     "up-grid": ("up setup1 --agents 4 --seed 1 --max-iterations 100 --no-record --json", ""),
     "up-arena-dft": ("up zmaze --controller dft --seed 1 --max-ticks 120 --no-record --json", ""),
     "up-arena-bg-colony": ("up bg-colony --seed 1 --max-ticks 120 --no-record --json", ""),
+    "up-record-grid": (
+        "up setup1 --agents 3 --seed 2 --max-iterations 60 --record {out}/up-grid.rrd --json",
+        "@report {out}/up-grid.rrd",
+    ),
+    "up-record-arena": (
+        "up zmaze --controller carrot --seed 2 --max-ticks 80 --record {out}/up-arena.rrd --json",
+        "@report {out}/up-arena.rrd",
+    ),
     "exp-table2": ("experiment table2 --reps 3 --jobs 2 --out {out}", OUTPUTS),
     "exp-carrot": ("experiment carrot --scenario zmaze --reps 2 --jobs 2 --out {out}", OUTPUTS),
     "exp-dft-case1": ("experiment dft-case1 --reps 1 --noise high --jobs 2 --out {out}", OUTPUTS),
@@ -96,7 +104,8 @@ def run_job(name: str, command: str, files: str, out: Path) -> str:
         raise SystemExit(f"{name}: swarm {' '.join(argv)} exited {done.returncode}:\n{done.stderr[-2000:]}")
     parts = [("exit", str(done.returncode))]
     if "--json" in argv:
-        parts.append(("stdout", json.dumps(normalize_json(json.loads(done.stdout)), sort_keys=True)))
+        summary = json.dumps(normalize_json(json.loads(done.stdout)), sort_keys=True)
+        parts.append(("stdout", summary.replace(str(out), "{out}")))
     if files.startswith("@report "):
         rrd = files.split(" ", 1)[1].replace("{out}", str(out))
         report = [*SWARM, "report", rrd, "--json", "--out", str(out / "report")]

@@ -480,7 +480,7 @@ def _scenario(args):
 
 
 def cmd_world(args) -> int:
-    from world_server.serve import serve
+    from swarm.world_process import serve
 
     scenario = _scenario(args)
     if args.until != "foraged" and scenario.controller == "ant":

@@ -10,11 +10,14 @@ from __future__ import annotations
 import re
 import tomllib
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from agents.controllers import CONTROLLERS
 from swarm.core.errors import ScenarioError
-from world_server.arena.scenario import ArenaScenario, parse_arena
 from world_server.grid.scenario import Scenario, paper_setup, parse_grid
+
+if TYPE_CHECKING:
+    from world_server.arena.scenario import ArenaScenario
 
 WORLD_KINDS = ("grid", "arena")
 
@@ -64,7 +67,7 @@ def parse_scenario_text(text: str, source: str = "<string>"):
     if kind not in WORLD_KINDS:
         raise ScenarioError(source, "kind", f"unknown world kind {kind!r}; expected one of {', '.join(WORLD_KINDS)}")
     if kind == "arena":
-        return parse_arena(data, source, Path(source).stem, arena_controllers())
+        return parse_arena_tables(data, source, Path(source).stem)
     data.pop("kind", None)
     return parse_grid(data, text, source)
 
@@ -80,4 +83,12 @@ def parse_arena_text(text: str, source: str = "<string>", default_name: str = "a
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(source, "TOML", f"not valid TOML ({exc})") from None
+    return parse_arena_tables(data, source, default_name)
+
+
+def parse_arena_tables(data: dict, source: str, default_name: str) -> ArenaScenario:
+    # Imported here, not above: the arena's sensors load numba, and `swarm agent` (an agent
+    # process, which reads no scenario) must start without it to stay under 80 MB.
+    from world_server.arena.scenario import parse_arena
+
     return parse_arena(data, source, default_name, arena_controllers())

@@ -9,7 +9,7 @@ import subprocess
 import sys
 import threading
 
-from world_server.serve import make_server
+from swarm.world_process import make_server
 
 
 def free_endpoint() -> str:

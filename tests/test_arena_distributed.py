@@ -238,10 +238,9 @@ def test_kill_9_the_arena_world_then_a_restart_ends_exactly_as_swarm_run(ref, ag
     import sys
     import time
 
-    from agents.controllers.arena import ShareLog
     from swarm.scenario import BUNDLED_DIR
     from world_server import persist
-    from world_server.history import SharedHistory
+    from world_server.history import SharedHistory, ShareLog
 
     text = (BUNDLED_DIR / f"{ref}.toml").read_text()
     (scenario_file := tmp_path / f"{ref}.toml").write_text(re.sub(r"(?m)^max_ticks = .*$", f"max_ticks = {max_ticks}",

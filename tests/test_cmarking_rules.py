@@ -3,7 +3,7 @@
 import numpy as np
 
 from agents.controllers.grid.cmarking import new_trail_id
-from agents.controllers.grid.dispatch import controller_params, step_controller
+from agents.controllers.grid.dispatch import step_controller
 from world_server.grid.face.layout import (
     A_LOAD,
     A_MARK,
@@ -32,6 +32,7 @@ from world_server.grid.face.layout import (
     TRAIL,
     TRAIL_ERASE,
     TRAIL_PAINT,
+    controller_params,
     new_action,
     new_memory,
     new_perception,

@@ -3,14 +3,14 @@
 import numpy as np
 import pytest
 
-from agents.controllers.grid.dispatch import controller_params, step_controller
+from agents.controllers.grid.dispatch import step_controller
 from swarm.engines.arena import ArenaEngine
 from swarm.engines.grid import Engine
 from swarm.engines.stepper import step_world
 from swarm.scenario import load_scenario
 from world_server.arena.world import ArenaWorld
 from world_server.contract import World
-from world_server.grid.face.layout import controller_kind, new_memory
+from world_server.grid.face.layout import controller_kind, controller_params, new_memory
 from world_server.grid.world import GridWorld
 
 

@@ -3,7 +3,7 @@ by reason and changes nothing, and the agent's batch step equals the engine's.""
 
 import numpy as np
 
-from agents.controllers.grid.dispatch import answer_rows, controller_params, step_controller
+from agents.controllers.grid.dispatch import answer_rows, step_controller
 from swarm.core import wire
 from swarm.scenario import load_scenario
 from world_server.grid.accept import (
@@ -16,7 +16,16 @@ from world_server.grid.accept import (
     write_observations,
 )
 from world_server.grid.face import wire as proto
-from world_server.grid.face.layout import A_MARK, A_MOVE, ACT_LEN, MARK, MARK_NONE, controller_kind, new_memory
+from world_server.grid.face.layout import (
+    A_MARK,
+    A_MOVE,
+    ACT_LEN,
+    MARK,
+    MARK_NONE,
+    controller_kind,
+    controller_params,
+    new_memory,
+)
 from world_server.grid.world import GridWorld
 
 ACTIVE, FREE = 2, 0

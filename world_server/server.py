@@ -19,8 +19,10 @@ from __future__ import annotations
 import queue
 import time
 import uuid
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import zenoh
@@ -51,6 +53,17 @@ class Stats:
         return sum(self.rejected.values())
 
 
+@dataclass(frozen=True)
+class RunnerServices:
+    """What the runner that starts a world process lends it: the parts of a run that live above the
+    worlds (swarm.world_process.services_for builds them for a scenario's kind)."""
+
+    # (server, path, live viewer or None) -> the recorder of this run, when it is recorded
+    open_recorder: Callable[[Any, Path, str | None], Any] | None = None
+    # world -> None: what the summary adds from outside the world (the arena's L_o, by A*)
+    complete_summary: Callable[[Any], None] | None = None
+
+
 class WorldServer:
     """The runtime around one world; subclasses bind it to a world kind."""
 
@@ -62,6 +75,7 @@ class WorldServer:
         until: str = "foraged", max_iterations: int = 1_000_000, null: bool = False,
         state_dir: str | None = None, persist_every: int = 50, resume_timeout: float = 30.0,
         mode: str = "lockstep", rate: float = 20.0, record: str | None = None, viewer: str | None = None,
+        services: RunnerServices | None = None,
     ):  # fmt: skip
         if mode not in ("lockstep", "realtime"):
             raise ValueError(f"unknown mode {mode!r}: lockstep or realtime")
@@ -103,6 +117,7 @@ class WorldServer:
         self.persist_every = persist_every
         self.resume_timeout = resume_timeout
         self.state_dir = state_dir
+        self.services = services or RunnerServices()
         self._make_world()
         self.resumed = self._resume()
         self.recording_path: str | None = None
@@ -165,10 +180,9 @@ class WorldServer:
         elif self.resumed and path.exists():
             path = path.with_name(f"{path.stem}.from-{self.tick}{path.suffix}")
         self.recording_path = str(path)
-        return self._open_recorder(path, viewer)
-
-    def _open_recorder(self, path: Path, viewer: str | None):
-        raise NotImplementedError
+        if self.services.open_recorder is None:
+            raise ValueError("this world process was started without a recorder (swarm.world_process starts one)")
+        return self.services.open_recorder(self, path, viewer)
 
     def _join_refusal(self, request: dict) -> str | None:
         """Why this join request cannot be served, or None."""

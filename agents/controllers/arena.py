@@ -14,7 +14,6 @@ process holds K.
 
 from __future__ import annotations
 
-import hashlib
 from typing import Any, Protocol
 
 import numpy as np
@@ -92,33 +91,3 @@ def deliver(controllers, agents, shared: list[tuple[int, str, bytes]]) -> int:
             except ValueError:
                 refused += 1
     return refused
-
-
-class ShareLog:
-    """Per agent, how many publications and a digest of them in order: equal in
-    both runtimes when every robot published the same bytes at the same ticks."""
-
-    def __init__(self) -> None:
-        self.count: dict[int, int] = {}
-        self.digest: dict[int, str] = {}  # chained: sha1(previous digest, tick, share, payload)
-
-    def add(self, tick: int, shared: list[tuple[int, str, bytes]]) -> None:
-        for a, share, payload in shared:
-            h = hashlib.sha1(f"{self.digest.get(a, '')}:{tick}:{share}:{len(payload)}:".encode())
-            h.update(payload)
-            self.digest[a] = h.hexdigest()
-            self.count[a] = self.count.get(a, 0) + 1
-
-    def of(self, agent: int) -> dict[str, Any] | None:
-        if agent not in self.count:
-            return None
-        return {"messages": self.count[agent], "digest": self.digest[agent][:16]}
-
-    def state(self) -> dict[str, list]:
-        """What a saved world keeps (JSON): a chained digest goes on from its last value."""
-        return {"agents": sorted(self.count), "count": [self.count[a] for a in sorted(self.count)],
-                "digest": [self.digest[a] for a in sorted(self.count)]}  # fmt: skip
-
-    def restore(self, state: dict[str, list]) -> None:
-        self.count = dict(zip(state["agents"], state["count"], strict=True))
-        self.digest = dict(zip(state["agents"], state["digest"], strict=True))

@@ -11,11 +11,13 @@ from typing import Any
 
 import numpy as np
 
-from agents.controllers.arena import ShareLog, as_action, deliver, make_controller, publications
+from agents.controllers.arena import as_action, deliver, make_controller, publications
 from agents.controllers.navigation.astar import Planner
 from swarm.engines.stepper import step_world
 from world_server.arena.scenario import ArenaScenario, controller_params
+from world_server.arena.summary import arena_summary
 from world_server.arena.world import ArenaWorld
+from world_server.history import ShareLog
 
 OPTIMUM_CELL, OPTIMUM_CLEARANCE = 0.01, 0.04  # the DFT paper's A* optimum
 MAX_OPTIMUM_CELLS = 4_000_000  # coarser cells on large floors (docs/arena.md)
@@ -121,6 +123,7 @@ class ArenaEngine:
         return self.summary()
 
     def summary(self) -> dict[str, Any]:
+        fill_optimum(self.world)
         out = arena_summary(self.world, self.wall_seconds, "in-process")
         for robot, c in zip(out["robots"], self.controllers, strict=True):
             if hasattr(c, "summary"):  # what a controller learned (a map), beside what its body did
@@ -129,36 +132,3 @@ class ArenaEngine:
                 robot["shared"] = shared
         out["rejected_shared"] = self.refused_shared
         return out
-
-
-def arena_summary(world: ArenaWorld, wall_seconds: float, runtime: str) -> dict[str, Any]:
-    s = world.scenario
-    fill_optimum(world)
-    robots = world.robot_summaries(world.optimum)
-    goals = [r for r in robots if r["goal"] is not None]
-    ratios = [r["path_ratio"] for r in robots if r["path_ratio"] is not None]
-    return {
-        "scenario": s.name,
-        "kind": "arena",
-        "controller": s.controller,
-        "agents": len(robots),
-        "seed": s.seed,
-        "noise": s.noise.level,
-        "runtime": runtime,
-        "ticks": world.tick,
-        "iterations": world.tick,
-        # with goals: all reached; without (explorers): the run went its full length; survival: its rule ended it
-        "finished": all(r["reached"] for r in goals)
-        if goals
-        else (world.tick >= s.max_ticks or (world.metabolism is not None and world.metabolism.done())),
-        "reached": sum(r["reached"] for r in goals),
-        "with_goal": len(goals),
-        "sim_seconds": round(world.tick * s.control_period, 3),
-        "wall_seconds": round(wall_seconds, 4),
-        "ticks_per_second": round(world.tick / wall_seconds, 1) if wall_seconds else None,
-        "mean_path_ratio": round(float(np.mean(ratios)), 4) if ratios else None,
-        "collisions": int(world.bodies.collisions.sum()),
-        "rejected_actions": sum(world.rejected.values()),
-        "rejected": dict(world.rejected),
-        "robots": robots,
-    }

@@ -14,42 +14,28 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from agents.controllers.grid.dispatch import controller_params, step_controller
+from agents.controllers.grid.dispatch import step_controller
 from swarm.core.errors import ScenarioError
 from swarm.recording.layer_classes import K_MARKS, K_RESOURCES, K_TRAILS, class_image
-from world_server.grid.face.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind, new_memory
+from world_server.grid.face.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind, controller_params, new_memory
 from world_server.grid.scenario import Layout, Scenario
 from world_server.grid.world import (
-    C_DELIVERED,
     C_EXPLORED,
     C_OPTIMAL,
     C_REJECTED,
     L_MARK,
     L_RES,
     L_TRAIL,
+    UNTIL,
     GridWorld,
+    is_done,
     perceive,
     resolve_tick,
 )
 
-UNTIL_FORAGED = 0
-UNTIL_CONVERGED = 1
-UNTIL_BOTH = 2
-UNTIL = {"foraged": UNTIL_FORAGED, "converged": UNTIL_CONVERGED, "both": UNTIL_BOTH}
 DEFAULT_MAX_ITERATIONS = 1_000_000
 RECORDED_LAYERS = (L_MARK, L_TRAIL, L_RES)  # the grid layers a recording holds per tick, of these class kinds:
 assert (K_MARKS, K_TRAILS, K_RESOURCES) == (0, 1, 2)
-
-
-@njit(cache=True)
-def is_done(until, counters, total, reachable):
-    foraged = counters[C_DELIVERED] >= total
-    converged = counters[C_OPTIMAL] == reachable
-    if until == UNTIL_FORAGED:
-        return foraged
-    if until == UNTIL_CONVERGED:
-        return converged
-    return foraged and converged
 
 
 @njit(cache=True)

@@ -335,3 +335,8 @@ class ArenaRecorder:
             self.rec.log("run/summary", self.rr.AnyValues(summary=json.dumps(summary)), static=True)
         self.rec.flush()
         self.rec.disconnect()
+
+
+def open_for_server(server, path, viewer: str | None) -> ArenaRecorder:
+    """The recorder of a world process's arena run (swarm.world_process lends it to the server)."""
+    return ArenaRecorder(path, server.world, {"run_id": server.keys.run, "runtime": server.mode}, viewer=viewer)

@@ -314,3 +314,10 @@ VIRIDIS = np.stack([np.interp(np.linspace(0, 8, 256), np.arange(9), _VIRIDIS_ANC
                    axis=1).astype(np.uint8)  # fmt: skip
 TAB20 = _hex("1f77b4 aec7e8 ff7f0e ffbb78 2ca02c 98df8a d62728 ff9896 9467bd c5b0d5 "
              "8c564b c49c94 e377c2 f7b6d2 7f7f7f c7c7c7 bcbd22 dbdb8d 17becf 9edae5")  # fmt: skip
+
+
+def open_for_server(server, path, viewer: str | None) -> Recorder:
+    """The recorder of a world process's grid run (swarm.world_process lends it to the server)."""
+    meta = run_meta(server.scenario, server.world, server.keys.run, server.until, server.mode)
+    meta["resumed_at"] = server.tick if server.resumed else None
+    return Recorder(path, server.world, meta, viewer=viewer)

@@ -17,14 +17,13 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.controllers.arena import ShareLog
 from swarm.core import wire
-from swarm.engines.arena import arena_summary
 from world_server import persist
 from world_server.arena.face import wire as arena_proto
 from world_server.arena.scenario import controller_params
+from world_server.arena.summary import arena_summary
 from world_server.arena.world import ArenaWorld
-from world_server.history import SharedHistory
+from world_server.history import SharedHistory, ShareLog
 from world_server.server import ACTIVE, FREE, JOINING, LOST, WorldServer
 
 
@@ -118,11 +117,6 @@ class ArenaServer(WorldServer):
             self.stats.reject("plan: names an agent of another process")
         elif self.recorder is not None:
             self.recorder.log_plan(plan.tick, plan.agent, plan.path)
-
-    def _open_recorder(self, path, viewer: str | None):
-        from swarm.recording.arena import ArenaRecorder
-
-        return ArenaRecorder(path, self.world, {"run_id": self.keys.run, "runtime": self.mode}, viewer=viewer)
 
     # ------------------------------------------------------------------ joins
 
@@ -263,6 +257,8 @@ class ArenaServer(WorldServer):
         return {"reached": int(w.finished.sum()), "with_goal": int(w.has_goal.sum())}
 
     def summary_fields(self) -> dict:
+        if self.services.complete_summary is not None:
+            self.services.complete_summary(self.world)
         out = arena_summary(self.world, 0.0, "distributed")
         for key in ("wall_seconds", "ticks_per_second"):  # the runtime's own, below
             out.pop(key)

@@ -13,13 +13,10 @@ a new agent taking the slot over starts with a fresh body at the base.
 from __future__ import annotations
 
 import threading
-from pathlib import Path
 
 import numpy as np
 
-from agents.controllers.grid.dispatch import controller_params
 from swarm.core import wire
-from swarm.engines.grid import UNTIL, is_done
 from world_server import persist
 from world_server.grid import accept as grid_wire
 from world_server.grid.accept import (
@@ -32,8 +29,18 @@ from world_server.grid.accept import (
     write_observations,
 )
 from world_server.grid.face import wire as proto
-from world_server.grid.face.layout import A_MARK, A_MODE, A_MOVE, A_TRAIL_OP, MARK_NONE, PERC_F_LEN, STAY, new_memory
-from world_server.grid.world import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, GridWorld
+from world_server.grid.face.layout import (
+    A_MARK,
+    A_MODE,
+    A_MOVE,
+    A_TRAIL_OP,
+    MARK_NONE,
+    PERC_F_LEN,
+    STAY,
+    controller_params,
+    new_memory,
+)
+from world_server.grid.world import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, UNTIL, GridWorld, is_done
 from world_server.server import ACTIVE, JOINING, WorldServer
 
 
@@ -91,13 +98,6 @@ class GridServer(WorldServer):
         for a, g in state["stats"].get("groups", {}).items():
             self._assign_group(int(a), g)
         return True
-
-    def _open_recorder(self, path: Path, viewer: str | None):
-        from swarm.recording.grid import Recorder, run_meta
-
-        meta = run_meta(self.scenario, self.world, self.keys.run, self.until, self.mode)
-        meta["resumed_at"] = self.tick if self.resumed else None
-        return Recorder(path, self.world, meta, viewer=viewer)
 
     def save_state(self) -> None:
         if self.state_file is None:

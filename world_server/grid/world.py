@@ -344,3 +344,21 @@ class GridWorld:
 
     def apf_optimal(self) -> bool:
         return int(self.counters[C_OPTIMAL]) == self.reachable
+
+
+# When a grid run ends: every unit delivered, marks equal to the BFS distance everywhere, or both.
+UNTIL_FORAGED = 0
+UNTIL_CONVERGED = 1
+UNTIL_BOTH = 2
+UNTIL = {"foraged": UNTIL_FORAGED, "converged": UNTIL_CONVERGED, "both": UNTIL_BOTH}
+
+
+@njit(cache=True)
+def is_done(until, counters, total, reachable):
+    foraged = counters[C_DELIVERED] >= total
+    converged = counters[C_OPTIMAL] == reachable
+    if until == UNTIL_FORAGED:
+        return foraged
+    if until == UNTIL_CONVERGED:
+        return converged
+    return foraged and converged

@@ -32,12 +32,11 @@ from world_server.grid.face.layout import (
     M_MODE,
     N_DIRS,
     OBST,
+    P_DETOUR,
+    P_THRESHOLD,
     PHER,
     RETURN,
 )
-
-P_THRESHOLD = 0
-P_DETOUR = 1
 
 
 @njit(cache=True, inline="always")

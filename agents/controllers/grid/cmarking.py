@@ -46,6 +46,7 @@ from world_server.grid.face.layout import (
     MARK,
     N_DIRS,
     OBST,
+    P_CLIMB_PATIENCE,
     RES,
     RETURN,
     RETURN_COLOUR,
@@ -57,8 +58,6 @@ from world_server.grid.face.layout import (
     TRAIL_PAINT,
 )
 from world_server.grid.face.marks import update_value
-
-P_CLIMB_PATIENCE = 0
 
 
 @njit(cache=True, inline="always")

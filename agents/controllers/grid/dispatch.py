@@ -9,8 +9,8 @@ implementation of every controller's step.
 import numpy as np
 from numba import njit
 
-from agents.controllers.grid.ant import P_DETOUR, P_THRESHOLD, ant_step
-from agents.controllers.grid.cmarking import P_CLIMB_PATIENCE, cmarking_step
+from agents.controllers.grid.ant import ant_step
+from agents.controllers.grid.cmarking import cmarking_step
 from agents.controllers.grid.marking import marking_step
 from world_server.grid.face.layout import (
     A_MARK,
@@ -24,7 +24,6 @@ from world_server.grid.face.layout import (
     MARK,
     MARK_NONE,
     MARKING,
-    N_PARAMS,
     PERC_F_LEN,
     STAY,
 )
@@ -87,14 +86,3 @@ def answer_rows(kind, ints_flat, pf_flat, mems, slot_of, out, params, seed, tick
         row[R_MEM:] = mem
         n += 1
     return n
-
-
-def controller_params(scenario) -> np.ndarray:
-    """The float parameter vector of a grid scenario's controller (its [cmarking] or [ant] table)."""
-    params = np.zeros(N_PARAMS, dtype=np.float64)
-    if scenario.controller == "cmarking":
-        params[P_CLIMB_PATIENCE] = scenario.cmarking.climb_patience
-    elif scenario.controller == "ant":
-        params[P_THRESHOLD] = scenario.ant.threshold
-        params[P_DETOUR] = scenario.ant.detour
-    return params

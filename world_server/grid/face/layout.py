@@ -97,7 +97,10 @@ MARKING = 0
 CMARKING = 1
 ANT = 2
 CONTROLLERS: dict[str, int] = {"cmarking": CMARKING, "marking": MARKING, "ant": ANT}
-N_PARAMS = 4  # length of the controllers' float parameter vector
+N_PARAMS = 4  # length of the controllers' float parameter vector (the world sends it in the welcome)
+P_CLIMB_PATIENCE = 0  # cmarking: ticks a climber may stall on a trail before it erases it ([cmarking])
+P_THRESHOLD = 0  # ant: the pheromone an ant follows ([ant])
+P_DETOUR = 1  # ant: ticks of random walk after losing the pheromone ([ant])
 
 
 def controller_kind(name: str) -> int:
@@ -105,6 +108,17 @@ def controller_kind(name: str) -> int:
         return CONTROLLERS[name]
     except KeyError:
         raise ValueError(f"unknown controller {name!r}: choose one of {', '.join(CONTROLLERS)}") from None
+
+
+def controller_params(scenario) -> np.ndarray:
+    """The float parameter vector of a grid scenario's controller (its [cmarking] or [ant] table)."""
+    params = np.zeros(N_PARAMS, dtype=np.float64)
+    if scenario.controller == "cmarking":
+        params[P_CLIMB_PATIENCE] = scenario.cmarking.climb_patience
+    elif scenario.controller == "ant":
+        params[P_THRESHOLD] = scenario.ant.threshold
+        params[P_DETOUR] = scenario.ant.detour
+    return params
 
 
 def new_perception() -> tuple[np.ndarray, np.ndarray]:
