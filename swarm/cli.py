@@ -19,12 +19,11 @@ from swarm.cli_arena import (
     run_arena,
 )
 from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_interrupt
+from swarm.core.registry import Option, Registry, resolve
+from swarm.core.tables import positive, seed
 from swarm.scenario import PRESET_HELP, bundled_scenarios, is_arena, load_scenario
 
 CONTROLLERS = CONTROLLER_REGISTRY.names()
-FINGERPRINT_EXPERIMENTS = ("fingerprint-calibrate", "fingerprint-map", "fingerprint-localize", "fingerprint-together")
-DFT_EXPERIMENTS = ("dft-case1", "dft-case2", "dft-case3", "dft-together")
-BG_EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze", "bg-colony")
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -52,72 +51,6 @@ examples:
 """
 
 
-def _positive(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
-    return value
-
-
-def _ratios(text: str) -> tuple[float, ...]:
-    from swarm.experiments.girard2005.bg import RATIOS
-
-    try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        values = ()
-    if not values or any(v not in RATIOS for v in values):
-        raise argparse.ArgumentTypeError(f"expected some of {','.join(f'{r:g}' for r in RATIOS)} (the tmaze-R "
-                                         f"scenarios), got {text}")  # fmt: skip
-    return values
-
-
-def _bg_setting(text: str) -> tuple[str, object]:
-    """KEY=VALUE, the value a TOML literal (0.5, true, "fear"); navigation.KEY names a [bg.navigation] field."""
-    import tomllib
-
-    key, sep, value = text.partition("=")
-    try:
-        parsed = tomllib.loads(f"v = {value}")["v"] if sep and key else None
-    except tomllib.TOMLDecodeError:
-        parsed = None
-    if parsed is None or isinstance(parsed, (dict, list)):
-        raise argparse.ArgumentTypeError(f"expected KEY=VALUE (e.g. usable_threshold=0.5, navigation.anchor=0.2), "
-                                         f"got {text}")  # fmt: skip
-    return key.strip(), parsed
-
-
-def _bg_table(settings: list[tuple[str, object]] | None) -> dict:
-    """--bg settings as a [bg] table (navigation.KEY into its [bg.navigation] table)."""
-    table: dict = {}
-    for key, value in settings or ():
-        if key.startswith("navigation."):
-            table.setdefault("navigation", {})[key.removeprefix("navigation.")] = value
-        else:
-            table[key] = value
-    return table
-
-
-def _sizes(text: str) -> tuple[int, ...]:
-    from swarm.experiments.girard2005.colony import NEST
-
-    try:
-        values = tuple(int(v) for v in text.split(","))
-    except ValueError:
-        values = ()
-    if not values or any(not 1 <= v <= len(NEST) for v in values):
-        raise argparse.ArgumentTypeError(f"expected colony sizes from 1 to {len(NEST)} (the nest's places), "
-                                         f"got {text}")  # fmt: skip
-    return values
-
-
-def _seed(text: str) -> int:
-    value = int(text)
-    if not 0 <= value < 2**63:
-        raise argparse.ArgumentTypeError(f"expected a seed from 0 to 2**63-1, got {text}")
-    return value
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="swarm", description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -134,9 +67,9 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="SCENARIO",
         help=f"a TOML file, a preset ({PRESET_HELP}) or a bundled name ({', '.join(bundled_scenarios())})",
     )
-    run.add_argument("--agents", type=_positive, help="number of agents (default: the scenario's)")
+    run.add_argument("--agents", type=positive, help="number of agents (default: the scenario's)")
     run.add_argument("--controller", choices=CONTROLLERS, help="controller to run")
-    run.add_argument("--seed", type=_seed, help="seed of the map and of every random choice")
+    run.add_argument("--seed", type=seed, help="seed of the map and of every random choice")
     _physics_args(run)
     add_arena_run_args(run)
     _record_args(run, "write a rerun recording of the run to FILE (.rrd)")
@@ -147,97 +80,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="foraged: every unit delivered (default); converged: marks equal the BFS "
         "distance on every reachable cell; both",
     )
-    run.add_argument("--max-iterations", type=_positive, default=1_000_000, metavar="M",
+    run.add_argument("--max-iterations", type=positive, default=1_000_000, metavar="M",
                      help="stop after M iterations if not done (default 1000000)")  # fmt: skip
     run.add_argument("--json", action="store_true", help="print one JSON object instead of text")
 
-    exp = sub.add_parser(
-        "experiment",
-        help="reproduce a table of the paper",
-        description="Rerun one of the paper's experiments (or the congestion study, which adds robot bodies "
-        "to Table 1) and write runs.csv, summary.csv, table.md (paper beside ours) and plot.png.",
-    )
-    from swarm.experiments.simonin2007.tables import EXPERIMENTS
-
-    names_help = "; ".join(f"{e.name}: {e.title.split(': ', 1)[1]}" for e in EXPERIMENTS.values())
-    names_help += "; carrot: follow the carrot in zmaze and large-maze at three noise levels (DFT paper, cases 1-2)"
-    names_help += (
-        "; fingerprint-calibrate | fingerprint-map | fingerprint-localize: topological mapping and "
-        "localization with fingerprints of places on office (Tapus et al. 2006)"
-    )
-    names_help += (
-        "; dft-case1 | dft-case2 | dft-case3: the dft controller (Billing et al. 2015) in zmaze and large-maze "
-        "beside follow the carrot, and replanning round an obstacle; dft-together: a scout shares the obstacle "
-        "it meets over the context key space"
-    )
-    names_help += (
-        "; bg-survival | bg-choice | bg-forget | bg-fear | bg-tmaze: the basal-ganglia animat (Girard et al. "
-        "2005): survival with and without its map, a new resource, a removed one, fear against need, the T-maze; "
-        "bg-colony: survival against colony size, with and without a shared map"
-    )
-    exp.add_argument("name", choices=[*EXPERIMENTS, "carrot", *FINGERPRINT_EXPERIMENTS, *DFT_EXPERIMENTS,
-                                      *BG_EXPERIMENTS],
-                     metavar="NAME",
-                     help=names_help)  # fmt: skip
-    exp.add_argument(
-        "--scenario",
-        help="carrot: zmaze or large-maze (default both); fingerprint-*: a floor with "
-        "'mapping', 'localize' and 'localize-off-map' routes and place zones (default office)",
-    )
-    exp.add_argument("--reps", type=_positive, help="runs per configuration (default per experiment)")
-    exp.add_argument("--noise", choices=["none", "low", "high"], help="dft-*: only the conditions at this noise level")
-    exp.add_argument(
-        "--max-steps",
-        type=_positive,
-        metavar="T",
-        help="dft-*: run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)",
-    )
-    exp.add_argument(
-        "--ratios",
-        type=_ratios,
-        metavar="R,R,...",
-        help="bg-tmaze: right / left branch length ratios to run (default 1,1.5,2: tmaze-R scenarios)",
-    )
-    exp.add_argument(
-        "--maps",
-        type=_positive,
-        metavar="N",
-        help="bg-choice | bg-forget | bg-fear | bg-tmaze: mapping runs per scenario; test k loads map "
-        "k mod N (default: one per test; 1: one map for every test)",
-    )
-    exp.add_argument(
-        "--mapping",
-        choices=["hungry", "explore"],
-        help="bg-choice | bg-forget | bg-fear | bg-tmaze: how the mapping animat maps: hungry, planning back to "
-        "what it found, or exploring without planning for at least 30 min (default: explore for bg-fear, "
-        "hungry for the others; docs/bg.md)",
-    )
-    exp.add_argument(
-        "--bg",
-        type=_bg_setting,
-        action="append",
-        metavar="KEY=VALUE",
-        help="bg-*: change a [bg] setting in every run, mapping runs included (repeatable; e.g. "
-        "usable_threshold=0.5, navigation.pursuit=0.5: docs/bg.md)",
-    )
-    exp.add_argument("--sizes", type=_sizes, metavar="N,N,...", help="bg-colony: colony sizes to run (default 1,2,4,8)")
-    exp.add_argument("--jobs", type=_positive, help="worker processes (default: all cores)")
-    exp.add_argument("--seed", type=_seed, default=0, help="first seed (runs use seed..seed+reps-1)")
-    exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
-
-    bench = sub.add_parser("bench", help="measure throughput", description="Measure throughput.")
-    bench.add_argument("target", choices=["engine", "distributed", "recording", "arena", "fingerprint", "dft",
-                                          "bg"],
-                       help="engine: the in-process engine; distributed: world + agent processes; "
-                       "recording: what recording costs; arena: sensing and physics of the arena; "
-                       "fingerprint: features, one alignment, localization against 20-1000 nodes; "
-                       "dft: one step of the neural-field architecture at 100x100 and 210x210 cells; "
-                       "bg: the animat's GPR loops, sensing, navigation and step, as real-time factors")  # fmt: skip
-    bench.add_argument("--json", action="store_true", help="print one JSON object")
-    bench.add_argument("--quick", action="store_true", help="shorter measurement")
-    bench.add_argument("--pairs", type=_positive, default=3,
-                       help="distributed: floor/run pairs measured in turn per size; the share is their median "
-                       "(default 3)")  # fmt: skip
+    _add_experiment(sub)
+    _add_bench(sub)
 
     world = sub.add_parser(
         "world",
@@ -251,10 +99,10 @@ def build_parser() -> argparse.ArgumentParser:
                        help="host a router listening here (default tcp/127.0.0.1:7447)")  # fmt: skip
     where.add_argument("--connect", metavar="ENDPOINT", help="join an existing router instead")
     _tick_args(world)
-    world.add_argument("--start-with", type=_positive, metavar="K",
+    world.add_argument("--start-with", type=positive, metavar="K",
                        help="start ticking once K agents have joined (default: --agents); more may join later, "
                        "up to --agents")  # fmt: skip
-    world.add_argument("--max-misses", type=_positive, default=3, metavar="K",
+    world.add_argument("--max-misses", type=positive, default=3, metavar="K",
                        help="an agent that misses K ticks in a row is lost (default 3)")  # fmt: skip
     world.add_argument("--summary-file", metavar="FILE", help="also write the summary JSON here")
     world.add_argument("--quiet", action="store_true", help="no log lines on stderr (swarm up shows its own progress)")
@@ -282,7 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     agent.add_argument("--controller", choices=CONTROLLERS, default="cmarking")
     _client_args(agent)
-    agent.add_argument("--count", type=_positive, default=1, metavar="K", help="independent agents in this process")
+    agent.add_argument("--count", type=positive, default=1, metavar="K", help="independent agents in this process")
     agent.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
     agent.add_argument("--join-timeout", type=float, default=60.0, metavar="S",
                        help="give up when no world has answered within S seconds (default 60)")  # fmt: skip
@@ -370,6 +218,75 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _add_experiment(sub) -> None:
+    from swarm.experiments import EXPERIMENTS
+
+    exp = sub.add_parser(
+        "experiment",
+        help="reproduce a table of the paper",
+        description="Rerun one of the paper's experiments (or the congestion study, which adds robot bodies "
+        "to Table 1) and write runs.csv, summary.csv, table.md (paper beside ours) and plot.png.",
+    )
+    exp.add_argument("name", choices=EXPERIMENTS.names(), metavar="NAME",
+                     help="; ".join(f"{e.name}: {e.description}" for e in EXPERIMENTS))  # fmt: skip
+    exp.add_argument("--reps", type=positive, help="runs per configuration (default per experiment)")
+    _add_entry_options(exp, EXPERIMENTS)
+    exp.add_argument("--jobs", type=positive, help="worker processes (default: all cores)")
+    exp.add_argument("--seed", type=seed, default=0, help="first seed (runs use seed..seed+reps-1)")
+    exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
+
+
+def _add_bench(sub) -> None:
+    from swarm.bench import BENCHMARKS
+
+    bench = sub.add_parser("bench", help="measure throughput", description="Measure throughput.")
+    bench.add_argument("target", choices=BENCHMARKS.names(),
+                       help="; ".join(f"{b.name}: {b.description}" for b in BENCHMARKS))  # fmt: skip
+    bench.add_argument("--json", action="store_true", help="print one JSON object")
+    bench.add_argument("--quick", action="store_true", help="shorter measurement")
+    _add_entry_options(bench, BENCHMARKS)
+
+
+def _entry_options(registry: Registry) -> dict[str, tuple[Option, list[str]]]:
+    """Every option the registry's entries declare, by flag: (the first declaration, who takes it)."""
+    found: dict[str, tuple[Option, list[str]]] = {}
+    for entry in registry:
+        for option in entry.options:
+            found.setdefault(option.flag, (option, []))[1].append(entry.name)
+    return found
+
+
+def _add_entry_options(parser: argparse.ArgumentParser, registry: Registry) -> None:
+    """The options the entries declare; each one's help says who takes it, with that entry's words."""
+    for flag, (option, _) in _entry_options(registry).items():
+        said: dict[str, list[str]] = {}
+        for entry in registry:
+            for o in entry.options:
+                if o.flag == flag:
+                    said.setdefault(o.help, []).append(entry.name)
+        help_text = "; ".join(f"{' | '.join(names)}: {text}" for text, names in said.items())
+        kw = {"dest": option.keyword, "help": help_text, "metavar": option.metavar, "default": option.default}
+        if option.type is not None:
+            kw["type"] = resolve(option.type)
+        if option.choices is not None:
+            kw["choices"] = list(option.choices)
+        parser.add_argument(flag, action="append" if option.repeat else "store", **kw)
+
+
+def _chosen_options(args, registry: Registry, entry) -> dict:
+    """The values of `entry`'s own options; one it does not take, given anyway, is a one-line error."""
+    mine = {o.flag for o in entry.options}
+    out = {}
+    for flag, (option, takers) in _entry_options(registry).items():
+        value = getattr(args, option.keyword)
+        if flag not in mine:
+            if value is not None and value != option.default:
+                raise ScenarioError("command line", flag, f"this is for {' | '.join(takers)}")
+            continue
+        out[option.keyword] = resolve(option.collect)(value) if option.collect else value
+    return out
+
+
 def _client_args(p: argparse.ArgumentParser) -> None:
     """Where a client of a running world finds it: agents, monitor, status."""
     p.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
@@ -417,12 +334,12 @@ def _physics_args(p: argparse.ArgumentParser) -> None:
 
 def _scenario_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", metavar="SCENARIO", help=f"a TOML file, a preset ({PRESET_HELP}) or a bundled name")
-    p.add_argument("--agents", type=_positive, help="number of agents (default: the scenario's)")
+    p.add_argument("--agents", type=positive, help="number of agents (default: the scenario's)")
     p.add_argument("--controller", choices=CONTROLLERS, help="controller to run")
-    p.add_argument("--seed", type=_seed, help="seed of the map and of every random choice")
+    p.add_argument("--seed", type=seed, help="seed of the map and of every random choice")
     _physics_args(p)
     p.add_argument("--until", choices=["foraged", "converged", "both"], default="foraged", help="when the run ends")
-    p.add_argument("--max-iterations", type=_positive, default=1_000_000, metavar="M", help="stop after M ticks")
+    p.add_argument("--max-iterations", type=positive, default=1_000_000, metavar="M", help="stop after M ticks")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
     add_arena_run_args(p)
 
@@ -593,123 +510,22 @@ def cmd_report(args) -> int:
 
 
 def cmd_experiment(args) -> int:
-    if args.bg and args.name not in BG_EXPERIMENTS[:-1]:
-        raise ScenarioError("command line", "--bg", "this is for the bg-* experiments but bg-colony")
-    if args.name == "fingerprint-together":
-        if args.scenario:
-            raise ScenarioError("command line", "--scenario", "fingerprint-together surveys office")
-        from swarm.experiments.tapus2006.team import run_team_experiment
+    from swarm.experiments import EXPERIMENTS
 
-        result = run_team_experiment(args.reps, args.jobs, args.seed, args.out)
-        print(result["markdown"])
-        print(f"wrote {result['out']}/runs.csv, table.md, plot.png")
-        return 0
-    if args.name in FINGERPRINT_EXPERIMENTS:
-        from swarm.experiments.tapus2006.fingerprint import run_fingerprint_experiment
-
-        result = run_fingerprint_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out)
-        print(result["markdown"])
-        print(f"wrote {result['out']}/runs.csv, table.md" + ("" if args.name.endswith("calibrate") else
-                                                             ", summary.csv, plot.png"))  # fmt: skip
-        return 0
-    if args.name in DFT_EXPERIMENTS:
-        from swarm.experiments.billing2015.dft import run_dft_experiment
-
-        result = run_dft_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
-                                    noise=args.noise, max_ticks=args.max_steps)  # fmt: skip
-        print(result["markdown"])
-        extra = ", paths.png, paths.npz" if args.name == "dft-case3" else ""
-        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png{extra}")
-        return 0
-    if args.noise or args.max_steps:
-        raise ScenarioError("command line", "--noise/--max-steps", "these are for the dft-* experiments")
-    if args.name == "bg-colony":
-        if args.scenario or args.ratios or args.maps or args.mapping:
-            raise ScenarioError("command line", "--scenario/--ratios/--maps/--mapping",
-                                "bg-colony runs bg-colony, with no mapping phase; give --sizes")  # fmt: skip
-        from swarm.experiments.girard2005.colony import run_colony_experiment
-
-        result = run_colony_experiment(args.sizes, args.reps, args.jobs, args.seed, args.out)
-        print(result["markdown"])
-        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
-        return 0
-    if args.sizes:
-        raise ScenarioError("command line", "--sizes", "this is for bg-colony")
-    if args.name in BG_EXPERIMENTS:
-        from swarm.experiments.girard2005.bg import run_bg_experiment
-
-        result = run_bg_experiment(args.name, args.scenario, args.reps, args.jobs, args.seed, args.out,
-                                   ratios=args.ratios, maps=args.maps, bg=_bg_table(args.bg),
-                                   mapping=args.mapping)  # fmt: skip
-        print(result["markdown"])
-        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
-        return 0
-    if args.ratios:
-        raise ScenarioError("command line", "--ratios", "this is for bg-tmaze")
-    if args.maps or args.mapping:
-        raise ScenarioError("command line", "--maps/--mapping",
-                            "these are for bg-choice, bg-forget, bg-fear and bg-tmaze")  # fmt: skip
-    if args.name == "carrot":
-        from swarm.experiments.billing2015.carrot import run_carrot_experiment
-
-        result = run_carrot_experiment(args.scenario, args.reps, args.jobs, args.seed, args.out)
-        print(result["markdown"])
-        print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
-        return 0
-    if args.scenario:
-        raise ScenarioError(
-            "command line", "--scenario", f"{args.name} uses the paper's setups; --scenario is for carrot"
-        )
-    from swarm.experiments.simonin2007.tables import run_experiment
-
-    result = run_experiment(args.name, args.reps, args.jobs, args.seed, args.out)
+    spec = EXPERIMENTS[args.name]
+    options = _chosen_options(args, EXPERIMENTS, spec)
+    result = resolve(spec.run)(spec.name, reps=args.reps, jobs=args.jobs, seed=args.seed, out=args.out, **options)
     print(result["markdown"])
-    print(f"wrote {result['out']}/runs.csv, summary.csv, table.md, plot.png")
+    print(f"wrote {result['out']}/{spec.writes}")
     return 0
 
 
 def cmd_bench(args) -> int:
-    if args.target == "bg":
-        from swarm.bench.bg import bench_bg, format_bg_bench
+    from swarm.bench import BENCHMARKS
 
-        result = bench_bg(quick=args.quick)
-        print(json.dumps(result) if args.json else format_bg_bench(result))
-        return 0
-    if args.target == "dft":
-        from swarm.bench.dft import bench_dft, format_dft_bench
-
-        result = bench_dft(quick=args.quick)
-        print(json.dumps(result) if args.json else format_dft_bench(result))
-        return 0
-    if args.target == "fingerprint":
-        from swarm.bench.fingerprint import bench_fingerprint, format_fingerprint_bench
-
-        result = bench_fingerprint(quick=args.quick)
-        print(json.dumps(result) if args.json else format_fingerprint_bench(result))
-        return 0
-    if args.target == "arena":
-        from swarm.bench.arena import bench_arena, format_arena_bench
-
-        result = bench_arena(quick=args.quick)
-        print(json.dumps(result) if args.json else format_arena_bench(result))
-        return 0
-    if args.target == "recording":
-        from swarm.bench.recording import bench_recording, format_recording_bench
-
-        result = bench_recording(quick=args.quick)
-        print(json.dumps(result) if args.json else format_recording_bench(result))
-        return 0
-    if args.target == "distributed":
-        from swarm.bench.distributed import bench_distributed, format_distributed_bench
-
-        result = bench_distributed(sizes=(10, 50) if args.quick else (10, 50, 100, 200),
-                                   packed=200 if args.quick else 1000, pairs=args.pairs)  # fmt: skip
-        print(json.dumps(result) if args.json else format_distributed_bench(result))
-        return 0
-    from swarm.bench.engine import bench_engine, format_engine_bench
-
-    result = bench_engine(quick=args.quick)
-    print(json.dumps(result) if args.json else format_engine_bench(result))
+    spec = BENCHMARKS[args.target]
+    result = resolve(spec.run)(quick=args.quick, **_chosen_options(args, BENCHMARKS, spec))
+    print(json.dumps(result) if args.json else resolve(spec.report)(result))
     return 0
 
 

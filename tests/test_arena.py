@@ -222,7 +222,7 @@ def test_cli_runs_and_senses_an_arena():
 def test_carrot_experiment_writes_its_table(tmp_path):
     from swarm.experiments.billing2015.carrot import run_carrot_experiment
 
-    result = run_carrot_experiment("zmaze", 3, 2, 0, tmp_path, progress=False)
+    result = run_carrot_experiment("carrot", "zmaze", 3, 2, 0, tmp_path, progress=False)
     assert result["runs"] == 9  # 3 pairs x none / low / high
     assert {"runs.csv", "summary.csv", "table.md", "plot.png"} <= {p.name for p in tmp_path.iterdir()}
     table = (tmp_path / "table.md").read_text()

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from agents.arena_runtime import give_back
+from agents.controllers import CONTROLLERS
 from agents.controllers.arena import make_controller
 from swarm.core import memory_codec, msgpack_views
 from swarm.core.wire import Rejected, pack
@@ -148,10 +149,9 @@ def test_a_broken_memory_is_a_reason_not_a_traceback(blob):
     assert isinstance(memory_codec.decode(blob), Rejected)
 
 
-@pytest.mark.parametrize("controller", ["carrot", "wander", "dft", "fingerprint", "bg"])
+@pytest.mark.parametrize("controller", CONTROLLERS.names(lambda c: c.world == "arena"))
 def test_a_controller_given_back_its_memory_through_the_codec_steps_on_as_before(controller):
-    ref = {"bg": "bg-exp1", "fingerprint": "office"}.get(controller, "zmaze")
-    scenario = load_scenario(ref).with_overrides(controller=controller, max_ticks=200)
+    scenario = load_scenario(CONTROLLERS[controller].example).with_overrides(controller=controller, max_ticks=200)
     engine = ArenaEngine(scenario)
     engine.step(60)
     twin = make_controller(controller)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from swarm.bench.recording import _in_process, _warm_up, format_recording_bench
+from swarm.bench.recording.measure import _in_process, _warm_up, format_recording_bench
 
 
 def test_an_in_process_row_times_the_recorded_run_in_parts_that_add_up(tmp_path):

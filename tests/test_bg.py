@@ -746,8 +746,9 @@ def test_bg_experiment_maps_option_is_checked():
 def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     import argparse
 
-    from swarm.cli import _bg_setting, _bg_table
     from swarm.experiments.girard2005.bg import _tests, _with, run_bg_experiment
+    from swarm.experiments.girard2005.options import bg_setting as _bg_setting
+    from swarm.experiments.girard2005.options import bg_table as _bg_table
 
     table = _bg_table([_bg_setting("usable_threshold=0.5"), _bg_setting("navigation.anchor=0.2")])
     assert table == {"usable_threshold": 0.5, "navigation": {"anchor": 0.2}}

@@ -107,7 +107,7 @@ def test_lockstep_colony_equals_in_process_bit_for_bit(processes, per_process):
 def test_the_colony_experiment_writes_its_table(tmp_path):
     from swarm.experiments.girard2005.colony import run_colony_experiment
 
-    result = run_colony_experiment((1, 2), 2, 2, 0, tmp_path, progress=False, max_ticks=120)
+    result = run_colony_experiment("bg-colony", (1, 2), 2, 2, 0, tmp_path, progress=False, max_ticks=120)
     assert result["runs"] == 6  # one alone twice, two with and without sharing twice each
     for name in ("runs.csv", "summary.csv", "table.md", "plot.png"):
         assert (tmp_path / name).exists(), name

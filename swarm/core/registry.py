@@ -40,8 +40,10 @@ class ControllerSpec:
     `table`: a callable that raises ValueError in one line for a bad [name] table of a scenario.
     `requires`: the sensors its robot must carry.  `shares`: the key space it writes
     (swarm/<run>/<share>/<agent>), if any.  `kernels`: modules whose `exported` kernels the
-    agents' ahead-of-time build must compile.  `records`: "module:Class" of the log that shows
-    what explains its choices in a recording, built with the controllers it watches."""
+    agents' ahead-of-time build must compile.  `example`: a bundled scenario it runs in
+    (`swarm run EXAMPLE --controller NAME`; the tests run every controller there).  What a robot
+    publishes on its share at tick t, every other robot of the same share receives before it steps
+    tick t + 1."""
 
     name: str
     world: str  # the world kind it drives in: "grid" or "arena"
@@ -51,7 +53,7 @@ class ControllerSpec:
     requires: tuple[str, ...] = ()
     shares: str | None = None
     kernels: tuple[str, ...] = ()
-    records: str | None = None
+    example: str = "setup1"
 
     def make(self) -> Any:
         """A fresh controller (arena), or the kind code of the compiled step (grid)."""
@@ -64,6 +66,56 @@ class ControllerSpec:
             resolve(self.table)(table)
 
 
+@dataclass(frozen=True)
+class Option:
+    """A command-line option of an experiment or a benchmark, declared beside it: the command
+    line offers every option some entry declares, and refuses one the chosen entry does not take.
+    `type` and `collect` are "module:function" references: the first parses the text (argparse's
+    type), the second turns the list of a repeated option into the value the entry is given."""
+
+    flag: str  # "--ratios"
+    help: str
+    dest: str | None = None  # the keyword the entry's run is given (default: the flag's name)
+    type: str | None = None
+    metavar: str | None = None
+    choices: tuple[str, ...] | None = None
+    repeat: bool = False
+    collect: str | None = None
+    default: Any = None
+
+    @property
+    def keyword(self) -> str:
+        return self.dest or self.flag.lstrip("-").replace("-", "_")
+
+
+@dataclass(frozen=True)
+class ExperimentSpec:
+    """One experiment of a paper: `run` ("module:function") is called as
+    run(name, reps=, jobs=, seed=, out=, **options) and returns {"markdown", "out", ...}; `writes`
+    lists the files it leaves in `out`."""
+
+    name: str
+    paper: str  # the folder's paper: simonin2007, billing2015, tapus2006, girard2005
+    description: str
+    run: str
+    options: tuple[Option, ...] = ()  # besides --reps, --jobs, --seed and --out, which every experiment takes
+    writes: str = "runs.csv, summary.csv, table.md, plot.png"
+    # Keywords for run() that make a run of seconds, all files written (tests run every experiment so).
+    smoke: tuple[tuple[str, Any], ...] = (("reps", 1),)
+
+
+@dataclass(frozen=True)
+class BenchmarkSpec:
+    """One benchmark: `run` ("module:function") is called as run(quick=, **options) and returns a
+    JSON-able result; `report` ("module:function") turns that result into the text printed."""
+
+    name: str
+    description: str
+    run: str
+    report: str
+    options: tuple[Option, ...] = ()
+
+
 class Entry(Protocol):
     name: str
 
@@ -73,7 +125,8 @@ E = TypeVar("E", bound=Entry)
 
 class Registry(Generic[E]):
     """The entries of one kind of part, found in the subpackages of `package` (each declares
-    `attribute`: an entry or a tuple of entries), in name order."""
+    `attribute`: an entry or a tuple of entries), folder by folder in name order, each folder's
+    entries in the order it declares them."""
 
     def __init__(self, what: str, package: str, attribute: str):
         self.what, self.package, self.attribute = what, package, attribute
@@ -91,7 +144,7 @@ class Registry(Generic[E]):
                     if entry.name in found:
                         raise RuntimeError(f"two {self.what}s named {entry.name!r}: {info.name} and another")
                     found[entry.name] = entry
-            self._entries = dict(sorted(found.items()))
+            self._entries = found
         return self._entries
 
     def __getitem__(self, name: str) -> E:

@@ -3,6 +3,7 @@ one line that names the file and the field, and a parameter dataclass filled fro
 
 from __future__ import annotations
 
+import argparse
 from dataclasses import fields
 from typing import Any
 
@@ -50,4 +51,20 @@ def typed(section: dict, key: str, kind, source: str, where: str | None = None):
     if isinstance(value, bool) or not isinstance(value, kinds):
         names = " or ".join(k.__name__ for k in kinds)
         raise ScenarioError(source, where or key, f"expected {names}, got {value!r}")
+    return value
+
+
+def positive(text: str) -> int:
+    """A command-line count: a positive integer."""
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
+    return value
+
+
+def seed(text: str) -> int:
+    """A command-line seed: 0 to 2**63-1."""
+    value = int(text)
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"expected a seed from 0 to 2**63-1, got {text}")
     return value

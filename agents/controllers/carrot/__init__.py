@@ -7,6 +7,7 @@ CONTROLLERS = ControllerSpec(
     name="carrot",
     world="arena",
     description="A* on the given map, then follow the carrot (the DFT paper's baseline)",
+    example="zmaze",
     factory="agents.controllers.carrot.controller:CarrotController",
     table="agents.controllers.carrot.controller:CarrotParams.from_table",
     requires=("position", "compass"),

@@ -7,6 +7,7 @@ CONTROLLERS = ControllerSpec(
     name="wander",
     world="arena",
     description="a reactive explorer: drive ahead, turn away from what is in front, now and then at random",
+    example="zmaze",
     factory="agents.controllers.wander.controller:WanderController",
     table="agents.controllers.wander.controller:WanderParams.from_table",
 )

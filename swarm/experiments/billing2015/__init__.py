@@ -1,0 +1,24 @@
+"""Billing, Lowe & Sandamirskaya (2015): the dft controller beside follow the carrot (its Appendix
+B baseline) in the Z-maze and the large maze."""
+
+from swarm.core.registry import ExperimentSpec, Option
+
+_MAZE = Option("--scenario", "zmaze or large-maze (default both)")
+_NOISE = Option("--noise", "only the conditions at this noise level", choices=("none", "low", "high"))
+_STEPS = Option("--max-steps", "run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)",
+                dest="max_ticks", type="swarm.core.tables:positive", metavar="T")  # fmt: skip
+_DFT = "swarm.experiments.billing2015.dft:run_dft_experiment"
+_WRITES = "runs.csv, summary.csv, table.md, plot.png"
+EXPERIMENTS = (
+    ExperimentSpec("carrot", "billing2015", "follow the carrot in zmaze and large-maze at three noise levels "
+                   "(DFT paper, cases 1-2)", "swarm.experiments.billing2015.carrot:run_carrot_experiment",
+                   options=(_MAZE,)),
+    ExperimentSpec("dft-case1", "billing2015", "the dft controller in zmaze beside follow the carrot", _DFT,
+                   options=(_MAZE, _NOISE, _STEPS)),
+    ExperimentSpec("dft-case2", "billing2015", "the dft controller in large-maze beside follow the carrot", _DFT,
+                   options=(_MAZE, _NOISE, _STEPS)),
+    ExperimentSpec("dft-case3", "billing2015", "replanning round an obstacle", _DFT,
+                   options=(_MAZE, _NOISE, _STEPS), writes=f"{_WRITES}, paths.png, paths.npz"),
+    ExperimentSpec("dft-together", "billing2015", "a scout shares the obstacle it meets over the context key space",
+                   _DFT, options=(_MAZE, _NOISE, _STEPS)),
+)  # fmt: skip

@@ -162,8 +162,9 @@ def plot(rows: list[dict], path: Path) -> None:
     plt.close(fig)
 
 
-def run_carrot_experiment(scenario: str | None, reps: int | None, jobs: int | None, seed: int,
+def run_carrot_experiment(name: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
                           out: Path | None, progress: bool = True) -> dict:  # fmt: skip
+    """`name`: "carrot", the one experiment this runs (the registry calls every experiment by name)."""
     from tqdm import tqdm
 
     scenarios = list(SCENARIOS) if scenario is None else [scenario]

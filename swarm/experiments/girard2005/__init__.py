@@ -1,0 +1,29 @@
+"""Girard, Filliat, Meyer, Berthoz & Guillot (2005): the basal-ganglia animat's survival and its
+choices between resources, alone and as a colony sharing one map."""
+
+from swarm.core.registry import ExperimentSpec, Option
+
+_FLOOR = Option("--scenario", "the floor (default: the experiment's)")
+_MAPS = Option("--maps", "mapping runs per scenario; test k loads map k mod N (default: one per test; 1: one map for "
+               "every test)", type="swarm.core.tables:positive", metavar="N")  # fmt: skip
+_MAPPING = Option("--mapping", "how the mapping animat maps: hungry, planning back to what it found, or exploring "
+                  "without planning for at least 30 min (default: explore for bg-fear, hungry for the others; "
+                  "docs/bg.md)", choices=("hungry", "explore"))  # fmt: skip
+_OPTIONS = "swarm.experiments.girard2005.options"
+_BG = Option("--bg", "change a [bg] setting in every run, mapping runs included (repeatable; e.g. "
+             "usable_threshold=0.5, navigation.pursuit=0.5: docs/bg.md)", type=f"{_OPTIONS}:bg_setting",
+             metavar="KEY=VALUE", repeat=True, collect=f"{_OPTIONS}:bg_table")  # fmt: skip
+_RATIOS = Option("--ratios", "right / left branch length ratios to run (default 1,1.5,2: tmaze-R scenarios)",
+                 type=f"{_OPTIONS}:ratios", metavar="R,R,...")  # fmt: skip
+_SIZES = Option("--sizes", "colony sizes to run (default 1,2,4,8)", type=f"{_OPTIONS}:sizes",
+                metavar="N,N,...")  # fmt: skip
+_RUN = "swarm.experiments.girard2005.bg:run_bg_experiment"
+EXPERIMENTS = (
+    ExperimentSpec("bg-survival", "girard2005", "survival with and without its map", _RUN, options=(_FLOOR, _BG)),
+    ExperimentSpec("bg-choice", "girard2005", "a new resource", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG)),
+    ExperimentSpec("bg-forget", "girard2005", "a removed resource", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG)),
+    ExperimentSpec("bg-fear", "girard2005", "fear against need", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG)),
+    ExperimentSpec("bg-tmaze", "girard2005", "the T-maze", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG, _RATIOS)),
+    ExperimentSpec("bg-colony", "girard2005", "survival against colony size, with and without a shared map",
+                   "swarm.experiments.girard2005.colony:run_colony_experiment", options=(_SIZES,)),
+)  # fmt: skip

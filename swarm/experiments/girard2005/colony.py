@@ -128,8 +128,9 @@ def _plot(rows: list[dict], path: Path) -> None:
     _save(fig, path)
 
 
-def run_colony_experiment(sizes: tuple[int, ...] | None, reps: int | None, jobs: int | None, seed: int,
+def run_colony_experiment(name: str, sizes: tuple[int, ...] | None, reps: int | None, jobs: int | None, seed: int,
                           out: Path | None, progress: bool = True, max_ticks: int | None = None) -> dict:  # fmt: skip
+    """`name`: "bg-colony", the one experiment this runs (the registry calls every experiment by name)."""
     sizes = tuple(sorted(set(sizes or SIZES)))
     reps = REPS if reps is None else reps
     for size in sizes:

@@ -1,0 +1,12 @@
+"""Simonin, Charpillet & Thierry (2007): c-marking foraging on the grid, its tables and studies."""
+
+from swarm.core.registry import ExperimentSpec
+
+_RUN = "swarm.experiments.simonin2007.tables:run_experiment"
+EXPERIMENTS = (
+    ExperimentSpec("table1", "simonin2007", "setup 1, agents 5..160", _RUN),
+    ExperimentSpec("table2", "simonin2007", "setup 2, agents 1..8, projected vs experimental", _RUN),
+    ExperimentSpec("table3", "simonin2007", "setup 3, 50 agents, sizes 12..200", _RUN),
+    ExperimentSpec("ants", "simonin2007", "c-marking vs the ant model, setup 3 sizes", _RUN),
+    ExperimentSpec("congestion", "simonin2007", "setup 1, ideal vs physical bodies, agents 10..160", _RUN),
+)

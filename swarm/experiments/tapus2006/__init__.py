@@ -1,0 +1,18 @@
+"""Tapus, Battaglia & Siegwart (2006): topological mapping and localization with fingerprints of
+places on the office floor."""
+
+from swarm.core.registry import ExperimentSpec, Option
+
+_FLOOR = Option("--scenario", "a floor with 'mapping', 'localize' and 'localize-off-map' routes and place zones "
+                "(default office)")  # fmt: skip
+_RUN = "swarm.experiments.tapus2006.fingerprint:run_fingerprint_experiment"
+EXPERIMENTS = (
+    ExperimentSpec("fingerprint-calibrate", "tapus2006", "fit the alignment's defaults on the mapping tour", _RUN,
+                   options=(_FLOOR,), writes="runs.csv, table.md"),
+    ExperimentSpec("fingerprint-map", "tapus2006", "map the floor on one tour", _RUN, options=(_FLOOR,),
+                   writes="runs.csv, table.md, summary.csv, plot.png"),
+    ExperimentSpec("fingerprint-localize", "tapus2006", "map on one tour, localize on another", _RUN,
+                   options=(_FLOOR,), writes="runs.csv, table.md, summary.csv, plot.png"),
+    ExperimentSpec("fingerprint-together", "tapus2006", "surveyors of office sharing one map",
+                   "swarm.experiments.tapus2006.team:run_team_experiment", writes="runs.csv, table.md, plot.png"),
+)  # fmt: skip

@@ -124,8 +124,9 @@ def known_places(lead, counts: list[dict]) -> set[int]:
     return out
 
 
-def run_team_experiment(reps: int | None, jobs: int | None, seed: int, out: Path | None, progress: bool = True,
-                        teams: tuple[int, ...] = TEAMS) -> dict:  # fmt: skip
+def run_team_experiment(name: str, reps: int | None, jobs: int | None, seed: int, out: Path | None,
+                        progress: bool = True, teams: tuple[int, ...] = TEAMS) -> dict:  # fmt: skip
+    """`name`: "fingerprint-together", the one experiment this runs (the registry calls every experiment by name)."""
     reps = reps or 1
     out = Path(out) if out is not None else Path("results") / "fingerprint-together"
     out.mkdir(parents=True, exist_ok=True)

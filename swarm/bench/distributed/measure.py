@@ -1,7 +1,7 @@
 """`swarm bench distributed`: the lock-step runtime against the messaging floor.
 
 For each swarm size, measured in the same command on the same machine: the
-bare floor (`swarm.bench.floor`, the method of shared/probes/lockstep_floor.py:
+bare floor (`swarm.bench.distributed.floor`, the method of shared/probes/lockstep_floor.py:
 processes that answer each observation and do nothing else), our runtime
 with a null controller and no world work, and the real run (world rules,
 c-marking controllers); the real run's ticks per second as a share of the
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import time
 
-from swarm.bench.floor import floor
+from swarm.bench.distributed.floor import floor
 from swarm.engines.grid import Engine
 from swarm.launcher import swarm_up
 from swarm.scenario import load_scenario
@@ -102,9 +102,16 @@ def bench_distributed(sizes=SIZES, ticks: int = 600, packed: int = 1000, port: i
     return result
 
 
+def run(quick: bool = False, pairs: int = 3) -> dict:
+    """`swarm bench distributed` (--quick: two sizes and a shorter packed run)."""
+    return bench_distributed(
+        sizes=(10, 50) if quick else (10, 50, 100, 200), packed=200 if quick else 1000, pairs=pairs
+    )
+
+
 def format_distributed_bench(result: dict) -> str:
     lines = ["Distributed lock-step runtime, setup1, one process per agent. floor: the bare exchange",
-             "(swarm.bench.floor, the method of shared/probes/lockstep_floor.py); null: our runtime, no controller",
+             "(floor.py here, the method of shared/probes/lockstep_floor.py); null: our runtime, no controller",
              "and no world work; ticks/s: the real run (over `ticks` ticks, until foraged and converged",
              "or the floor's ticks); share: ticks/s over floor, the median of",
              f"{result.get('pairs', 1)} floor/run pairs measured in turn (each pair's share in the last column)", "",

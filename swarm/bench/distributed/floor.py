@@ -8,7 +8,7 @@ decoding, no world work).  No runtime can pass this number; `swarm bench
 distributed` reports its own ticks per second as a share of it, measured in
 the same command.
 
-    python -m swarm.bench.floor 100 300
+    python -m swarm.bench.distributed.floor 100 300
 """
 
 from __future__ import annotations
