@@ -22,6 +22,7 @@ from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_int
 from swarm.core.registry import Option, Registry, resolve
 from swarm.core.tables import positive, seed
 from swarm.scenario import PRESET_HELP, bundled_scenarios, is_arena, load_scenario
+from world_server.grid.scenario import DEFAULT_CONTROLLER, check_until
 
 CONTROLLERS = CONTROLLER_REGISTRY.names()
 
@@ -56,7 +57,24 @@ def build_parser() -> argparse.ArgumentParser:
         prog="swarm", description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    _add_run(sub)
+    _add_experiment(sub)
+    _add_bench(sub)
+    _add_world(sub)
+    _add_agent(sub)
+    _add_up(sub)
+    _add_replay(sub)
+    _add_report(sub)
+    _add_monitor(sub)
+    _add_status(sub)
+    _add_router(sub)
+    _add_prepare(sub)
+    add_sense_parser(sub)
+    sub.add_parser("scenarios", help="list presets and bundled scenarios")
+    return parser
 
+
+def _add_run(sub) -> None:
     run = sub.add_parser(
         "run",
         help="run a scenario to completion in one process",
@@ -84,9 +102,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="stop after M iterations if not done (default 1000000)")  # fmt: skip
     run.add_argument("--json", action="store_true", help="print one JSON object instead of text")
 
-    _add_experiment(sub)
-    _add_bench(sub)
 
+def _add_world(sub) -> None:
     world = sub.add_parser(
         "world",
         help="serve a scenario's world over zenoh (the world process)",
@@ -123,18 +140,22 @@ def build_parser() -> argparse.ArgumentParser:
                        help="keep serving swarm/<run-id>/marks/** for S seconds after the run")  # fmt: skip
     _record_args(world, "write a rerun recording of the run to FILE (.rrd), or into FOLDER/ as <run-id>-<UTC time>.rrd")
 
+
+def _add_agent(sub) -> None:
     agent = sub.add_parser(
         "agent",
         help="run agent process(es) that join a world",
         description="Join a world over zenoh and run one controller (or K with --count).",
     )
-    agent.add_argument("--controller", choices=CONTROLLERS, default="cmarking")
+    agent.add_argument("--controller", choices=CONTROLLERS, default=DEFAULT_CONTROLLER)
     _client_args(agent)
     agent.add_argument("--count", type=positive, default=1, metavar="K", help="independent agents in this process")
     agent.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
     agent.add_argument("--join-timeout", type=float, default=60.0, metavar="S",
                        help="give up when no world has answered within S seconds (default 60)")  # fmt: skip
 
+
+def _add_up(sub) -> None:
     up = sub.add_parser(
         "up",
         help="launch a world and N agent processes, and follow the run",
@@ -148,6 +169,8 @@ def build_parser() -> argparse.ArgumentParser:
     _record_args(up, "where the recording goes (default runs/<run-id>.rrd)")
     up.add_argument("--no-record", action="store_true", help="do not record the run")
 
+
+def _add_replay(sub) -> None:
     replay = sub.add_parser(
         "replay",
         help="open a recording in the rerun viewer",
@@ -160,6 +183,8 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_argument("--grpc-port", type=int, default=9876, help="port of the data stream (default 9876)")
     replay.add_argument("--bind", default="127.0.0.1", help="address to serve on (0.0.0.0 for other machines)")
 
+
+def _add_report(sub) -> None:
     rep = sub.add_parser(
         "report",
         help="summary and plots from a recording",
@@ -170,6 +195,8 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--out", metavar="DIR", help="where the plots go (default: FILE without .rrd)")
     rep.add_argument("--json", action="store_true", help="print one JSON object instead of text")
 
+
+def _add_monitor(sub) -> None:
     mon = sub.add_parser(
         "monitor",
         help="follow a running world and print its summary when the run ends",
@@ -183,6 +210,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="give up if no world answers for S seconds (default 600)")  # fmt: skip
     mon.add_argument("--json", action="store_true", help="print one JSON object instead of text")
 
+
+def _add_status(sub) -> None:
     st = sub.add_parser(
         "status",
         help="ask a router or a world whether it is up (health checks)",
@@ -194,6 +223,8 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--timeout", type=float, default=3.0, metavar="S", help="how long to wait (default 3)")
     st.add_argument("--json", action="store_true", help="print one JSON object")
 
+
+def _add_router(sub) -> None:
     router = sub.add_parser(
         "router",
         help="run a bare zenoh router (for worlds and agents on several hosts)",
@@ -203,6 +234,8 @@ def build_parser() -> argparse.ArgumentParser:
     router.add_argument("--listen", default="tcp/0.0.0.0:7447", metavar="ENDPOINT",
                         help="where to listen (default tcp/0.0.0.0:7447)")  # fmt: skip
 
+
+def _add_prepare(sub) -> None:
     prep = sub.add_parser(
         "prepare",
         help="compile the kernels and the agents' step now, so runs start at once",
@@ -212,10 +245,6 @@ def build_parser() -> argparse.ArgumentParser:
     )
     prep.add_argument("--require-aot", action="store_true",
                       help="fail if the ahead-of-time build cannot be made (no C compiler)")  # fmt: skip
-
-    add_sense_parser(sub)
-    sub.add_parser("scenarios", help="list presets and bundled scenarios")
-    return parser
 
 
 def _add_experiment(sub) -> None:
@@ -400,8 +429,8 @@ def cmd_world(args) -> int:
     from swarm.world_process import serve
 
     scenario = _scenario(args)
-    if args.until != "foraged" and scenario.controller == "ant":
-        raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
+    if not is_arena(scenario):
+        check_until(scenario, args.until)
     summary = serve(scenario, args.run_id, args.summary_file, quiet=args.quiet,
                     listen=None if args.connect else args.listen,
                     connect=args.connect, deadline=args.deadline, max_misses=args.max_misses, until=args.until,
@@ -436,8 +465,8 @@ def cmd_up(args) -> int:
     from world_server.server import new_run_id
 
     scenario = _scenario(args)
-    if args.until != "foraged" and scenario.controller == "ant":
-        raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
+    if not is_arena(scenario):
+        check_until(scenario, args.until)
     run_id = args.run_id or new_run_id()
     record = None if args.no_record else (args.record or f"runs/{run_id}.rrd")
     arena = is_arena(scenario)

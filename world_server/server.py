@@ -95,25 +95,7 @@ class WorldServer:
         self.until = until
         self.max_iterations = max_iterations
         self.null = null  # benchmark floor: messaging only, no perception and no world rules
-        self.tick_seconds: list[float] = []
-        self.bytes_out = 0
-        self.bytes_in = 0
-        self.agent_steps = 0  # actions received in time, over the run
-        self.slots = np.full(scenario.agents, FREE, dtype=np.int64)
-        self.misses = np.zeros(scenario.agents, dtype=np.int64)
-        # A resumed run's agents that have not come back yet: a newcomer takes one over (body and memory).
-        self.returning = np.zeros(scenario.agents, dtype=bool)
-        self.acted = np.zeros(scenario.agents, dtype=bool)  # action received this tick
-        self.nonces: dict[str, int] = {}
-        self.group_of: dict[int, str] = {}  # agent -> its agent process (message group)
-        self.group_index: dict[str, int] = {}  # message group -> a number, for the compiled checks
-        self.group_ids = np.full(scenario.agents, -1, dtype=np.int64)  # agent -> its group's number
-        self._publishers: dict[str, object] = {}  # message group -> its declared observation publisher
-        self._grouping: tuple[bytes, int, dict] | None = None  # (active agents, joins, their groups) of the last tick
-        self.stats = Stats()
-        self.tick = 0
-        self.events: queue.SimpleQueue = queue.SimpleQueue()
-        self.started = 0.0
+        self._init_bookkeeping()
         self.persist_every = persist_every
         self.resume_timeout = resume_timeout
         self.state_dir = state_dir
@@ -122,6 +104,32 @@ class WorldServer:
         self.resumed = self._resume()
         self.recording_path: str | None = None
         self.recorder = None if null or not record else self._recorder(record, viewer)
+        self._open_session(listen, connect)
+
+    def _init_bookkeeping(self) -> None:
+        """Traffic and timing counters, the agent slots and their message groups, and the event queue."""
+        self.tick_seconds: list[float] = []
+        self.bytes_out = 0
+        self.bytes_in = 0
+        self.agent_steps = 0  # actions received in time, over the run
+        self.slots = np.full(self.scenario.agents, FREE, dtype=np.int64)
+        self.misses = np.zeros(self.scenario.agents, dtype=np.int64)
+        # A resumed run's agents that have not come back yet: a newcomer takes one over (body and memory).
+        self.returning = np.zeros(self.scenario.agents, dtype=bool)
+        self.acted = np.zeros(self.scenario.agents, dtype=bool)  # action received this tick
+        self.nonces: dict[str, int] = {}
+        self.group_of: dict[int, str] = {}  # agent -> its agent process (message group)
+        self.group_index: dict[str, int] = {}  # message group -> a number, for the compiled checks
+        self.group_ids = np.full(self.scenario.agents, -1, dtype=np.int64)  # agent -> its group's number
+        self._publishers: dict[str, object] = {}  # message group -> its declared observation publisher
+        self._grouping: tuple[bytes, int, dict] | None = None  # (active agents, joins, their groups) of the last tick
+        self.stats = Stats()
+        self.tick = 0
+        self.events: queue.SimpleQueue = queue.SimpleQueue()
+        self.started = 0.0
+
+    def _open_session(self, listen: str | None, connect: str | None) -> None:
+        """The zenoh session, with the join, info, action, liveliness, shared and state keys declared."""
         self.session = open_client(connect) if connect else open_router(listen or "tcp/127.0.0.1:7447")
         put = self.events.put
         k = self.keys

@@ -40,7 +40,8 @@ class ControllerSpec:
     `table`: a callable that raises ValueError in one line for a bad [name] table of a scenario.
     `requires`: the sensors its robot must carry.  `shares`: the key space it writes
     (swarm/<run>/<share>/<agent>), if any.  `kernels`: modules whose `exported` kernels the
-    agents' ahead-of-time build must compile.  `example`: a bundled scenario it runs in
+    agents' ahead-of-time build must compile.  `records`: the logs an arena recording keeps of
+    its record() (its map, its fields, its channels).  `example`: a bundled scenario it runs in
     (`swarm run EXAMPLE --controller NAME`; the tests run every controller there).  What a robot
     publishes on its share at tick t, every other robot of the same share receives before it steps
     tick t + 1."""
@@ -53,6 +54,7 @@ class ControllerSpec:
     requires: tuple[str, ...] = ()
     shares: str | None = None
     kernels: tuple[str, ...] = ()
+    records: tuple[str, ...] = ()  # "module:Class" of the logs that show what explains its choices (swarm.core.series)
     example: str = "setup1"
 
     def make(self) -> Any:

@@ -15,10 +15,9 @@ import numpy as np
 from numba import njit
 
 from agents.controllers.grid.dispatch import step_controller
-from swarm.core.errors import ScenarioError
 from swarm.recording.layer_classes import K_MARKS, K_RESOURCES, K_TRAILS, class_image
 from world_server.grid.face.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind, controller_params, new_memory
-from world_server.grid.scenario import Layout, Scenario
+from world_server.grid.scenario import Layout, Scenario, check_until
 from world_server.grid.world import (
     C_EXPLORED,
     C_OPTIMAL,
@@ -180,8 +179,7 @@ class Engine:
         (swarm.recording.grid.Recorder) every tick goes into the recording."""
         if until not in UNTIL:
             raise ValueError(f"unknown --until {until!r}: choose foraged, converged or both")
-        if until != "foraged" and self.scenario.controller == "ant":
-            raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
+        check_until(self.scenario, until)
         bar = None
         if progress:
             from tqdm import tqdm

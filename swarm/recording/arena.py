@@ -14,10 +14,9 @@ Layout (timeline `tick`; the record at tick t shows the world after tick t):
     world/plans/<agent>   the path a controller planned (in process from its record(); distributed, sent
                           by its agent process on swarm/<run>/plans/<group>)
     world/optimum/<agent> static: the A* optimum from the robot's start to its goal (L_o; not for routes)
-    fields/<agent>/…      a dft controller's fields and intentions (in process; swarm/recording/fields.py)
-    bg/<agent>/…          a bg animat's E, Ep, D, motivations, acts and channels (in process; swarm/recording/bg.py)
-    world/map/<agent>/…,  a controller's topological map over the floor plan, its belief and current
-    map/<agent>/…         fingerprint (in process; swarm/recording/topomap.py)
+    …/<agent>/…           what explains a controller's choices, by the logs its registry entry names
+                          (ControllerSpec.records: its map, its fields, its channels; in process, and a
+                          map from its publications when distributed): each log's module lists its paths
     metrics/<name>        reached, collisions, distance, agents_alive, tick_ms, rejected_messages
                           (in-process: the actions the world refused)
     metrics/robots/<name> per robot, one scalar each: path_length, collisions, in_goal, finished (dwelt)
@@ -33,13 +32,12 @@ import math
 
 import numpy as np
 
+from swarm.core.registry import resolve
 from swarm.engines.arena import _planner, fill_optimum
 from swarm.recording.grid import FORMAT_VERSION, software_versions
 
 ARENA_METRICS = ("reached", "collisions", "distance", "agents_alive", "tick_ms", "rejected_messages")
 ROBOT_SERIES = ("path_length", "collisions", "in_goal", "finished")
-# What explains a controller, by the flag it sets: the log that records it (in process).
-CONTROLLER_LOGS = {"keeps_fields": "swarm.recording.fields:FieldLog", "keeps_channels": "swarm.recording.bg:ChannelLog"}
 GROUP_COLOURS = ((40, 160, 40), (220, 120, 20), (60, 90, 220), (200, 40, 140), (30, 170, 190), (150, 150, 30))
 
 
@@ -106,8 +104,10 @@ class ArenaRecorder:
         self._paths = world.pose[:, None, :2].astype(np.float32)  # (n, T, 2): every robot's path so far
         self._obstacles_on: tuple | None = None
         self._plans_logged: set[int] = set()
-        self._maps = None
-        self._logs: dict = {}  # per CONTROLLER_LOGS flag, its log
+        self._logs: dict = {}  # each controller log (ControllerSpec.records) in use, by its class
+        specs = world.scenario.known_controllers
+        self._records_of = [specs[g.controller].records if g.controller in specs else ()
+                            for g in world.scenario.groups for _ in range(g.count)]  # fmt: skip
         self._published = None
         self._static_done = False
 
@@ -118,6 +118,28 @@ class ArenaRecorder:
         self.meta = {"format": FORMAT_VERSION, **built, **self._meta_given, "versions": software_versions()}
         rec.log("run/meta", rr.AnyValues(meta=json.dumps(self.meta)), rr.TextDocument(json.dumps(self.meta, indent=1)),
                 static=True)  # fmt: skip
+        self._log_walls()
+        self._log_zones()
+        goals = np.flatnonzero(w.has_goal & w.in_world)
+        if len(goals):
+            rec.log(
+                "world/goals",
+                rr.Points2D(
+                    flip(w.goal[goals]),
+                    radii=s.goal_radius / 3,
+                    colors=self.colours[goals],
+                    labels=[f"goal {a}" for a in goals],
+                    draw_order=2.0,
+                ),
+                static=True,
+            )
+        rec.log("world/robots", rr.Points2D.from_fields(radii=w.radius.astype(np.float32), colors=self.colours,
+                                                        draw_order=5.0), static=True)  # fmt: skip
+        self._log_optimum(goals)
+
+    def _log_walls(self) -> None:
+        """The walls as line strips (a rectangle closed on itself), static."""
+        rr, rec, s = self.rr, self.rec, self.world.scenario
         strips, colours = [], []
         for wall in s.walls:
             c = wall.coords
@@ -127,6 +149,10 @@ class ArenaRecorder:
             colours.append(wall.colour)
         if strips:
             rec.log("world/walls", rr.LineStrips2D(strips, colors=colours, radii=0.004, draw_order=1.0), static=True)
+
+    def _log_zones(self) -> None:
+        """The rectangular zones as boxes and the disc zones as circles, static."""
+        rr, rec, s = self.rr, self.rec, self.world.scenario
         boxes = [z for z in s.zones if z.shape == "rect"]
         if boxes:
             centres = flip(
@@ -158,22 +184,6 @@ class ArenaRecorder:
                 ),
                 static=True,
             )
-        goals = np.flatnonzero(w.has_goal & w.in_world)
-        if len(goals):
-            rec.log(
-                "world/goals",
-                rr.Points2D(
-                    flip(w.goal[goals]),
-                    radii=s.goal_radius / 3,
-                    colors=self.colours[goals],
-                    labels=[f"goal {a}" for a in goals],
-                    draw_order=2.0,
-                ),
-                static=True,
-            )
-        rec.log("world/robots", rr.Points2D.from_fields(radii=w.radius.astype(np.float32), colors=self.colours,
-                                                        draw_order=5.0), static=True)  # fmt: skip
-        self._log_optimum(goals)
 
     def _log_optimum(self, robots) -> None:
         """The A* optimum (1 cm, 4 cm clearance: L_o) from each robot's start to its goal, for robots
@@ -217,8 +227,7 @@ class ArenaRecorder:
         if self.controllers is not None:
             records = [c.record() for c in self.controllers]  # once a tick: the logs below share them
             self._log_plans(tick, records)
-            self._log_maps(tick, records)
-            self._log_fields(tick, records)
+            self._log_explanations(tick, records)
         if len(self._ticks) >= self.flush_every:
             self.flush()
 
@@ -240,42 +249,27 @@ class ArenaRecorder:
                 if len(path) > 1:
                     self.log_plan(tick, a, path)
 
-    def _log_maps(self, tick: int, records: list[dict]) -> None:
-        """The topological map of each controller that keeps one (swarm.recording.topomap)."""
-        for a, c in enumerate(self.controllers):
-            if not getattr(c, "keeps_map", False):
-                continue
-            if self._maps is None:
-                from swarm.recording.topomap import MapLog
+    def _log_explanations(self, tick: int, records: list[dict]) -> None:
+        """What explains each controller's choices, by the logs its registry entry names (its map, its
+        neural fields, its basal-ganglia channels), each log made at its first use."""
+        for a, refs in enumerate(self._records_of):
+            for ref in refs:
+                self._log(resolve(ref)).capture(tick, a, records[a], self.world.pose[a, :2])
 
-                self._maps = MapLog(self.rr, self.rec, self.colours)
-            self._maps.capture(tick, a, records[a], self.world.pose[a, :2])
-
-    def _log_fields(self, tick: int, records: list[dict]) -> None:
-        """What explains each controller that says it keeps some: neural fields (swarm.recording.fields),
-        basal-ganglia channels (swarm.recording.bg); each log made at its first use."""
-        import importlib
-
-        for a, c in enumerate(self.controllers):
-            for flag, target in CONTROLLER_LOGS.items():
-                if not getattr(c, flag, False):
-                    continue
-                if flag not in self._logs:
-                    module, cls = target.split(":")
-                    self._logs[flag] = getattr(importlib.import_module(module), cls)(self.rr, self.rec)
-                self._logs[flag].capture(tick, a, records[a])
+    def _log(self, cls):
+        if cls not in self._logs:
+            self._logs[cls] = cls(self.rr, self.rec, self.colours)
+        return self._logs[cls]
 
     def log_published_map(self, tick: int, agent: int, data) -> None:
         """Distributed: a robot's map from its publication on the map key space."""
-        from swarm.recording.topomap import MapLog, PublishedMaps
+        from agents.controllers.navigation.recording import MapLog, PublishedMaps
 
-        if self._maps is None:
-            self._maps = MapLog(self.rr, self.rec, self.colours)
         if self._published is None:
             self._published = PublishedMaps()
         record = self._published.update(agent, data)
         if record is not None:
-            self._maps.capture(tick, agent, record, self.world.pose[agent, :2])
+            self._log(MapLog).capture(tick, agent, record, self.world.pose[agent, :2])
 
     def log_plan(self, tick: int, agent: int, path: np.ndarray) -> None:
         """A controller's planned path, at the tick it was planned."""

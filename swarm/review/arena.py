@@ -19,21 +19,7 @@ def arena_summary_from(rec) -> dict:
     n = m["agents"]
     if len(ticks) == 0:
         in_goal = lengths = collisions = finished = np.zeros((0, n))
-    robots = []
-    for a in range(n):
-        goal = m["goals"][a]
-        reached = bool(goal is not None and len(in_goal) and (in_goal[-1, a] > 0 or finished[-1, a] > 0))
-        first = np.flatnonzero(in_goal[:, a] > 0) if len(in_goal) else np.zeros(0, int)
-        lp = float(lengths[-1, a]) if len(lengths) else 0.0
-        lo = m["optimal_lengths"][a]
-        robots.append({
-            "agent": a, "controller": m["controllers"][a], "start": [round(v, 4) for v in m["starts"][a]],
-            "goal": None if goal is None else [round(v, 4) for v in goal], "reached": reached,
-            "ticks_to_goal": int(ticks[first[0]]) + 1 if goal is not None and len(first) else None,
-            "path_length": round(lp, 4), "optimal_length": None if lo is None else round(lo, 4),
-            "path_ratio": round(lp / lo, 4) if reached and lo else None,
-            "collisions": int(collisions[-1, a]) if len(collisions) else 0,
-        })  # fmt: skip
+    robots = _robot_rows(m, ticks, in_goal, lengths, collisions, finished)
     goals = [r for r in robots if r["goal"] is not None]
     ratios = [r["path_ratio"] for r in robots if r["path_ratio"] is not None]
     summary = {
@@ -57,6 +43,33 @@ def arena_summary_from(rec) -> dict:
         "robots": robots,
     }
     summary["iterations"] = summary["ticks"]
+    _add_runtime_fields(summary, rec, m)
+    return summary
+
+
+def _robot_rows(m: dict, ticks, in_goal, lengths, collisions, finished) -> list[dict]:
+    """Each robot's line of the summary, from the meta and the per-robot series (one row a tick)."""
+    robots = []
+    for a in range(m["agents"]):
+        goal = m["goals"][a]
+        reached = bool(goal is not None and len(in_goal) and (in_goal[-1, a] > 0 or finished[-1, a] > 0))
+        first = np.flatnonzero(in_goal[:, a] > 0) if len(in_goal) else np.zeros(0, int)
+        lp = float(lengths[-1, a]) if len(lengths) else 0.0
+        lo = m["optimal_lengths"][a]
+        robots.append({
+            "agent": a, "controller": m["controllers"][a], "start": [round(v, 4) for v in m["starts"][a]],
+            "goal": None if goal is None else [round(v, 4) for v in goal], "reached": reached,
+            "ticks_to_goal": int(ticks[first[0]]) + 1 if goal is not None and len(first) else None,
+            "path_length": round(lp, 4), "optimal_length": None if lo is None else round(lo, 4),
+            "path_ratio": round(lp / lo, 4) if reached and lo else None,
+            "collisions": int(collisions[-1, a]) if len(collisions) else 0,
+        })  # fmt: skip
+    return robots
+
+
+def _add_runtime_fields(summary: dict, rec, m: dict) -> None:
+    """The fields that depend on the runtime: rejected actions in-process, else the world server's
+    run id, mode, messages, peak agents and tick times."""
     if m["runtime"] == "in-process":
         summary["rejected_actions"] = int(rec.last("rejected_messages"))
     else:
@@ -71,7 +84,6 @@ def arena_summary_from(rec) -> dict:
                 "tick_ms_p99": round(float(np.percentile(tick_ms, 99)), 3) if len(tick_ms) else 0.0,
             }
         )
-    return summary
 
 
 def write_arena_plots(rec, out: Path) -> list[Path]:

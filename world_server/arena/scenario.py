@@ -580,20 +580,7 @@ def _check_controller(name: str, controllers: Mapping[str, ControllerSpec], sour
 
 def check_arena(s: ArenaScenario, source: str) -> None:
     w, h = s.size
-    if not 0 <= s.seed < 2**63:
-        raise ScenarioError(source, "seed", f"expected 0 to 2**63-1, got {s.seed}")
-    if not 0.001 <= s.control_period <= 10:
-        raise ScenarioError(source, "control_period", f"expected 0.001 to 10 s, got {s.control_period}")
-    if not 1 <= s.substeps <= 1000:
-        raise ScenarioError(source, "substeps", f"expected 1 to 1000, got {s.substeps}")
-    if not 1 <= s.checkpoint <= 1_000_000:
-        raise ScenarioError(source, "checkpoint", f"expected 1 to 1000000 ticks, got {s.checkpoint}")
-    if not 1 <= s.max_ticks <= 100_000_000:
-        raise ScenarioError(source, "max_ticks", f"expected 1 to 100000000, got {s.max_ticks}")
-    if not 0 < s.goal_radius <= max(w, h) or s.goal_dwell < 1:
-        raise ScenarioError(source, "goal_radius/goal_dwell", "expected a positive radius and dwell >= 1 tick")
-    if not 1 <= s.agents <= 100_000:
-        raise ScenarioError(source, "group.count", f"expected 1 to 100000 robots in all, got {s.agents}")
+    _check_arena_settings(s, source)
 
     def inside(x: float, y: float) -> bool:
         return -1e-9 <= x <= w + 1e-9 and -1e-9 <= y <= h + 1e-9
@@ -639,6 +626,25 @@ def check_arena(s: ArenaScenario, source: str) -> None:
     for name, route in s.routes.items():
         if len(route) < 1 or not all(inside(x, y) for x, y in route):
             raise ScenarioError(source, f"routes.{name}", "expected at least one waypoint, all inside the arena")
+
+
+def _check_arena_settings(s: ArenaScenario, source: str) -> None:
+    """The run-wide numbers within their ranges: seed, timing, tick limits, goal and robot count."""
+    w, h = s.size
+    if not 0 <= s.seed < 2**63:
+        raise ScenarioError(source, "seed", f"expected 0 to 2**63-1, got {s.seed}")
+    if not 0.001 <= s.control_period <= 10:
+        raise ScenarioError(source, "control_period", f"expected 0.001 to 10 s, got {s.control_period}")
+    if not 1 <= s.substeps <= 1000:
+        raise ScenarioError(source, "substeps", f"expected 1 to 1000, got {s.substeps}")
+    if not 1 <= s.checkpoint <= 1_000_000:
+        raise ScenarioError(source, "checkpoint", f"expected 1 to 1000000 ticks, got {s.checkpoint}")
+    if not 1 <= s.max_ticks <= 100_000_000:
+        raise ScenarioError(source, "max_ticks", f"expected 1 to 100000000, got {s.max_ticks}")
+    if not 0 < s.goal_radius <= max(w, h) or s.goal_dwell < 1:
+        raise ScenarioError(source, "goal_radius/goal_dwell", "expected a positive radius and dwell >= 1 tick")
+    if not 1 <= s.agents <= 100_000:
+        raise ScenarioError(source, "group.count", f"expected 1 to 100000 robots in all, got {s.agents}")
 
 
 # --------------------------------------------------------------------- helpers

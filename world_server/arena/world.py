@@ -45,9 +45,17 @@ class ArenaWorld:
     def __init__(self, scenario: ArenaScenario, index_cell: float | None = None, parked: bool = False):
         """`parked`: no robot is in the world yet; each comes in with `enter`
         (the world server's agents, as they join).  Else all start now."""
-        s = self.scenario = scenario
+        self.scenario = scenario
         self.tick = 0
-        models = s.robot_models()
+        self._init_robot_models()
+        self._init_geometry(index_cell)
+        start = self._init_bodies(parked)
+        self._init_goals()
+        self._init_progress(start)
+
+    def _init_robot_models(self) -> None:
+        """Each robot's body and drive limits, one array entry per robot."""
+        models = self.scenario.robot_models()
         self.n = len(models)
         self.radius = np.array([m.radius for m in models])
         self.axle = np.array([m.axle for m in models])
@@ -55,7 +63,11 @@ class ArenaWorld:
         self.max_speed = np.array([m.max_speed for m in models])
         self.max_turn = np.array([m.max_turn_rate for m in models])
         self.robot_rgb = np.array([m.colour for m in models], np.uint8).reshape(-1, 3)
-        # Geometry: wall rectangles and segments, then every obstacle's edges (switched by seg_on).
+
+    def _init_geometry(self, index_cell: float | None) -> None:
+        """Wall rectangles and segments, then every obstacle's edges (switched by seg_on), and the
+        ray-cast indexes over them."""
+        s = self.scenario
         segs, colours, self.obstacle_segs, self.obstacle_layer = [], [], [], []
         for w in s.walls:
             edges = rect_edges(w.coords) if w.shape == "rect" else [w.coords]
@@ -76,7 +88,11 @@ class ArenaWorld:
         self.s_coords = np.ascontiguousarray(self.segs[self.s_items])
         self.d_start = np.zeros(self.nx * self.ny + 1, np.int64)
         self._grow_discs(4 * self.n + 16)
-        # Bodies and sensors.  A parked robot waits outside the arena, touching nothing.
+
+    def _init_bodies(self, parked: bool) -> np.ndarray:
+        """Bodies and sensors.  A parked robot waits outside the arena, touching nothing.
+        Returns the start poses."""
+        s = self.scenario
         self.in_world = np.full(self.n, not parked)
         start = np.column_stack([-10.0 - 4 * self.radius.max() * np.arange(self.n), np.full(self.n, -10.0),
                                  np.zeros(self.n)]) if parked else s.start_poses()  # fmt: skip
@@ -88,7 +104,12 @@ class ArenaWorld:
             self.suites.append(Suite(g.robot, np.arange(first, first + g.count), s.noise, s.seed))
             first += g.count
         self._obstacles_at(0)
-        # Goals and routes, tracked on ground truth for the summary.
+        return start
+
+    def _init_goals(self) -> None:
+        """Goals and routes, tracked on ground truth for the summary; a routed robot's goal is its
+        route's last waypoint."""
+        s = self.scenario
         self.goal = np.full((self.n, 2), np.nan)
         self.route: list[np.ndarray | None] = [None] * self.n
         for a, goal in enumerate(s.goals()):
@@ -101,6 +122,10 @@ class ArenaWorld:
                     self.route[agent] = np.array(s.routes[g.route], np.float64).reshape(-1, 2)
                     self.goal[agent] = self.route[agent][-1]
                 agent += 1
+
+    def _init_progress(self, start: np.ndarray) -> None:
+        """Per-robot progress for the summary and checkpoints, the zones and the metabolism."""
+        s = self.scenario
         self.waypoint = np.zeros(self.n, np.int64)  # next route waypoint per robot
         self.has_goal = ~np.isnan(self.goal[:, 0])
         self.reached_tick = np.full(self.n, -1, np.int64)

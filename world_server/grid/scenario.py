@@ -24,6 +24,8 @@ from swarm.core.tables import no_unknown, section_of, typed
 from world_server.grid.face.layout import CONTROLLERS
 
 CONTROLLER_NAMES = tuple(CONTROLLERS)  # the grid face's compiled controllers
+DEFAULT_CONTROLLER = "cmarking"
+MARKLESS = ("ant",)  # controllers that write no marks: a run of theirs cannot end "converged"
 MAX_AGENTS = (1 << 20) - 2  # trail ids reserve 20 bits for the agent id
 MAP_STREAM = 0x4D4150  # keeps map draws apart from any other use of the seed
 MAX_MAP_DRAWS = 200
@@ -92,7 +94,7 @@ class Scenario:
     source: str
     seed: int = 0
     agents: int = 10
-    controller: str = "cmarking"
+    controller: str = DEFAULT_CONTROLLER
     q_max: int = 100
     quantity: int = 1000
     ascii_map: tuple[str, ...] | None = None
@@ -197,33 +199,9 @@ def parse_grid(data: dict, text: str, source: str) -> Scenario:
     if "controller" in data:
         kw["controller"] = typed(data, "controller", str, source)
     if has_map:
-        section = section_of(data, "map", source)
-        no_unknown(section, {"ascii"}, source, "[map]")
-        if "ascii" not in section:
-            raise ScenarioError(source, "map.ascii", "missing: a multi-line string of # . B R")
-        rows = typed(section, "ascii", str, source, "map.ascii")
-        lines = [ln.rstrip() for ln in rows.splitlines()]
-        while lines and not lines[0]:
-            lines.pop(0)
-        while lines and not lines[-1]:
-            lines.pop()
-        kw["ascii_map"] = tuple(lines)
-        kw["map_first_line"] = _first_map_line(text, lines)
+        _parse_map(data, text, source, kw)
     else:
-        section = section_of(data, "generator", source)
-        keys = {"width", "height", "obstacle_density", "resources"}
-        no_unknown(section, keys, source, "[generator]")
-        for key in keys:
-            if key not in section:
-                raise ScenarioError(source, f"generator.{key}", "missing")
-        kw["generator"] = Generator(
-            width=typed(section, "width", int, source, "generator.width"),
-            height=typed(section, "height", int, source, "generator.height"),
-            obstacle_density=float(
-                typed(section, "obstacle_density", (int, float), source, "generator.obstacle_density")
-            ),
-            resources=typed(section, "resources", int, source, "generator.resources"),
-        )
+        kw["generator"] = _parse_generator(data, source)
     if "ant" in data:
         section = section_of(data, "ant", source)
         no_unknown(section, set(AntParams.__dataclass_fields__), source, "[ant]")
@@ -243,6 +221,38 @@ def parse_grid(data: dict, text: str, source: str) -> Scenario:
     scenario = Scenario(**kw)
     check_scenario(scenario)
     return scenario
+
+
+def _parse_map(data: dict, text: str, source: str, kw: dict[str, Any]) -> None:
+    """The [map] table into `kw`: the ascii map without its blank edge lines, and the file line it starts on."""
+    section = section_of(data, "map", source)
+    no_unknown(section, {"ascii"}, source, "[map]")
+    if "ascii" not in section:
+        raise ScenarioError(source, "map.ascii", "missing: a multi-line string of # . B R")
+    rows = typed(section, "ascii", str, source, "map.ascii")
+    lines = [ln.rstrip() for ln in rows.splitlines()]
+    while lines and not lines[0]:
+        lines.pop(0)
+    while lines and not lines[-1]:
+        lines.pop()
+    kw["ascii_map"] = tuple(lines)
+    kw["map_first_line"] = _first_map_line(text, lines)
+
+
+def _parse_generator(data: dict, source: str) -> Generator:
+    """The [generator] table, every key required."""
+    section = section_of(data, "generator", source)
+    keys = {"width", "height", "obstacle_density", "resources"}
+    no_unknown(section, keys, source, "[generator]")
+    for key in keys:
+        if key not in section:
+            raise ScenarioError(source, f"generator.{key}", "missing")
+    return Generator(
+        width=typed(section, "width", int, source, "generator.width"),
+        height=typed(section, "height", int, source, "generator.height"),
+        obstacle_density=float(typed(section, "obstacle_density", (int, float), source, "generator.obstacle_density")),
+        resources=typed(section, "resources", int, source, "generator.resources"),
+    )
 
 
 def _first_map_line(text: str, lines: list[str]) -> int:
@@ -407,3 +417,9 @@ def generate_layout(g: Generator, quantity: int, seed: int, source: str = "gener
     resources = np.zeros(h * w, dtype=np.int64)
     resources[rng.choice(reachable, size=g.resources, replace=False)] = quantity
     return Layout(obstacles, resources.reshape(h, w), base, bfs)
+
+
+def check_until(scenario: Scenario, until: str) -> None:
+    """A run's end rule must fit its controller: marks converge only where robots write them."""
+    if until != "foraged" and scenario.controller in MARKLESS:
+        raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")

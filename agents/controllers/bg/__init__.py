@@ -9,6 +9,7 @@ CONTROLLERS = ControllerSpec(
     name="bg",
     world="arena",
     description="the basal-ganglia animat that survives on two resources (Girard et al. 2005)",
+    records=("agents.controllers.navigation.recording:MapLog", "agents.controllers.bg.recording:ChannelLog"),
     example="bg-exp1",
     factory="agents.controllers.bg.controller:BgController",
     table="agents.controllers.bg.controller:check_table",

@@ -80,9 +80,6 @@ def check_table(table: dict[str, Any]) -> None:
 
 
 class BgController:
-    keeps_map = True  # the recording draws its map (swarm/recording/topomap.py) ...
-    keeps_channels = True  # ... and its E, Ep, D, motivations and channels (swarm/recording/bg.py)
-
     def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
         table = params.get("bg") or {}
         self.p = BgParams.from_table(table)
@@ -219,7 +216,7 @@ class BgController:
             "dorsal": self.last["dorsal"], "ventral": self.last["ventral"],
             "act": np.array(self.last["act"]), "direction": np.array(self.last["direction"]),
             "reflex": np.array(self.last["reflex"]),
-            # the map, for swarm/recording/topomap.py: node, nodes, links, belief, and what nodes hold
+            # the map, for agents/controllers/navigation/recording.py: node, nodes, links, belief, and what nodes hold
             "node": np.array(m.current), "nodes": np.array(m.size), "folded": np.array(sorted(m.folded), np.int64),
             "links": np.array(list(m.links), np.int64).reshape(-1, 2), "belief": np.asarray(m.belief, np.float64),
             "holds": np.array(holds, dtype=object),

@@ -9,6 +9,7 @@ CONTROLLERS = ControllerSpec(
     name="dft",
     world="arena",
     description="planning and acting with dynamic neural fields (Billing et al. 2015)",
+    records=("agents.controllers.dft.recording:FieldLog",),
     example="zmaze",
     factory="agents.controllers.dft.controller:DftController",
     table="agents.controllers.dft.controller:check_table",

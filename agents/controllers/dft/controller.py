@@ -66,8 +66,6 @@ def check_table(table: dict[str, Any]) -> None:
 
 
 class DftController:
-    keeps_fields = True  # the recorder logs record()'s fields (swarm/recording/fields.py)
-
     def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
         self.seed, self.agent = seed, agent
         self.p = DftParams.from_table(params.get("dft"))

@@ -9,6 +9,7 @@ CONTROLLERS = ControllerSpec(
     name="fingerprint",
     world="arena",
     description="topological mapping and localization with fingerprints of places (Tapus et al. 2006)",
+    records=("agents.controllers.navigation.recording:MapLog",),
     example="office",
     factory="agents.controllers.fingerprint.controller:FingerprintController",
     table="agents.controllers.fingerprint.controller:check_table",

@@ -82,7 +82,6 @@ def _plain(value: Any) -> Any:
 
 
 class FingerprintController:
-    keeps_map = True  # the recorder draws its topological map
     shares = "map"  # it publishes its map to swarm/<run>/map/<agent> and merges the others' (mapshare.py)
 
     def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:

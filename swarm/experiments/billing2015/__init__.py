@@ -16,7 +16,7 @@ EXPERIMENTS = (
     ExperimentSpec("dft-case1", "billing2015", "the dft controller in zmaze beside follow the carrot", _DFT,
                    options=(_MAZE, _NOISE, _STEPS)),
     ExperimentSpec("dft-case2", "billing2015", "the dft controller in large-maze beside follow the carrot", _DFT,
-                   options=(_MAZE, _NOISE, _STEPS)),
+                   options=(_MAZE, _NOISE, _STEPS), smoke=(("reps", 1), ("max_ticks", 300))),
     ExperimentSpec("dft-case3", "billing2015", "replanning round an obstacle", _DFT,
                    options=(_MAZE, _NOISE, _STEPS), writes=f"{_WRITES}, paths.png, paths.npz"),
     ExperimentSpec("dft-together", "billing2015", "a scout shares the obstacle it meets over the context key space",

@@ -18,12 +18,19 @@ _RATIOS = Option("--ratios", "right / left branch length ratios to run (default 
 _SIZES = Option("--sizes", "colony sizes to run (default 1,2,4,8)", type=f"{_OPTIONS}:sizes",
                 metavar="N,N,...")  # fmt: skip
 _RUN = "swarm.experiments.girard2005.bg:run_bg_experiment"
+# Smoke runs: reps 2, the least run_bg_experiment takes ("at least 2 runs per condition"), and one map for every test.
 EXPERIMENTS = (
-    ExperimentSpec("bg-survival", "girard2005", "survival with and without its map", _RUN, options=(_FLOOR, _BG)),
-    ExperimentSpec("bg-choice", "girard2005", "a new resource", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG)),
-    ExperimentSpec("bg-forget", "girard2005", "a removed resource", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG)),
-    ExperimentSpec("bg-fear", "girard2005", "fear against need", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG)),
-    ExperimentSpec("bg-tmaze", "girard2005", "the T-maze", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG, _RATIOS)),
+    ExperimentSpec("bg-survival", "girard2005", "survival with and without its map", _RUN, options=(_FLOOR, _BG),
+                   smoke=(("reps", 2),)),
+    ExperimentSpec("bg-choice", "girard2005", "a new resource", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG),
+                   smoke=(("reps", 2), ("maps", 1))),
+    ExperimentSpec("bg-forget", "girard2005", "a removed resource", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG),
+                   smoke=(("reps", 2), ("maps", 1))),
+    ExperimentSpec("bg-fear", "girard2005", "fear against need", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG),
+                   smoke=(("reps", 2), ("maps", 1))),
+    ExperimentSpec("bg-tmaze", "girard2005", "the T-maze", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG, _RATIOS),
+                   smoke=(("reps", 2), ("maps", 1), ("ratios", (1.0,)))),
     ExperimentSpec("bg-colony", "girard2005", "survival against colony size, with and without a shared map",
-                   "swarm.experiments.girard2005.colony:run_colony_experiment", options=(_SIZES,)),
+                   "swarm.experiments.girard2005.colony:run_colony_experiment", options=(_SIZES,),
+                   smoke=(("reps", 1), ("sizes", (1, 2)), ("max_ticks", 200))),
 )  # fmt: skip

@@ -14,5 +14,6 @@ EXPERIMENTS = (
     ExperimentSpec("fingerprint-localize", "tapus2006", "map on one tour, localize on another", _RUN,
                    options=(_FLOOR,), writes="runs.csv, table.md, summary.csv, plot.png"),
     ExperimentSpec("fingerprint-together", "tapus2006", "surveyors of office sharing one map",
-                   "swarm.experiments.tapus2006.team:run_team_experiment", writes="runs.csv, table.md, plot.png"),
+                   "swarm.experiments.tapus2006.team:run_team_experiment", writes="runs.csv, table.md, plot.png",
+                   smoke=(("reps", 1), ("teams", (1, 2)))),
 )  # fmt: skip

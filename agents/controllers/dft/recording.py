@@ -19,7 +19,7 @@ import io
 
 import numpy as np
 
-from swarm.recording.series import SeriesLog
+from swarm.core.series import SeriesLog
 
 EBS = ("N", "S", "W", "E")
 FIELD_RANGE = 10.0
@@ -38,10 +38,10 @@ def png(u: np.ndarray) -> bytes:
 
 
 class FieldLog(SeriesLog):
-    def __init__(self, rr, rec, every: int = 20):
+    def __init__(self, rr, rec, colours=None, every: int = 20):
         super().__init__(rr, rec, every)
 
-    def capture(self, tick: int, agent: int, record: dict[str, np.ndarray]) -> None:
+    def capture(self, tick: int, agent: int, record: dict[str, np.ndarray], xy=None) -> None:
         series = self.tick(agent, tick)
         series.setdefault("intention", []).append(np.asarray(record["intention_max"], np.float64))
         action = np.asarray(record["action"])

@@ -65,6 +65,9 @@ class MapLog:
         self.sums: dict[int, dict[int, np.ndarray]] = {}
         self.shown: dict[int, tuple] = {}
 
+    def flush(self) -> None:
+        """Every map is logged as it changes: nothing waits for a flush."""
+
     def capture(self, tick: int, agent: int, record: dict, xy: np.ndarray) -> None:
         node = int(record.get("node", -1))
         if node < 0:

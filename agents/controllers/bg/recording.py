@@ -1,6 +1,6 @@
 """The BG animat in an arena recording: what explains its choices (in
 process: the recorder asks each controller that keeps channels for its
-`record()`).  Its map goes through swarm/recording/topomap.py like the
+`record()`).  Its map goes through agents/controllers/navigation/recording.py like the
 fingerprint robot's, with the resources its nodes hold in their labels.
 
     bg/<agent>/energy, potential, disorientation        E, Ep, D per tick
@@ -15,17 +15,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from swarm.recording.series import SeriesLog
+from swarm.core.series import SeriesLog
 
 SCALARS = ("energy", "potential", "disorientation", "act", "direction", "reflex")
 MOTIVATIONS = ("E", "Ep", "BKA", "DA")
 
 
 class ChannelLog(SeriesLog):
-    def __init__(self, rr, rec, every: int = 4):
+    def __init__(self, rr, rec, colours=None, every: int = 4):
         super().__init__(rr, rec, every)
 
-    def capture(self, tick: int, agent: int, record: dict[str, np.ndarray]) -> None:
+    def capture(self, tick: int, agent: int, record: dict[str, np.ndarray], xy=None) -> None:
         if "energy" not in record:
             return
         rows = self.tick(agent, tick)

@@ -1,5 +1,10 @@
 """Per-agent scalar series a controller's log gathers tick by tick and sends
-as columns at each flush (one rerun call per entity, not one per tick)."""
+as columns at each flush (one rerun call per entity, not one per tick).
+
+A controller's log (ControllerSpec.records) is built once per recording as
+Log(rr, rec, colours), is given capture(tick, agent, record, xy) with the
+controller's record() and its robot's true position at every recorded tick,
+and flush() with the recording."""
 
 from __future__ import annotations
 

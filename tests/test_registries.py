@@ -1,0 +1,187 @@
+"""Every entry of the three registries does what it declares: each controller in its example scenario, each
+experiment's smoke run, each benchmark's quick run.  The tests are parametrized over the registries
+(swarm/core/registry.py), so a new controller, experiment or benchmark is tested here as soon as its folder
+declares it."""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from agents.controllers import CONTROLLERS
+from agents.controllers.arena import as_action, deliver, publications
+from agents.controllers.grid.dispatch import step_controller
+from swarm.bench import BENCHMARKS
+from swarm.core import memory_codec
+from swarm.core.errors import ScenarioError
+from swarm.core.kernels import EXPORTS
+from swarm.core.registry import resolve
+from swarm.engines.arena import ArenaEngine
+from swarm.experiments import EXPERIMENTS
+from swarm.scenario import is_arena, load_scenario
+from tests.arena_helpers import arena
+from world_server.arena.face.robots import SENSOR_KINDS
+from world_server.arena.scenario import controller_params
+from world_server.grid.face import layout
+
+ARENA = CONTROLLERS.names(lambda c: c.world == "arena")
+GRID = CONTROLLERS.names(lambda c: c.world == "grid")
+WITH_TABLE = CONTROLLERS.names(lambda c: c.world == "arena" and c.table is not None)
+RUN_TICKS = 30  # the engine's controller runs this long before its snapshot is taken ...
+TWIN_TICKS = 8  # ... then it and its twin restored from that snapshot step side by side this long
+JOBS = 2  # worker processes of an experiment's smoke run
+# Benchmarks whose quick run takes over a minute on two cores, marked `experiment` (deselected by default; run them
+# with -m experiment), and why.
+SLOW_BENCHMARKS = {
+    "distributed": "16 timed runs of world and agent processes over zenoh (10 and 50 agents, 3 pairs): 76 s",
+}
+
+
+def _references(spec) -> list[str]:
+    return [r for r in (spec.factory, spec.table, *spec.records) if r]
+
+
+# ------------------------------------------------------------------ controllers
+
+
+@pytest.mark.parametrize("name", CONTROLLERS.names())
+def test_a_controllers_entry_names_real_sensors_kernels_parts_and_a_scenario_it_runs_in(name):
+    spec = CONTROLLERS[name]
+    assert spec.world in ("grid", "arena"), f"{name}: world {spec.world!r}"
+    assert spec.description and "\n" not in spec.description
+    if spec.world == "arena":
+        unknown = set(spec.requires) - set(SENSOR_KINDS)
+        assert not unknown, f"{name} requires {sorted(unknown)}, not sensors of the arena's robots ({SENSOR_KINDS})"
+    else:
+        assert spec.requires == (), f"{name}: a grid robot carries no sensor suite"
+    for module in spec.kernels:
+        importlib.import_module(module)
+        declared = [k for k, (kernel, _) in EXPORTS.items() if kernel.__module__ == module]
+        assert declared, f"{name}: {module} declares no @exported kernel for the ahead-of-time build"
+    for reference in _references(spec):
+        assert resolve(reference) is not None, reference
+    scenario = load_scenario(spec.example).with_overrides(controller=name)  # its robots carry what it requires
+    assert is_arena(scenario) == (spec.world == "arena") and scenario.controller == name
+
+
+def _copy(perception: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """One controller's own copy of a perception: neither sees what the other may write into it."""
+    return {k: np.array(v, copy=True) for k, v in perception.items()}
+
+
+@pytest.mark.parametrize("name", ARENA)
+def test_an_arena_controller_restored_from_its_encoded_snapshot_steps_on_bit_equal(name):
+    spec = CONTROLLERS[name]
+    scenario = load_scenario(spec.example).with_overrides(controller=name, max_ticks=RUN_TICKS + TWIN_TICKS + 10)
+    engine = ArenaEngine(scenario)
+    assert engine.step(RUN_TICKS) == RUN_TICKS
+    saved = memory_codec.encode(engine.controllers[0].snapshot())
+    twin = spec.make()
+    twin.reset(scenario.seed, 0, controller_params(scenario, 0))
+    twin.restore(memory_codec.decode(saved))
+    assert memory_codec.encode(twin.snapshot()) == saved
+    world = engine.world
+    for _ in range(TWIN_TICKS):  # as the engine steps (swarm.engines.arena), with the twin beside robot 0
+        perceptions = world.perceive()
+        actions = np.array([as_action(c.step(_copy(p))) for c, p in zip(engine.controllers, perceptions, strict=True)])
+        np.testing.assert_array_equal(as_action(twin.step(_copy(perceptions[0]))), actions[0], f"tick {world.tick}")
+        shared = publications(engine.controllers, engine.agent_ids)
+        assert publications([twin], [0]) == [s for s in shared if s[0] == 0], f"tick {world.tick}: what it publishes"
+        deliver([*engine.controllers, twin], [*engine.agent_ids, 0], shared)
+        world.apply(actions)
+    assert memory_codec.encode(twin.snapshot()) == memory_codec.encode(engine.controllers[0].snapshot())
+
+
+def _with_table(name: str, table: str) -> str:
+    """A box with one robot of `name`, carrying the sensors it requires, and a [name] table of `table`'s lines."""
+    sensors = json.dumps(list(CONTROLLERS[name].requires))
+    group = f'[[group]]\ncount = 1\ncontroller = "{name}"\nrobot = {{ model = "epuck", sensors = {sensors} }}\n'
+    return f"{group}[{name}]\n{table}\n"
+
+
+@pytest.mark.parametrize("name", WITH_TABLE)
+def test_a_bad_parameter_table_is_refused_in_one_line_that_names_the_field(name):
+    with pytest.raises(ValueError) as refused:
+        CONTROLLERS[name].check_table({"no_such_field": 1})
+    assert "\n" not in str(refused.value) and "no_such_field" in str(refused.value)
+    assert controller_params(arena(_with_table(name, "")), 0)[name] == {}  # the same file, its table empty, is fine
+    with pytest.raises(ScenarioError) as refused:
+        arena(_with_table(name, "no_such_field = 1"))
+    message = str(refused.value)
+    assert "\n" not in message and "no_such_field" in message and f"[{name}]" in message, message
+
+
+@pytest.mark.parametrize("name", GRID)
+def test_a_grid_controller_steps_once_on_a_fresh_perception_and_writes_a_move(name):
+    spec = CONTROLLERS[name]
+    kind = spec.make()
+    assert kind == layout.controller_kind(name)  # the compiled step knows it by the same code
+    scenario = load_scenario(spec.example).with_overrides(controller=name)
+    pi, pf = layout.new_perception()
+    act = layout.new_action()
+    act[layout.A_MOVE] = -1
+    step_controller(kind, pi, pf, layout.new_memory()[0], act, layout.controller_params(scenario),
+                    np.int64(scenario.seed), 0, 1)  # fmt: skip
+    assert 0 <= act[layout.A_MOVE] <= layout.STAY, act
+
+
+# ------------------------------------------------------------------ experiments
+
+
+def _experiment_keywords(name: str, out: Path | None) -> dict:
+    """What `swarm experiment NAME` gives its run when no option is chosen (swarm/cli.py), then its smoke."""
+    spec = EXPERIMENTS[name]
+    kw = {o.keyword: resolve(o.collect)(o.default) if o.collect else o.default for o in spec.options}
+    kw |= {"reps": None, "jobs": JOBS, "seed": 0, "out": out, **dict(spec.smoke)}
+    if "progress" in inspect.signature(resolve(spec.run)).parameters:
+        kw["progress"] = False
+    return kw
+
+
+@pytest.mark.parametrize("name", EXPERIMENTS.names())
+def test_an_experiments_run_takes_every_option_and_smoke_keyword_it_declares(name):
+    spec = EXPERIMENTS[name]
+    assert spec.run.startswith(f"swarm.experiments.{spec.paper}."), spec.run
+    inspect.signature(resolve(spec.run)).bind(name, **_experiment_keywords(name, None))
+    assert all(isinstance(k, str) for k, _ in spec.smoke) and spec.writes.strip()
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("name", EXPERIMENTS.names())
+def test_an_experiments_smoke_run_writes_every_file_it_declares(name, tmp_path):
+    spec = EXPERIMENTS[name]
+    result = resolve(spec.run)(name, **_experiment_keywords(name, tmp_path))
+    assert result["markdown"].strip() and Path(result["out"]) == tmp_path
+    files = [f.strip() for f in spec.writes.split(",")]
+    missing = [f for f in files if not (tmp_path / f).is_file() or (tmp_path / f).stat().st_size == 0]
+    assert not missing, f"{name} wrote {sorted(p.name for p in tmp_path.iterdir())}, not {missing}"
+
+
+# ------------------------------------------------------------------- benchmarks
+
+
+def _benchmark(name: str):
+    if name in SLOW_BENCHMARKS:
+        return pytest.param(name, marks=pytest.mark.experiment, id=name)
+    return name
+
+
+@pytest.mark.parametrize("name", BENCHMARKS.names())
+def test_a_benchmarks_options_are_keywords_its_run_takes(name):
+    spec = BENCHMARKS[name]
+    inspect.signature(resolve(spec.run)).bind(quick=True, **{o.keyword: o.default for o in spec.options})
+    assert callable(resolve(spec.report))
+
+
+@pytest.mark.parametrize("name", [_benchmark(n) for n in BENCHMARKS.names()])
+def test_a_benchmarks_quick_run_reports_text(name):
+    spec = BENCHMARKS[name]
+    result = resolve(spec.run)(quick=True)
+    json.dumps(result)  # the command line prints it with --json
+    text = resolve(spec.report)(result)
+    assert isinstance(text, str) and text.strip()
