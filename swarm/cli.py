@@ -276,23 +276,21 @@ def _add_bench(sub) -> None:
     _add_entry_options(bench, BENCHMARKS)
 
 
-def _entry_options(registry: Registry) -> dict[str, tuple[Option, list[str]]]:
-    """Every option the registry's entries declare, by flag: (the first declaration, who takes it)."""
-    found: dict[str, tuple[Option, list[str]]] = {}
+def _entry_options(registry: Registry) -> dict[str, tuple[Option, list[str], dict[str, list[str]]]]:
+    """Every option the registry's entries declare, by flag: (the first declaration, who takes it,
+    who says what of it: help text -> entries)."""
+    found: dict[str, tuple[Option, list[str], dict[str, list[str]]]] = {}
     for entry in registry:
         for option in entry.options:
-            found.setdefault(option.flag, (option, []))[1].append(entry.name)
+            _, takers, said = found.setdefault(option.flag, (option, [], {}))
+            takers.append(entry.name)
+            said.setdefault(option.help, []).append(entry.name)
     return found
 
 
 def _add_entry_options(parser: argparse.ArgumentParser, registry: Registry) -> None:
     """The options the entries declare; each one's help says who takes it, with that entry's words."""
-    for flag, (option, _) in _entry_options(registry).items():
-        said: dict[str, list[str]] = {}
-        for entry in registry:
-            for o in entry.options:
-                if o.flag == flag:
-                    said.setdefault(o.help, []).append(entry.name)
+    for flag, (option, _, said) in _entry_options(registry).items():
         help_text = "; ".join(f"{' | '.join(names)}: {text}" for text, names in said.items())
         kw = {"dest": option.keyword, "help": help_text, "metavar": option.metavar, "default": option.default}
         if option.type is not None:
@@ -306,7 +304,7 @@ def _chosen_options(args, registry: Registry, entry) -> dict:
     """The values of `entry`'s own options; one it does not take, given anyway, is a one-line error."""
     mine = {o.flag for o in entry.options}
     out = {}
-    for flag, (option, takers) in _entry_options(registry).items():
+    for flag, (option, takers, _) in _entry_options(registry).items():
         value = getattr(args, option.keyword)
         if flag not in mine:
             if value is not None and value != option.default:

@@ -15,20 +15,19 @@ import os
 from pathlib import Path
 
 _PACKAGES = ("swarm", "agents", "world_server")
+_ROOT = Path(__file__).resolve().parents[2]  # the folder holding the three packages
 
 
 def source_files() -> list[Path]:
     """Every source file of the three packages, in a fixed order."""
-    root = Path(__file__).resolve().parents[2]  # the folder holding the three packages
-    return [path for pkg in _PACKAGES for path in sorted((root / pkg).rglob("*.py"))]
+    return [path for pkg in _PACKAGES for path in sorted((_ROOT / pkg).rglob("*.py"))]
 
 
 @functools.cache
 def source_digest() -> str:
-    root = Path(__file__).resolve().parents[2]
     h = hashlib.sha1()
     for path in source_files():
-        h.update(str(path.relative_to(root)).encode())
+        h.update(str(path.relative_to(_ROOT)).encode())
         h.update(path.read_bytes())
     return h.hexdigest()[:16]
 
