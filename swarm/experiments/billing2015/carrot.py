@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import csv
 import math
-import multiprocessing as mp
-import os
 from pathlib import Path
 
 import numpy as np
 
 from swarm.core.errors import ScenarioError
+from swarm.core.plots import pyplot, save_figure
+from swarm.experiments.runner import Outputs, batch_run
 from swarm.scenario import BUNDLED_DIR
 
 NOISES = ("none", "low", "high")
@@ -120,12 +120,12 @@ def summarise(rows: list[dict]) -> tuple[list[dict], str]:
                             "path_ratio_sd": round(float(ratios.std(ddof=1)), 4) if len(ratios) > 1 else None,
                             "collisions_mean": round(float(np.mean([r["collisions"] for r in sel])), 2)})  # fmt: skip
             lines.append(f"| {name} | FTC-{noise[0].upper()}N | {ok}/{len(sel)} | "
-                         f"{_fmt(ratios.mean() if len(ratios) else math.nan)} ± "
-                         f"{_fmt(ratios.std(ddof=1) if len(ratios) > 1 else math.nan)} | |")  # fmt: skip
+                         f"{fmt(ratios.mean() if len(ratios) else math.nan)} ± "
+                         f"{fmt(ratios.std(ddof=1) if len(ratios) > 1 else math.nan)} | |")  # fmt: skip
         usable = [g for g in groups if len(g) > 1]
         f = f_oneway(*usable) if len(usable) > 1 else None
-        lines.append(f"| {name} | ANOVA over FTC conditions | | F = {_fmt(f.statistic if f else math.nan, 2)}, "
-                     f"p = {_fmt(f.pvalue if f else math.nan, 3)} | paper F = {PAPER_F.get(name, math.nan)} "
+        lines.append(f"| {name} | ANOVA over FTC conditions | | F = {fmt(f.statistic if f else math.nan, 2)}, "
+                     f"p = {fmt(f.pvalue if f else math.nan, 3)} | paper F = {PAPER_F.get(name, math.nan)} "
                      f"(all five conditions) |")  # fmt: skip
     head = ("| scenario | condition | reached | L_p / L_o (mean ± sd, reached runs) | paper |\n"
             "|---|---|---|---|---|\n")  # fmt: skip
@@ -137,16 +137,12 @@ def summarise(rows: list[dict]) -> tuple[list[dict], str]:
     return summary, head + "\n".join(lines) + "\n" + note
 
 
-def _fmt(x: float, digits: int = 3) -> str:
+def fmt(x: float, digits: int = 3) -> str:
     return "n/a" if x != x else f"{x:.{digits}f}"
 
 
 def plot(rows: list[dict], path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     names = list(dict.fromkeys(r["scenario"] for r in rows))
     fig, axes = plt.subplots(2, len(names), figsize=(5 * len(names), 7), squeeze=False)
     for j, name in enumerate(names):
@@ -157,16 +153,12 @@ def plot(rows: list[dict], path: Path) -> None:
         ratios = [[r["path_ratio"] for r in s if r["path_ratio"] not in (None, "")] for s in sel]
         axes[1, j].boxplot(ratios, tick_labels=labels)
         axes[1, j].set(title=f"{name}: L_p / L_o (reached runs)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def run_carrot_experiment(name: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
                           out: Path | None, progress: bool = True) -> dict:  # fmt: skip
     """`name`: "carrot", the one experiment this runs (the registry calls every experiment by name)."""
-    from tqdm import tqdm
-
     scenarios = list(SCENARIOS) if scenario is None else [scenario]
     for name in scenarios:
         if name not in SCENARIOS:
@@ -174,54 +166,13 @@ def run_carrot_experiment(name: str, scenario: str | None, reps: int | None, job
     reps = 100 if reps is None else reps
     if not 1 <= reps <= (100 if scenarios == ["zmaze"] else 10_000):
         raise ScenarioError("command line", "--reps", "zmaze has the paper's 100 pairs: --reps 1 to 100")
-    out = Path(out) if out is not None else Path("results") / "carrot"
-    out.mkdir(parents=True, exist_ok=True)
-    work = plan_jobs(scenarios, reps, seed)
-    rows = []
-    bar = tqdm(total=len(work), desc="carrot", unit="run", disable=not progress)
-    with mp.get_context("spawn").Pool(jobs or os.cpu_count() or 1) as pool:
-        for row in pool.imap_unordered(run_pair, work):
-            rows.append(row)
-            bar.update()
-    bar.close()
+    out = Outputs(out, "carrot")
+    rows = batch_run(run_pair, plan_jobs(scenarios, reps, seed), jobs=jobs, desc="carrot", progress=progress)
     rows.sort(key=lambda r: (SCENARIOS.index(r["scenario"]), NOISES.index(r["noise"]), r["pair"]))
-    with open(out / "runs.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=RUN_FIELDS)
-        w.writeheader()
-        w.writerows(rows)
+    out.runs(rows, RUN_FIELDS)
     summary, md = summarise(rows)
-    with open(out / "summary.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(summary[0]))
-        w.writeheader()
-        w.writerows(summary)
     text = (f"# Follow the carrot (Billing et al. 2015, cases 1 and 2)\n\n{reps} pairs per scenario, each at noise "
             f"none, low and high; seed {seed}.\n\n{md}")  # fmt: skip
-    (out / "table.md").write_text(text)
+    result = out.finish(summary, text)
     plot(rows, out / "plot.png")
-    return {"name": "carrot", "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
-
-
-def pool_map(work: list[tuple], fn, jobs: int | None, desc: str, progress: bool) -> list[dict]:
-    """fn over every job in `jobs` spawned processes (default: every core), with a progress bar; rows as they end."""
-    from tqdm import tqdm
-
-    rows = []
-    bar = tqdm(total=len(work), desc=desc, unit="run", disable=not progress)
-    with mp.get_context("spawn").Pool(jobs or os.cpu_count() or 1) as pool:
-        for row in pool.imap_unordered(fn, work):
-            rows.append(row)
-            bar.update()
-    bar.close()
-    return rows
-
-
-def write_runs(out: Path, name: str, fields: list[str], rows: list[dict], summary: list[dict]) -> None:
-    """The runs (these fields) to out/name and the summary rows to out/summary.csv."""
-    with open(out / name, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
-        w.writeheader()
-        w.writerows(rows)
-    with open(out / "summary.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(dict.fromkeys(k for row in summary for k in row)))
-        w.writeheader()
-        w.writerows(summary)
+    return result

@@ -18,17 +18,16 @@ from pathlib import Path
 import numpy as np
 
 from swarm.core.errors import ScenarioError
+from swarm.core.plots import pyplot, save_figure
 from swarm.experiments.billing2015.carrot import (
     LARGE_HEADING,
     RUN_FIELDS,
-    _fmt,
-    pool_map,
+    fmt,
     random_pairs,
     run_pair,
-    write_runs,
     zmaze_pairs,
 )
-from swarm.experiments.simonin2007.tables import _pyplot, _save
+from swarm.experiments.runner import Outputs, batch_run
 
 CONDITIONS = (("dft", "low"), ("dft", "high"), ("carrot", "none"), ("carrot", "low"), ("carrot", "high"))
 PAPER_F = {"zmaze": 0.97, "large-maze": 0.98}
@@ -86,19 +85,19 @@ def summarise_pairs(rows: list[dict]) -> tuple[list[dict], str]:
                         "ticks_to_goal_median": float(np.median(ticks)) if ticks else None,
                         "collisions_mean": round(float(np.mean([r["collisions"] for r in sel])), 2)})  # fmt: skip
         lines.append(f"| {label(controller, noise)} | {ok}/{len(sel)} | "
-                     f"{_fmt(ratios.mean() if len(ratios) else math.nan)} ± "
-                     f"{_fmt(ratios.std(ddof=1) if len(ratios) > 1 else math.nan)} | "
-                     f"{_fmt(float(np.median(ticks)) if ticks else math.nan, 0)} |")  # fmt: skip
+                     f"{fmt(ratios.mean() if len(ratios) else math.nan)} ± "
+                     f"{fmt(ratios.std(ddof=1) if len(ratios) > 1 else math.nan)} | "
+                     f"{fmt(float(np.median(ticks)) if ticks else math.nan, 0)} |")  # fmt: skip
     usable = [g for g in groups.values() if len(g) > 1]
     f = f_oneway(*usable) if len(usable) > 1 else None
     spa = [g for (c, _), g in groups.items() if c == "dft" and len(g) > 1]
     f_spa = f_oneway(*spa) if len(spa) == 2 else None
     head = ("| condition | reached | L_p / L_o (mean ± sd, reached runs) | median ticks to goal |\n"
             "|---|---|---|---|\n")  # fmt: skip
-    tail = (f"\nOne-way ANOVA of L_p / L_o over the five conditions: F = {_fmt(f.statistic if f else math.nan, 2)}, "
-            f"p = {_fmt(f.pvalue if f else math.nan, 3)}; paper F = {PAPER_F[name]} (no significant difference).  "
-            f"SPA low against high noise alone: F = {_fmt(f_spa.statistic if f_spa else math.nan, 2)}, "
-            f"p = {_fmt(f_spa.pvalue if f_spa else math.nan, 3)}.\n"
+    tail = (f"\nOne-way ANOVA of L_p / L_o over the five conditions: F = {fmt(f.statistic if f else math.nan, 2)}, "
+            f"p = {fmt(f.pvalue if f else math.nan, 3)}; paper F = {PAPER_F[name]} (no significant difference).  "
+            f"SPA low against high noise alone: F = {fmt(f_spa.statistic if f_spa else math.nan, 2)}, "
+            f"p = {fmt(f_spa.pvalue if f_spa else math.nan, 3)}.\n"
             "\nThe paper shows successes and L_p / L_o as bar charts (Figures 7 and 8), which we do not have; its "
             "text says SPA succeeds in most runs, is robust to noise, and that FTC succeeds notably less often "
             "than SPA in the large maze.\n")  # fmt: skip
@@ -106,7 +105,7 @@ def summarise_pairs(rows: list[dict]) -> tuple[list[dict], str]:
 
 
 def plot_pairs(rows: list[dict], path: Path) -> None:
-    plt = _pyplot()
+    plt = pyplot()
     labels = [label(c, n) for c, n in CONDITIONS]
     sel = [[r for r in rows if r["controller"] == c and r["noise"] == n] for c, n in CONDITIONS]
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
@@ -115,7 +114,7 @@ def plot_pairs(rows: list[dict], path: Path) -> None:
     ratios = [[r["path_ratio"] for r in s if r["path_ratio"] not in (None, "")] or [math.nan] for s in sel]
     axes[1].boxplot(ratios, tick_labels=labels)
     axes[1].set(title="L_p / L_o, reached runs (Figure 8)")
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # -------------------------------------------------------------------- case 3
@@ -205,7 +204,7 @@ def summarise_case3(rows: list[dict]) -> tuple[list[dict], str]:
                          f"{counts['north-then-south']} | {counts['south-then-north'] + counts['neither']} | "
                          f"{summary[-1]['south_share_appear_lt_200']:.2f} | "
                          f"{summary[-1]['north_share_appear_gt_500']:.2f} | "
-                         f"{_fmt(summary[-1]['replanning_stall_median'] or math.nan, 0)} |")  # fmt: skip
+                         f"{fmt(summary[-1]['replanning_stall_median'] or math.nan, 0)} |")  # fmt: skip
     head = ("| obstacle | noise | runs | reached | north (green) | south (blue) | north then south (red) | other | "
             "south when t_i < 200 | north when t_i > 500 | median stalled ticks when switching |\n"
             "|---|---|---|---|---|---|---|---|---|---|---|\n")  # fmt: skip
@@ -220,7 +219,7 @@ def summarise_case3(rows: list[dict]) -> tuple[list[dict], str]:
 
 def _case3_panels(rows: list[dict], side: float):
     """One panel per (noise, obstacle type) of the rows: (pyplot, figure, [(axes, noise, kind), ...])."""
-    plt = _pyplot()
+    plt = pyplot()
     kinds = list(CASE3_BOXES)
     noises = list(dict.fromkeys(r["noise"] for r in rows))
     fig, axes = plt.subplots(len(noises), len(kinds), figsize=(5 * len(kinds), side * len(noises)), squeeze=False)
@@ -245,7 +244,7 @@ def plot_case3_paths(rows: list[dict], path: Path) -> None:
         ax.plot(*CASE3_START[:2], "ko", ms=4)
         ax.plot(*CASE3_GOAL, "kx", ms=7)
         ax.set(title=f"{kind} obstacle, {noise} noise (Figure 13)", xlim=(0, 1), ylim=(0, 1), aspect="equal")
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def _scatter_routes(ax, rows: list[dict], title: str) -> None:
@@ -263,7 +262,7 @@ def plot_case3(rows: list[dict], path: Path) -> None:
     for ax, noise, kind in panels:
         sel = [r for r in rows if r["obstacle"] == kind and r["noise"] == noise]
         _scatter_routes(ax, sel, f"{kind} obstacle, {noise} noise (Figures 15, 16)")
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # ------------------------------------------------------- the swarm (item 4)
@@ -350,7 +349,7 @@ def summarise_together(rows: list[dict]) -> tuple[list[dict], str]:
         other = len(sel) - counts["north"] - counts["south"] - counts["north-then-south"]
         lines.append(f"| {c} | {len(sel)} | {summary[-1]['reached']} | {counts['north']} | {counts['south']} | "
                      f"{counts['north-then-south']} | {other} | "
-                     f"{_fmt(summary[-1]['ticks_to_goal_median'] or math.nan, 0)} |")  # fmt: skip
+                     f"{fmt(summary[-1]['ticks_to_goal_median'] or math.nan, 0)} |")  # fmt: skip
     by = {(r["condition"], r["run"]): r for r in rows}
     runs = sorted({r["run"] for r in rows})
     both = [(by[("alone-sensed", k)], by[("scout-sensed", k)]) for k in runs
@@ -365,7 +364,7 @@ def summarise_together(rows: list[dict]) -> tuple[list[dict], str]:
     )
     head = ("| condition | runs | robot 0 reached | north | south | north then south | other | median ticks to goal |\n"
             "|---|---|---|---|---|---|---|---|\n")  # fmt: skip
-    med, q1, q3 = (_fmt(float(np.percentile(earlier, q)) if earlier else math.nan, 0) for q in (50, 25, 75))
+    med, q1, q3 = (fmt(float(np.percentile(earlier, q)) if earlier else math.nan, 0) for q in (50, 25, 75))
     tail = (
         f"\nWith the scout sharing what it sensed, robot 0 gave the north route up (replanned) in {south_scout} "
         f"of {len(both)} runs, against {south_alone} alone with its own sensors; it replanned sooner than "
@@ -386,11 +385,11 @@ def summarise_together(rows: list[dict]) -> tuple[list[dict], str]:
 
 
 def plot_together(rows: list[dict], path: Path) -> None:
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(1, len(TOGETHER), figsize=(5 * len(TOGETHER), 4), squeeze=False)
     for ax, c in zip(axes[0], TOGETHER, strict=True):
         _scatter_routes(ax, [r for r in rows if r["condition"] == c], f"robot 0, {c}")
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
@@ -399,24 +398,24 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
     expected = CASE_SCENARIO[case]
     if scenario not in (None, expected):
         raise ScenarioError("command line", "--scenario", f"{case} runs on {expected} (the paper's)")
-    out = Path(out) if out is not None else Path("results") / case
-    out.mkdir(parents=True, exist_ok=True)
+    out = Outputs(out, case)
     if case == "dft-together":
         reps = 60 if reps is None else reps
-        rows = pool_map(together_jobs(reps, seed, noise or "low", max_ticks), run_together, jobs, case, progress)
+        work = together_jobs(reps, seed, noise or "low", max_ticks)
+        rows = batch_run(run_together, work, jobs=jobs, desc=case, progress=progress)
         rows.sort(key=lambda r: (TOGETHER.index(r["condition"]), r["run"]))
+        out.runs(rows, TOGETHER_FIELDS)
         summary, md = summarise_together(rows)
-        write_runs(out, "runs.csv", TOGETHER_FIELDS, rows, summary)
         plot_together(rows, out / "plot.png")
         title = (f"# The swarm: a scout shares the obstacle it meets (case 3, full box)\n\n{reps} draws of t_i, t_p; "
                  f"noise {noise or 'low'}; seed {seed}.\n\n")  # fmt: skip
     elif case == "dft-case3":
         reps = 240 if reps is None else reps
         noises = (noise,) if noise else ("low", "high")
-        rows = pool_map(case3_jobs(reps, seed, noises, max_ticks), run_case3, jobs, case, progress)
+        rows = batch_run(run_case3, case3_jobs(reps, seed, noises, max_ticks), jobs=jobs, desc=case, progress=progress)
         rows.sort(key=lambda r: (r["obstacle"], r["noise"], r["run"]))
+        out.runs(rows, CASE3_FIELDS)
         summary, md = summarise_case3(rows)
-        write_runs(out, "runs.csv", CASE3_FIELDS, rows, summary)
         plot_case3(rows, out / "plot.png")
         plot_case3_paths(rows, out / "paths.png")
         np.savez_compressed(out / "paths.npz", **{f"{r['obstacle']}_{r['noise']}_{r['run']}": r["path"] for r in rows})
@@ -432,16 +431,14 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
         work = pair_jobs(case, reps, seed, max_ticks)
         if noise:
             work = [j for j in work if j[1] == noise]
-        rows = pool_map(work, run_pair, jobs, case, progress)
+        rows = batch_run(run_pair, work, jobs=jobs, desc=case, progress=progress)
         order = [label(c, n) for c, n in CONDITIONS]
         rows.sort(key=lambda r: (order.index(label(r["controller"], r["noise"])), r["pair"]))
+        out.runs(rows, RUN_FIELDS)
         summary, md = summarise_pairs(rows)
-        write_runs(out, "runs.csv", RUN_FIELDS, rows, summary)
         plot_pairs(rows, out / "plot.png")
         number = case[-1]
         title = (f"# Case {number} (Billing et al. 2015): SPA beside follow the carrot in {expected}\n\n{reps} "
                  f"start/goal pairs per condition; seed {seed}; at most {max_ticks or 3000} steps of 64 ms; a run "
                  f"succeeds when the robot dwelt 40 steps within 7 cm of its goal or ends there.\n\n")  # fmt: skip
-    text = title + md
-    (out / "table.md").write_text(text)
-    return {"name": case, "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
+    return out.finish(summary, title + md)

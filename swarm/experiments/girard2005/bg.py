@@ -37,7 +37,8 @@ from typing import Any
 import numpy as np
 
 from swarm.core.errors import ScenarioError
-from swarm.experiments.billing2015.carrot import pool_map, write_runs
+from swarm.core.plots import pyplot, save_figure
+from swarm.experiments.runner import Outputs, batch_run
 from swarm.scenario import load_scenario
 
 EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze")
@@ -327,9 +328,7 @@ def direct_seconds(name: str, stops: tuple[str, ...] = ("Ep2", "Ep1")) -> float:
 
 
 def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) -> None:
-    from swarm.experiments.simonin2007.tables import _pyplot, _save
-
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     if experiment == "bg-survival":
         for k, cond in enumerate(("A", "B")):
@@ -358,7 +357,7 @@ def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) ->
         ax.set_ylabel("tests (bars ours, black ticks the paper;\nhatched: the control)")
         ax.legend()
     ax.set_title(experiment)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # ------------------------------------------------------------------ entry
@@ -395,12 +394,12 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
     mapping = MAPPING.get(experiment, "hungry") if mapping is None else mapping
     if mapping not in MAPPING_MODES:
         raise ScenarioError("command line", "--mapping", f"one of {', '.join(MAPPING_MODES)}, not {mapping!r}")
-    out = Path(out) if out is not None else Path("results") / experiment
-    out.mkdir(parents=True, exist_ok=True)
+    out = Outputs(out, experiment)
     if experiment == "bg-survival":
         work = [(c, k, seed + k, changes) for c in ("A", "B") for k in range(reps)]
-        rows = pool_map(work, run_survival, jobs, experiment, progress)
+        rows = batch_run(run_survival, work, jobs=jobs, desc=experiment, progress=progress)
         rows.sort(key=lambda r: (r["condition"], r["run"]))
+        out.runs(rows, list(rows[0]))
         summary, md = _survival_summary(rows)
         title = (
             f"# Experiment 1 (Girard et al. 2005): survival with and without the map\n\n{reps} runs per "
@@ -410,16 +409,15 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
         made = _maps(experiment, maps, seed, ratios, jobs, progress, changes, mapping)
         (out / "maps.json").write_text(json.dumps(made))
         work = _tests(experiment, reps, seed, made, changes, mapping)
-        rows = pool_map(work, run_test, jobs, experiment, progress)
+        rows = batch_run(run_test, work, jobs=jobs, desc=experiment, progress=progress)
         rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
+        out.runs(rows, list(rows[0]))
         summary, md, title = _test_summary(experiment, rows, reps, seed, made, mapping)
-    write_runs(out, "runs.csv", list(rows[0]), rows, summary)
-    _plot(experiment, rows, summary, out / "plot.png")
     if changes:
         title += f"[bg] changed in every run: {json.dumps(changes)}.\n\n"
-    text = title + md
-    (out / "table.md").write_text(text)
-    return {"name": experiment, "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
+    result = out.finish(summary, title + md)
+    _plot(experiment, rows, summary, out / "plot.png")
+    return result
 
 
 def _mapped(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
@@ -441,8 +439,8 @@ def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None, prog
     """`count` maps per scenario, map k from a mapping run with seed + k (in parallel)."""
     mapped = _mapped(experiment, ratios)
     work = [(name, k, seed + k, absent, changes or {}, mode) for name, absent in mapped.items() for k in range(count)]
-    made = {(m["scenario"], m["index"]): m["data"]
-            for m in pool_map(work, _build_map_job, jobs, f"{experiment} mapping", progress)}  # fmt: skip
+    rows = batch_run(_build_map_job, work, jobs=jobs, desc=f"{experiment} mapping", progress=progress)
+    made = {(m["scenario"], m["index"]): m["data"] for m in rows}
     return {name: [made[name, k] for k in range(count)] for name in mapped}
 
 

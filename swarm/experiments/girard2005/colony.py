@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from swarm.core.errors import ScenarioError
-from swarm.experiments.billing2015.carrot import pool_map, write_runs
+from swarm.core.plots import pyplot, save_figure
+from swarm.experiments.runner import Outputs, batch_run
 from swarm.scenario import load_scenario
 
 SIZES = (1, 2, 4, 8)
@@ -108,9 +109,7 @@ def _summary(rows: list[dict]) -> tuple[list[dict], str]:
 
 
 def _plot(rows: list[dict], path: Path) -> None:
-    from swarm.experiments.simonin2007.tables import _pyplot, _save
-
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     sizes = sorted({r["size"] for r in rows})
     for share, marker, offset in ((False, "o", -0.08), (True, "s", 0.08)):
@@ -125,7 +124,7 @@ def _plot(rows: list[dict], path: Path) -> None:
     ax.set_xticks(range(len(sizes)), [str(s) for s in sizes])
     ax.set(xlabel="animats in the colony", ylabel="colony mean survival (h)", title="bg-colony (4 h cap)")
     ax.legend()
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def run_colony_experiment(name: str, sizes: tuple[int, ...] | None, reps: int | None, jobs: int | None, seed: int,
@@ -135,17 +134,16 @@ def run_colony_experiment(name: str, sizes: tuple[int, ...] | None, reps: int | 
     reps = REPS if reps is None else reps
     for size in sizes:
         colony_scenario(size, False, seed)  # one clear line for a size the nest cannot hold
-    out = Path(out) if out is not None else Path("results") / "bg-colony"
-    out.mkdir(parents=True, exist_ok=True)
+    out = Outputs(out, "bg-colony")
     work = [(n, share, k, seed + k, max_ticks) for n in sorted(sizes, reverse=True)
             for share in ((False,) if n == 1 else (False, True)) for k in range(reps)]  # fmt: skip
-    rows = pool_map(work, run_colony, jobs, "bg-colony", progress)
+    rows = batch_run(run_colony, work, jobs=jobs, desc="bg-colony", progress=progress)
     rows.sort(key=lambda r: (r["size"], r["share"], r["run"]))
+    out.runs(rows, list(rows[0]))
     summary, md = _summary(rows)
-    write_runs(out, "runs.csv", list(rows[0]), rows, summary)
-    _plot(rows, out / "plot.png")
     text = (f"# A colony of BG animats: survival against colony size, with and without a shared map\n\n{reps} runs "
             f"per size and condition, at most 4 h; seeds {seed}..{seed + reps - 1}; bg-colony (bg-exp1's floor, a "
             f"nest in the east passage).\n\n" + md)  # fmt: skip
-    (out / "table.md").write_text(text)
-    return {"name": "bg-colony", "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
+    result = out.finish(summary, text)
+    _plot(rows, out / "plot.png")
+    return result

@@ -8,8 +8,6 @@ beside ours, with the ratio) and plot.png.
 
 from __future__ import annotations
 
-import csv
-import multiprocessing as mp
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -17,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from swarm.core.plots import pyplot, save_figure
+from swarm.experiments.runner import Outputs, batch_run, cross
 from swarm.experiments.simonin2007 import paper
 
 RUN_FIELDS = ["experiment", "scenario", "size", "agents", "controller", "physics", "seed", "iterations", "finished",
@@ -124,7 +124,7 @@ def _table1_report(rows):
 
 
 def _table1_plot(rows, path):
-    plt = _pyplot()
+    plt = pyplot()
     ns = list(paper.TABLE1)
     ours = [_stats(rows, agents=n) for n in ns]
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -134,7 +134,7 @@ def _table1_plot(rows, path):
     ax.set(xscale="log", yscale="log", xlabel="agents", ylabel="iterations to forage",
            title="Setup 1: 40x40, 30% obstacles, 20 resources")  # fmt: skip
     ax.legend()
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # --------------------------------------------------------------------- table 2
@@ -165,7 +165,7 @@ def _table2_report(rows):
 
 
 def _table2_plot(rows, path):
-    plt = _pyplot()
+    plt = pyplot()
     ns = list(paper.TABLE2)
     ours = [_stats(rows, agents=n)[0] for n in ns]
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -175,7 +175,7 @@ def _table2_plot(rows, path):
     ax.plot(ns, [paper.TABLE2[1] / n for n in ns], ":", label="paper: projected")
     ax.set(xlabel="agents", ylabel="iterations to forage", title="Setup 2: 20x20, 5%, 2 resources")
     ax.legend()
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # --------------------------------------------------------------------- table 3
@@ -205,7 +205,7 @@ def _table3_report(rows):
 
 
 def _table3_plot(rows, path):
-    plt = _pyplot()
+    plt = pyplot()
     sizes = list(paper.TABLE3)
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(sizes, [_stats(rows, size=s)[0] for s in sizes], "o-", label="swarm")
@@ -213,7 +213,7 @@ def _table3_plot(rows, path):
     ax.set(xscale="log", yscale="log", xlabel="side of the square environment",
            ylabel="iterations to forage", title="Setup 3: 50 agents, 5%, 20 resources x 2000")  # fmt: skip
     ax.legend()
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # ------------------------------------------------------------------------ ants
@@ -244,14 +244,14 @@ def _ants_report(rows):
 
 
 def _ants_plot(rows, path):
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     for c in ("cmarking", "ant"):
         ax.plot(ANT_SIZES, [_stats(rows, size=s, controller=c)[0] for s in ANT_SIZES], "o-", label=c)
     ax.set(xscale="log", yscale="log", xlabel="side of the square environment",
            ylabel="iterations to forage", title="c-marking vs ants (setup 3, 50 agents)")  # fmt: skip
     ax.legend()
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # ------------------------------------------------------------------ congestion
@@ -290,7 +290,7 @@ def _congestion_report(rows):
 
 
 def _congestion_plot(rows, path):
-    plt = _pyplot()
+    plt = pyplot()
     ns = list(CONGESTION_AGENTS)
     fig, ax = plt.subplots(figsize=(6, 4))
     for physics, marker in (("ideal", "o-"), ("physical", "^-")):
@@ -300,27 +300,10 @@ def _congestion_plot(rows, path):
     ax.set(xscale="log", yscale="log", xlabel="agents", ylabel="iterations to forage",
            title="Setup 1: what robot bodies cost")  # fmt: skip
     ax.legend()
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # ------------------------------------------------------------------ machinery
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save(fig, path: Path) -> None:
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
 
 
 EXPERIMENTS: dict[str, Experiment] = {
@@ -341,8 +324,7 @@ def plan(name: str, reps: int, seed: int) -> list[RunSpec]:
     exp = EXPERIMENTS[name]
     specs = [
         RunSpec(name, c.scenario, c.size, c.agents, c.controller, c.physics, seed + rep, exp.max_iterations)
-        for c in exp.configs()
-        for rep in range(reps)
+        for c, rep in cross(exp.configs(), range(reps))
     ]
     return sorted(specs, key=_expected_work, reverse=True)
 
@@ -366,24 +348,19 @@ def run_experiment(
     if reps < 1:
         raise ValueError("--reps must be at least 1")
     jobs = jobs or os.cpu_count() or 1
-    out = Path(out) if out is not None else Path("results") / name
-    out.mkdir(parents=True, exist_ok=True)
+    out = Outputs(out, name)
     specs = plan(name, reps, seed)
-    rows = _execute(specs, jobs, progress, exp.title)
+    physics = sorted({s.physics for s in specs})
+    # many short runs go in chunks (less messaging); a few long ones one by one (a live progress bar)
+    rows = batch_run(run_one, specs, jobs=jobs, desc=exp.title.split(":")[0], progress=progress, warm_up=warm_up,
+                     warm_args=(physics,), chunksize=max(1, min(16, len(specs) // (jobs * 100))))  # fmt: skip
     rows.sort(key=lambda r: (r["size"], r["agents"], r["controller"], r["physics"], r["seed"]))
-    with open(out / "runs.csv", "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=RUN_FIELDS)
-        writer.writeheader()
-        writer.writerows(rows)
+    out.runs(rows, RUN_FIELDS)
     summary, md = exp.report(rows)
-    with open(out / "summary.csv", "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(summary[0]))
-        writer.writeheader()
-        writer.writerows(summary)
     text = f"# {exp.title}\n\n{reps} runs per configuration, seeds {seed}..{seed + reps - 1}.\n\n{md}\n"
-    (out / "table.md").write_text(text)
+    result = out.finish(summary, text)
     exp.plot(rows, out / "plot.png")
-    return {"name": name, "out": str(out), "runs": len(rows), "summary": summary, "markdown": text}
+    return result
 
 
 def warm_up(physics: list[str]) -> None:
@@ -394,27 +371,3 @@ def warm_up(physics: list[str]) -> None:
 
     for mode in physics:
         Engine(load_scenario("setup2").with_overrides(agents=2, physics=mode)).step(2)
-
-
-def _execute(specs: list[RunSpec], jobs: int, progress: bool, title: str) -> list[dict]:
-    from tqdm import tqdm
-
-    physics = sorted({s.physics for s in specs})
-    warm_up(physics)  # compiles into the cache once, before the workers load it
-    bar = tqdm(total=len(specs), desc=title.split(":")[0], unit="run", disable=not progress)
-    rows: list[dict] = []
-    try:
-        if jobs == 1:
-            for spec in specs:
-                rows.append(run_one(spec))
-                bar.update()
-        else:
-            with mp.get_context("spawn").Pool(jobs, initializer=warm_up, initargs=(physics,)) as pool:
-                # many short runs go in chunks (less messaging); a few long ones one by one (a live progress bar)
-                chunk = max(1, min(16, len(specs) // (jobs * 100)))
-                for row in pool.imap_unordered(run_one, specs, chunksize=chunk):
-                    rows.append(row)
-                    bar.update()
-    finally:
-        bar.close()
-    return rows

@@ -31,10 +31,7 @@ mapping fingerprint (off the mapped floor) are left out of the shares
 
 from __future__ import annotations
 
-import csv
 import math
-import multiprocessing as mp
-import os
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -42,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from swarm.core.errors import ScenarioError
+from swarm.experiments.runner import Outputs, batch_run
 
 NOISES = ("low", "high")
 THETAS = (0.2, 0.35, 0.5, 0.65, 0.8)
@@ -274,31 +272,6 @@ def fit_logistic(d: np.ndarray, same: np.ndarray) -> tuple[float, float]:
 # --------------------------------------------------------------- reports
 
 
-def _pool(fn, work: list, jobs: int | None, desc: str, progress: bool) -> list[dict]:
-    from tqdm import tqdm
-
-    rows = []
-    bar = tqdm(total=len(work), desc=desc, unit="run", disable=not progress)
-    if len(work) == 1 or jobs == 1:
-        for job in work:
-            rows.append(fn(job))
-            bar.update()
-    else:
-        with mp.get_context("spawn").Pool(min(jobs or os.cpu_count() or 1, len(work))) as pool:
-            for row in pool.imap_unordered(fn, work):
-                rows.append(row)
-                bar.update()
-    bar.close()
-    return rows
-
-
-def _write_csv(path: Path, rows: list[dict]) -> None:
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-
-
 def _mean(rows: list[dict], key: str) -> float:
     return float(np.mean([r[key] for r in rows])) if rows else math.nan
 
@@ -307,37 +280,34 @@ def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | Non
                                out: Path | None, progress: bool = True) -> dict:  # fmt: skip
     name = scenario or "office"
     reps = reps or 3
-    out = Path(out) if out is not None else Path("results") / which
-    out.mkdir(parents=True, exist_ok=True)
+    out = Outputs(out, which)
     if which == "fingerprint-calibrate":
         return _calibrate(name, seed, out)
     if which == "fingerprint-map":
         work = [(name, noise, seed + r, theta, "mapping") for noise in NOISES for r in range(reps) for theta in THETAS]
         work += [(name, noise, seed + r, 0.5, route) for route in LOCALIZE_TOURS for noise in NOISES
                  for r in range(reps)]  # loops  # fmt: skip
-        rows = _pool(map_job, work, jobs, which, progress)
+        rows = batch_run(map_job, work, jobs=jobs, desc=which, progress=progress)
         rows.sort(key=lambda r: (("mapping", *LOCALIZE_TOURS).index(r["route"]), NOISES.index(r["noise"]), r["theta"],
                                  r["seed"]))  # fmt: skip
         md = _map_table(rows, name, reps, seed)
         plot_map(rows, name, seed, out / "plot.png")
     elif which == "fingerprint-localize":
         work = [(name, noise, seed + r, route) for route in LOCALIZE_TOURS for noise in NOISES for r in range(reps)]
-        rows = _pool(localize_job, work, jobs, which, progress)
+        rows = batch_run(localize_job, work, jobs=jobs, desc=which, progress=progress)
         rows.sort(key=lambda r: (LOCALIZE_TOURS.index(r["route"]), NOISES.index(r["noise"]), r["seed"]))
         md = _localize_table(rows, name, reps, seed)
         plot_localize(rows, out / "plot.png")
     else:
         raise ValueError(f"unknown fingerprint experiment {which!r}")
-    _write_csv(out / "runs.csv", rows)
-    (out / "table.md").write_text(md)
+    out.runs(rows)
     tours = ("mapping",) if which == "fingerprint-map" else LOCALIZE_TOURS
     summary = [{"route": t, "noise": n,
                 **{k: round(_mean([r for r in rows if r["noise"] == n and r["route"] == t and
                                    (which != "fingerprint-map" or r["theta"] == 0.5)], k), 4)
                    for k in rows[0] if isinstance(rows[0][k], (int, float)) and k != "seed"}}
                for t in tours for n in NOISES]  # fmt: skip
-    _write_csv(out / "summary.csv", summary)
-    return {"name": which, "out": str(out), "runs": len(rows), "rows": rows, "summary": summary, "markdown": md}
+    return out.finish(summary, md)
 
 
 def _revisits(rows: list[dict]) -> str:
@@ -414,7 +384,7 @@ def _localize_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _calibrate(name: str, seed: int, out: Path) -> dict:
+def _calibrate(name: str, seed: int, out: Outputs) -> dict:
     rows, fits = [], []
     for noise in NOISES:
         d, same = calibration_pairs(name, noise, seed)
@@ -424,7 +394,7 @@ def _calibrate(name: str, seed: int, out: Path) -> dict:
                      "same_pairs": int(same.sum()), "different_pairs": int((~same).sum()),
                      "same_d_median": round(float(np.median(d[same])), 4),
                      "different_d_median": round(float(np.median(d[~same])), 4)})  # fmt: skip
-    _write_csv(out / "runs.csv", rows)
+    out.runs(rows)
     md = ["# Calibrating P(match) on `" + name + "` (mapping tour, every pair of fingerprints)\n",
           "| noise | centre | width | same-place pairs | different-place pairs | median d, same | "
           "median d, different |",
@@ -435,9 +405,7 @@ def _calibrate(name: str, seed: int, out: Path) -> dict:
         "\nd: alignment cost per character of the longer fingerprint.  "
         "P(match) = 1 / (1 + exp((d - centre) / width)), fitted by weighted logistic regression."
     )
-    text = "\n".join(md) + "\n"
-    (out / "table.md").write_text(text)
-    return {"name": "fingerprint-calibrate", "out": str(out), "runs": len(rows), "rows": rows, "markdown": text}
+    return out.finish(None, "\n".join(md) + "\n")
 
 
 def plot_map(rows: list[dict], name: str, seed: int, path: Path) -> None:

@@ -23,7 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from swarm.experiments.tapus2006.fingerprint import _pool, _write_csv, place_of, places
+from swarm.experiments.runner import Outputs, batch_run
+from swarm.experiments.tapus2006.fingerprint import place_of, places
 
 TEAMS = (1, 2, 4, 8)
 FLOOR = 32.0
@@ -128,16 +129,14 @@ def run_team_experiment(name: str, reps: int | None, jobs: int | None, seed: int
                         progress: bool = True, teams: tuple[int, ...] = TEAMS) -> dict:  # fmt: skip
     """`name`: "fingerprint-together", the one experiment this runs (the registry calls every experiment by name)."""
     reps = reps or 1
-    out = Path(out) if out is not None else Path("results") / "fingerprint-together"
-    out.mkdir(parents=True, exist_ok=True)
+    out = Outputs(out, "fingerprint-together")
     work = [(n, "low", seed + r) for n in sorted(teams, reverse=True) for r in range(reps)]
-    rows = _pool(team_job, work, jobs, "fingerprint-together", progress)
+    rows = batch_run(team_job, work, jobs=jobs, desc="fingerprint-together", progress=progress)
     rows.sort(key=lambda r: (r["robots"], r["seed"]))
-    _write_csv(out / "runs.csv", rows)
-    md = _table(rows, reps, seed)
-    (out / "table.md").write_text(md)
+    out.runs(rows)
+    result = out.finish(None, _table(rows, reps, seed))
     plot(rows, out / "plot.png")
-    return {"name": "fingerprint-together", "out": str(out), "runs": len(rows), "rows": rows, "markdown": md}
+    return result
 
 
 def _mean(sel: list[dict], key: str) -> float:
