@@ -22,7 +22,8 @@ sys.path.insert(0, str(ROOT / "tests"))
 GENERIC = ("world_server/server.py", "world_server/grid/server.py", "world_server/arena/server.py",
            "agents/runtime.py", "agents/grid_runtime.py", "agents/arena_runtime.py", "agents/runtimes.py",
            "swarm/world_process.py", "swarm/engines", "swarm/launcher.py", "swarm/monitor.py", "swarm/recording",
-           "swarm/review", "swarm/cli.py", "swarm/cli_arena.py", "swarm/scenario.py")  # fmt: skip
+           "swarm/review", "swarm/cli.py", "swarm/cli_arena.py", "swarm/cli_reproduce.py",
+           "swarm/scenario.py")  # fmt: skip
 LONG = 60
 
 

@@ -18,6 +18,7 @@ from swarm.cli_arena import (
     print_arena_summary,
     run_arena,
 )
+from swarm.cli_reproduce import add_reproduce_parser, cmd_reproduce
 from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_interrupt
 from swarm.core.registry import Option, Registry, resolve
 from swarm.core.tables import positive, seed
@@ -59,6 +60,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     _add_run(sub)
     _add_experiment(sub)
+    add_reproduce_parser(sub)
     _add_bench(sub)
     _add_world(sub)
     _add_agent(sub)
@@ -608,7 +610,7 @@ def cmd_scenarios(args) -> int:
 COMMANDS = {"run": cmd_run, "experiment": cmd_experiment, "bench": cmd_bench, "scenarios": cmd_scenarios,
             "world": cmd_world, "agent": cmd_agent, "up": cmd_up, "replay": cmd_replay,
             "report": cmd_report, "monitor": cmd_monitor, "status": cmd_status, "router": cmd_router,
-            "prepare": cmd_prepare, "sense": cmd_sense}  # fmt: skip
+            "prepare": cmd_prepare, "sense": cmd_sense, "reproduce": cmd_reproduce}  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -37,6 +37,7 @@ LAYERS = {  # module prefix -> layer (the longest prefix wins)
     "swarm.bench": 4,
     "swarm.cli": 4,
     "swarm.cli_arena": 4,
+    "swarm.cli_reproduce": 4,
     "swarm.__main__": 4,
 }
 NAMES = ("core", "worlds", "agents", "runners", "top")

@@ -32,7 +32,9 @@ from swarm.experiments.stats import (
     mean_ci,
     median_ci,
     proportion_ci,
+    ratio_of_means,
     restricted_mean,
+    spearman,
     wilcoxon_paired,
 )
 
@@ -124,3 +126,17 @@ def test_the_claims_table_prints_the_paper_beside_ours_with_the_verdict():
     md = claims_table([Claim("more agents forage faster", "73%", "80% [70%, 88%]", t), Claim("a count", "12", "11")])
     assert "| more agents forage faster | 73% | 80% [70%, 88%] | 20 | McNemar (exact) | < 0.001 | +0.5" in md
     assert md.rstrip().endswith("| a count | 12 | 11 |  | – |  |  | – |")
+
+
+def test_ratio_of_means_tests_against_its_null_and_pairs_when_told():
+    rng = np.random.default_rng(1)
+    b = rng.uniform(90, 110, 60)
+    est, t = ratio_of_means(b * 0.5 + rng.normal(0, 1, 60), b, paired=True, null=0.5)
+    assert est.low < 0.5 < est.high and t.p > 0.05
+    est, t = ratio_of_means(b * 0.4, b, paired=True, null=0.5)
+    assert est.value == pytest.approx(0.4) and t.p < 0.001 and t.effect == pytest.approx(-0.1)
+
+
+def test_spearman_sees_a_falling_trend():
+    t = spearman([12, 25, 50, 100] * 5, [0.9, 0.7, 0.5, 0.3] * 5)
+    assert t.effect == pytest.approx(-1.0) and t.p < 0.001

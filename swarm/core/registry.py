@@ -118,6 +118,19 @@ class BenchmarkSpec:
     options: tuple[Option, ...] = ()
 
 
+@dataclass(frozen=True)
+class PaperSpec:
+    """One paper we reproduce: `reproduce` ("module:function") is called as
+    reproduce(quick=, jobs=, out=, progress=); it runs the paper's experiments on the confirmation
+    seeds and writes one report (report.md, its plots and CSVs) into `out`, the results part of the
+    model's page `page`; it returns {"markdown", "out", "claims", "verdicts"}."""
+
+    name: str  # the folder: simonin2007, billing2015, tapus2006, girard2005
+    title: str
+    reproduce: str
+    page: str
+
+
 class Entry(Protocol):
     name: str
 

@@ -31,11 +31,19 @@ class Estimate:
     what: str = "mean"
 
     def text(self, digits: int = 3) -> str:
+        """'value [low, high]' to `digits` significant digits (whole numbers in full from 10**digits up)."""
         if math.isnan(self.value):
             return "n/a"
         if math.isnan(self.low):
-            return f"{self.value:.{digits}g}"
-        return f"{self.value:.{digits}g} [{self.low:.{digits}g}, {self.high:.{digits}g}]"
+            return number(self.value, digits)
+        return f"{number(self.value, digits)} [{number(self.low, digits)}, {number(self.high, digits)}]"
+
+
+def number(x: float, digits: int = 3) -> str:
+    """x to `digits` significant digits, or as a whole number with thousands separated once it has more."""
+    if math.isnan(x):
+        return "n/a"
+    return f"{x:,.0f}" if abs(x) >= 10**digits else f"{x:.{digits}g}"
 
 
 @dataclass(frozen=True)
@@ -215,3 +223,42 @@ def logrank(times_a: Sequence[float], finished_a: Sequence[bool], times_b: Seque
     effect = restricted_mean(times_a, finished_a, horizon) - restricted_mean(times_b, finished_b, horizon)
     return Comparison("log-rank", float(res.statistic), float(res.pvalue), effect, "difference of restricted means",
                 len(times_a) + len(times_b))  # fmt: skip
+
+
+def ratio_of_means(a: Sequence[float], b: Sequence[float], paired: bool, null: float = 1.0,
+                   seed: int = 0) -> tuple[Estimate, Comparison]:  # fmt: skip
+    """mean(a) / mean(b) with its bootstrap interval (pairs resampled together when `paired`: the same seeds
+    and maps), and a bootstrap test of ratio = `null`: p is twice the smaller tail of the resampled ratios
+    beyond `null`.  Effect: the ratio minus `null`."""
+    from scipy.stats import bootstrap
+
+    x, y = np.asarray(a, float), np.asarray(b, float)
+    value = float(x.mean() / y.mean()) if len(x) and len(y) else math.nan
+    if len(x) < 3 or len(y) < 3:
+        return (Estimate(value, math.nan, math.nan, len(x), "ratio of means"),
+                Comparison("bootstrap ratio", value, math.nan, value - null, "ratio minus null", len(x)))  # fmt: skip
+
+    def ratio(u, v, axis=-1):
+        return np.mean(u, axis=axis) / np.mean(v, axis=axis)
+
+    res = bootstrap((x, y), ratio, paired=paired, vectorized=True, confidence_level=CONFIDENCE,
+                    n_resamples=RESAMPLES, method="percentile", random_state=np.random.default_rng(seed))  # fmt: skip
+    dist = res.bootstrap_distribution
+    p = min(1.0, 2.0 * min(float(np.mean(dist <= null)), float(np.mean(dist >= null))))
+    low, high = res.confidence_interval
+    n = len(x) if paired else len(x) + len(y)
+    return (Estimate(value, float(low), float(high), n, "ratio of means"),
+            Comparison("bootstrap ratio", value, p, value - null, "ratio minus null", n))  # fmt: skip
+
+
+def spearman(x: Sequence[float], y: Sequence[float]) -> Comparison:
+    """A monotone trend of y with x: Spearman's rank correlation (the effect, from -1 to 1) and its p-value."""
+    from scipy.stats import spearmanr
+
+    u, v = np.asarray(x, float), np.asarray(y, float)
+    keep = np.isfinite(u) & np.isfinite(v)
+    if keep.sum() < 3:
+        return Comparison("Spearman", math.nan, math.nan, math.nan, "rho", int(keep.sum()))
+    res = spearmanr(u[keep], v[keep])
+    return Comparison("Spearman", float(res.statistic), float(res.pvalue), float(res.statistic), "rho",
+                      int(keep.sum()))  # fmt: skip

@@ -1,6 +1,6 @@
 """Simonin, Charpillet & Thierry (2007): c-marking foraging on the grid, its tables and studies."""
 
-from swarm.core.registry import ExperimentSpec
+from swarm.core.registry import ExperimentSpec, PaperSpec
 
 _RUN = "swarm.experiments.simonin2007.tables:run_experiment"
 EXPERIMENTS = (
@@ -9,4 +9,10 @@ EXPERIMENTS = (
     ExperimentSpec("table3", "simonin2007", "setup 3, 50 agents, sizes 12..200", _RUN),
     ExperimentSpec("ants", "simonin2007", "c-marking vs the ant model, setup 3 sizes", _RUN),
     ExperimentSpec("congestion", "simonin2007", "setup 1, ideal vs physical bodies, agents 10..160", _RUN),
+)
+PAPER = PaperSpec(
+    "simonin2007",
+    "Simonin, Charpillet & Thierry (2007): c-marking agents foraging",
+    "swarm.experiments.simonin2007.reproduce:reproduce",
+    "docs/cmarking.md",
 )

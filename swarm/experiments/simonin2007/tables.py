@@ -326,10 +326,10 @@ def plan(name: str, reps: int, seed: int) -> list[RunSpec]:
         RunSpec(name, c.scenario, c.size, c.agents, c.controller, c.physics, seed + rep, exp.max_iterations)
         for c, rep in cross(exp.configs(), range(reps))
     ]
-    return sorted(specs, key=_expected_work, reverse=True)
+    return sorted(specs, key=expected_work, reverse=True)
 
 
-def _expected_work(spec: RunSpec) -> float:
+def expected_work(spec: RunSpec) -> float:
     """Biggest work first, so the pool is not left waiting on one long run at the end."""
     work = spec.size**2 * (3 if spec.controller == "ant" else 1)
     if spec.physics == "physical":  # bodies cost per agent, and crowds jam

@@ -1,0 +1,57 @@
+"""`swarm reproduce`: every paper's report from its registry entry, on confirmation seeds only, every
+claim with n, a test and a verdict by the protocol's rule."""
+
+from __future__ import annotations
+
+import csv
+import re
+
+import pytest
+
+from swarm.core.registry import resolve
+from swarm.experiments import PAPERS
+from swarm.experiments.protocol import CONFIRMATION_SEEDS, NOT_REPRODUCED, REPRODUCED, REVERSED, SAME_DIRECTION
+
+VERDICTS = {REPRODUCED, SAME_DIRECTION, NOT_REPRODUCED, REVERSED, "–"}
+
+
+def test_every_paper_names_its_report_function_and_an_existing_page():
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    for spec in PAPERS:
+        assert callable(resolve(spec.reproduce)) and (root / spec.page).is_file(), spec
+
+
+@pytest.mark.timeout(600)
+@pytest.mark.parametrize("name", PAPERS.names())
+def test_a_quick_report_runs_on_confirmation_seeds_and_judges_every_claim(name, tmp_path, monkeypatch):
+    module = resolve(PAPERS[name].reproduce).__module__
+    import importlib
+
+    mod = importlib.import_module(module)
+    monkeypatch.setattr(mod, "QUICK_REPS", {k: 3 for k in mod.QUICK_REPS})
+    result = resolve(PAPERS[name].reproduce)(quick=True, jobs=2, out=tmp_path, progress=False)
+    report = (tmp_path / "report.md").read_text()
+    assert "Quick run" in report and result["claims"] > 0
+    with open(tmp_path / "runs.csv") as f:
+        seeds = {int(r["seed"]) for r in csv.DictReader(f)}
+    assert seeds and seeds <= set(CONFIRMATION_SEEDS)
+    with open(tmp_path / "summary.csv") as f:
+        claims = list(csv.DictReader(f))
+    assert len(claims) == result["claims"] and {c["verdict"] for c in claims} <= VERDICTS
+    assert sum(result["verdicts"].values()) == result["claims"]
+    assert re.search(r"\| claim \| paper \| ours \(95% CI\) \| n \| test \| p \| effect \| verdict \|", report)
+
+
+@pytest.mark.experiment
+@pytest.mark.timeout(900)
+def test_reproduce_all_quick_from_the_command_line(tmp_path):
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "swarm", "reproduce", "all", "--quick", "--out", str(tmp_path)],
+                          capture_output=True, text=True, timeout=900)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    for name in PAPERS.names():
+        assert (tmp_path / name / "report.md").is_file()
