@@ -132,7 +132,7 @@ def format_distributed_bench(result: dict) -> str:
 
 
 def _targets(result: dict) -> list[str]:
-    """Issue 12's targets, each met or not, as measured by this run."""
+    """The bench's targets, each met or not, as measured by this run."""
     said = []
     for r in result["runs"]:
         if r["agents"] == 100:
