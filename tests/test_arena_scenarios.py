@@ -58,8 +58,8 @@ def test_bg_exp1_resources_cannot_be_seen_from_each_others_vicinity():
 
 
 def test_bg_exp1_ep_sits_in_a_niche_seen_only_through_its_door():
-    """Ep's niche (stop 36) hides it from most of the south room: seen from the door's side, not from behind
-    the niche's north wall or from the room's middle north of it."""
+    """Ep's niche (docs/bg.md, Experiment 1) hides it from most of the south room: seen from the door's side, not
+    from behind the niche's north wall or from the room's middle north of it."""
     assert _sees(_animat_at("bg-exp1", 4.0, 1.4, math.pi), 127)  # looking west through the door
     for x, y in ((1.2, 3.2), (3.5, 3.2), (2.6, 3.8)):
         assert not _sees(_animat_at("bg-exp1", x, y, -math.pi / 2), 127), (x, y)

@@ -580,7 +580,7 @@ def test_the_plan_cache_key_and_the_selection_sum_are_numpys_to_the_bit():
 
 def test_with_learn_map_off_an_animat_localizes_on_a_loaded_map_and_leaves_it_as_it_is():
     """`learn_map = false`: the belief follows the animat's views over the loaded map, which gains no node or
-    link and whose nodes stay where they were (until stop 37 the belief froze after the first fix)."""
+    link and whose nodes stay where they were (the belief keeps moving after the first fix)."""
     from swarm.experiments.girard2005.bg import _with
 
     maker = ArenaEngine(load_scenario("bg-exp1").with_overrides(max_ticks=1200))
@@ -712,8 +712,8 @@ def test_a_choice_table_says_how_many_of_neither_died():
 
 def test_an_exploring_mapping_run_maps_half_an_hour_and_knows_both_ep_where_they_are():
     """bg-fear's mapping (MAPPING_MODES["explore"]): W_plan 0, at least 30 min.  At this seed the hungry
-    mapping animat knew only Ep2 (docs/bg.md, stop 40); the exploring one knows both, on nodes within 1.5 m
-    of each (positions by odometry from the start)."""
+    mapping animat knows only Ep2 (docs/bg.md, Maps for experiments 2 and 3); the exploring one knows both, on
+    nodes within 1.5 m of each (positions by odometry from the start)."""
     from swarm.experiments.girard2005.bg import MAPPING, build_map
     from swarm.scenario import load_scenario
 

@@ -377,7 +377,7 @@ class Navigator:
 
     def _first_metre(self, pred: np.ndarray, source: int) -> np.ndarray | None:
         """The route's link displacements summed over its first `lookahead` metres (None: no way to go).
-        Round a wall's end this cuts the corner (docs/bg.md, stop 32): see `_next_place`."""
+        Round a wall's end this cuts the corner (docs/bg.md, Experiment 1): see `_next_place`."""
         offset, node, travelled = np.zeros(2), self.map.current, 0.0
         while pred[node] != source and pred[node] >= 0 and travelled < self.p.lookahead:
             nxt = int(pred[node])
@@ -482,7 +482,7 @@ class Navigator:
                 raise ValueError("one resource weight per node expected")
             self.assoc = assoc
             self.xy, self.since = np.array(data["xy"], np.float64), np.array(data["since"], np.float64)
-            self.at = np.array(data.get("at", self.xy - self.since), np.float64)  # maps saved before stop 32 lack it
+            self.at = np.array(data.get("at", self.xy - self.since), np.float64)  # a map without it: xy - since
             self.D, self.created = float(data["D"]), int(data["created"])
             self.born, self.observations = [int(b) for b in data["born"]], int(data["observations"])
             self._known_key = ()

@@ -34,9 +34,8 @@ def _one(agents: int, ticks: int, per_process: int, null: bool, port: int) -> di
     """One run of `ticks` ticks, or fewer where setup 1 ends first.  It runs
     until foraged and converged ("both"): foraging alone ends setup 1 at
     seed 1 after 397 ticks with 100 agents, 260 with 200 and 174 with 1000,
-    so until stop 35 the real run was timed over fewer ticks than the floor
-    beside it, the first ticks' warm-up weighing more (1000 packed: p50 2.6
-    ms a tick, mean 3.0)."""
+    and a real run timed over fewer ticks than the floor beside it would
+    weigh the first ticks' warm-up more."""
     run_id = f"bench{new_run_id()}"  # fresh: never resume an earlier bench's saved state
     s = swarm_up("setup1", agents, "cmarking", 1, run_id, f"tcp/127.0.0.1:{port}", "both", ticks,
                  deadline=10.0, progress=False, per_process=per_process, null=null)  # fmt: skip
@@ -133,7 +132,7 @@ def format_distributed_bench(result: dict) -> str:
 
 
 def _targets(result: dict) -> list[str]:
-    """Issue 12's targets, each met or not, as measured by this run."""
+    """The bench's targets, each met or not, as measured by this run."""
     said = []
     for r in result["runs"]:
         if r["agents"] == 100:
