@@ -44,7 +44,7 @@ class ArenaAgentRuntime(AgentRuntime):
 
     def _restore(self, msg: arena_proto.ArenaMemory) -> None:
         """Each blob (a view of the message: world_server/arena/face/wire.py) is let go once decoded, before
-        any rollback state is taken: for a DFT robot each is MBs (issue 12's 80 MB)."""
+        any rollback state is taken: for a DFT robot each is MBs (an agent process's 80 MB budget)."""
         handed = msg.memory
         while handed:
             agent, blob = handed.pop()
@@ -72,7 +72,7 @@ class ArenaAgentRuntime(AgentRuntime):
         if self.kept:  # the message that carried last tick's memory (MBs for a DFT robot) and zenoh's copy
             heap.give_back()  # of it are freed by now: all of it back to the system, not kept in the heap
         self.kept = keep = obs.keep and not self.null
-        # the memory's arrays are written once, straight into the message (the save-tick peak: issue 12)
+        # the memory's arrays are written once, straight into the message (the save-tick peak)
         memory = [(a, memory_codec.pieces(b.snapshot())) for a, b in mine] if keep else []
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory)
         self.act_publisher.put(payload)

@@ -108,7 +108,7 @@ class AgentRuntime:
         Python operations and one compiled call, and nothing else, since at
         100 processes on 2 cores each object an agent touches is cold when
         its turn comes (dropping a numpy slice, an `item` and a `try_recv`
-        gained some 4% of a tick, issue 12).  Anything else, or in real time
+        gained some 4% of a tick).  Anything else, or in real time
         more than one message waiting, goes through `_answer_batch`."""
         answered = 0
         self._heard = time.monotonic()
@@ -116,7 +116,7 @@ class AgentRuntime:
         recv, try_recv, answer_raw, monotonic = self.inbox.recv, self.inbox.try_recv, self._answer_raw, time.monotonic
         lockstep = self.lockstep  # the world waits for every answer: never more than one observation waiting
         while True:
-            raw = recv().payload.to_bytes()  # and zenoh's copy goes at once (issue 12's 80 MB)
+            raw = recv().payload.to_bytes()  # and zenoh's copy goes at once (an agent process's 80 MB budget)
             if lockstep or (more := try_recv()) is None:
                 if (fast := answer_raw(raw)) is not None:
                     answered += fast
@@ -140,7 +140,7 @@ class AgentRuntime:
         for i, item in enumerate(batch):
             tried = isinstance(item, bytes)  # bytes: `run` has read them (and tried the short way if last)
             raw = item if tried else item.payload.to_bytes()
-            batch[i] = item = None  # zenoh's copy goes now: memory handed back is MBs (issue 12's 80 MB)
+            batch[i] = item = None  # zenoh's copy goes now: memory handed back is MBs (an agent process's 80 MB budget)
             if i == last and not tried and (fast := self._answer_raw(raw)) is not None:  # a plain observation
                 self._heard = time.monotonic()
                 return False, fast  # older observations of the batch are superseded

@@ -127,7 +127,7 @@ def test_an_action_message_written_from_pieces_equals_the_one_packed_from_its_bl
 
 
 def test_a_save_ticks_message_copies_the_memorys_arrays_once():
-    """The agent process's peak at a save tick (issue 12): the fields go straight into the message,
+    """The agent process's peak at a save tick: the fields go straight into the message,
     not through a snapshot copy, a blob and a second packing (3.1 times their size before)."""
     fields = {f"u{g}": np.random.default_rng(g).random((8, 210 * 210)).astype(np.float32) for g in range(2)}
     size = sum(a.nbytes for a in fields.values())
@@ -178,7 +178,7 @@ def test_a_memory_that_does_not_fit_its_controller_is_refused_and_changes_nothin
 
 
 def test_a_dft_robot_takes_its_memory_back_without_a_rollback_copy():
-    """A resume's peak (issue 12): the DFT controller checks a memory whole before writing it, so the agent
+    """A resume's peak: the DFT controller checks a memory whole before writing it, so the agent
     keeps no copy of the old state to roll back to; the decoded arrays are written in place, not copied."""
     from agents.arena_runtime import restore_or_keep
 
@@ -412,7 +412,7 @@ def test_broken_array_extensions_are_refused_with_views_as_with_copies():
 
 
 def test_a_dft_memory_handed_back_is_read_where_it_lies_in_the_message():
-    """A resume's peak (issue 12): the memory message is parsed with its blob as a view, the blob decoded
+    """A resume's peak: the memory message is parsed with its blob as a view, the blob decoded
     with its fields as views, and the controller copies them into its own arrays: no MB-sized copy on the way."""
     from agents.arena_runtime import ArenaAgentRuntime
 

@@ -1,4 +1,4 @@
-"""A colony of bg animats (issue 15, item 6): the map and what its places hold
+"""A colony of bg animats: the map and what its places hold
 shared over the `map` key space, frames aligned by the places two animats
 share, the same colony in both runtimes, and the colony experiment."""
 

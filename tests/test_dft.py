@@ -110,7 +110,7 @@ def test_a_shift_moves_activity_by_its_cells():
 
 def test_the_engines_transforms_are_scipy_fft_bit_for_bit_without_importing_it():
     """agents.controllers.dft.pocketfft calls scipy's compiled pocketfft as scipy.fft does (the same
-    numbers) while an agent process never imports scipy (issue 12's 80 MB)."""
+    numbers) while an agent process never imports scipy (an agent process's 80 MB budget)."""
     import subprocess
     import sys
 

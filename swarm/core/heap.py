@@ -5,7 +5,7 @@ memory: a DFT robot on `large-maze` packs ~3.4 MB of fields several times over
 (the copy, the blob, the action message) and zenoh copies it once more.  glibc
 keeps such freed blocks in its heaps (after the first large free it raises its
 own mmap threshold), so each save would leave the process ~10 MB larger than
-it needs to be, against issue 12's 80 MB per agent process.  `malloc_trim`
+it needs to be, against the 80 MB budget of an agent process.  `malloc_trim`
 returns those pages; elsewhere (no glibc) this does nothing.
 """
 

@@ -8,7 +8,7 @@ Decoding never raises: a broken blob is a `Rejected` reason, and the agent
 runtime counts it (the controller then goes on with what it has).
 
 Why pieces: a DFT robot's memory is MBs of fields, sent at every save tick
-from a process that must stay under 80 MB (issue 12).  `pieces` gives the
+from a process that must stay under 80 MB.  `pieces` gives the
 msgpack form as a list of small headers and the arrays' own bytes (views, no
 copy), so the action message that carries it is written once, by one
 `b"".join`, straight from the fields.  The form is msgpack's own, byte for

@@ -4,7 +4,7 @@ msgpack-python copies every bin and extension out of the bytes it decodes.
 A resumed world hands a DFT robot its 3.2 MB memory in one message, so the
 agent held the message, the memory's blob copied out of it and the fields
 copied out of that at once: three copies of MBs in a process that must stay
-under 80 MB (issue 12).  This reader returns each bin as a read-only
+under 80 MB.  This reader returns each bin as a read-only
 memoryview of the message and gives each extension's bytes to a hook as a
 view too; everything else decodes to what `msgpack.unpackb(raw=False,
 strict_map_key=False)` gives (tested against it).  It walks values in

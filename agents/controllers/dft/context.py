@@ -29,7 +29,7 @@ MAX_CELLS = 4096  # most cells one publication may name
 def grown(mask: np.ndarray, by: int) -> np.ndarray:
     """`mask` dilated by a (2 by + 1)-cell square, nothing beyond the edge: scipy.ndimage's
     binary_dilation with that square, one axis at a time (a square is separable), in numpy so an
-    agent process need not import scipy (issue 12's memory budget)."""
+    agent process need not import scipy (the agent process's 80 MB budget)."""
     out = mask
     for axis in range(mask.ndim):
         wide = out.copy()

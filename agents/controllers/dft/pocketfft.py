@@ -3,7 +3,7 @@
 The field engine needs two calls: a real forward transform over some axes and
 its inverse.  `import scipy.fft` also imports scipy.special (for FFTLog),
 numpy.f2py and unittest: about 30 MB in an agent process whose whole budget
-is 80 MB (issue 12).  The transforms themselves are one compiled module,
+is 80 MB.  The transforms themselves are one compiled module,
 scipy's pypocketfft, which needs nothing but numpy; this loads that module
 from scipy's installed files and calls it exactly as `scipy.fft.rfftn` and
 `scipy.fft.irfftn` do, so the numbers are scipy's, bit for bit (tested).

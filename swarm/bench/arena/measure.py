@@ -1,7 +1,7 @@
 """`swarm bench arena`: what sensing and physics cost in the arena, and how
 the cost grows with robots and with walls.
 
-The world is the issue's: a 20 x 20 m walled arena with 100 rectangular
+The world: a 20 x 20 m walled arena with 100 rectangular
 obstacles (sides 0.3-1.5 m, seeded), robots of 0.2 m radius placed on a
 jittered lattice clear of the obstacles, driving forward with a slight turn
 (so they meet walls and each other).  Two sensor suites: the animat's

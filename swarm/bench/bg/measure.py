@@ -11,7 +11,7 @@ from __future__ import annotations
 import time
 from statistics import median
 
-TARGET_REAL_TIME = 1000  # issue 15: one animat in-process, the GPR at its stable step included
+TARGET_REAL_TIME = 1000  # the target: one animat in-process, the GPR at its stable step included
 
 
 def _engine(ticks: int):

@@ -23,7 +23,7 @@ from agents.controllers.fingerprint.signatures import FingerprintSignatures, pac
 from agents.controllers.navigation.topomap import Link, Node, TopoMap
 
 SIZES = (20, 200, 1000)
-TARGET_MS = 10.0  # issue 14: one fingerprint against 1000 nodes, all rotations, on one core
+TARGET_MS = 10.0  # the target: one fingerprint against 1000 nodes, all rotations, on one core
 
 
 def collect(every: int, quick: bool) -> tuple[list[dict], list[Fingerprint]]:

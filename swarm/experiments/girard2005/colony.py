@@ -1,5 +1,5 @@
 """`swarm experiment bg-colony`: survival against colony size, with and
-without a shared map (issue 15, item 6; the paper has one animat).
+without a shared map (the paper has one animat).
 
 N animats (condition A: taxon + topological navigation) live in bg-colony
 (bg-exp1's floor) from a nest in the east passage, each until it dies or

@@ -1,5 +1,5 @@
 """`swarm experiment fingerprint-together`: N fingerprint robots map one floor
-together over the `map` key space (issue 14, item 6).
+together over the `map` key space.
 
 The floor is split into N stretches of the corridor; robot k drives its
 stretch west to east and enters every room whose door is on it, north then

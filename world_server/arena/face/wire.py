@@ -200,7 +200,7 @@ def _decode(entry) -> np.ndarray | Rejected:
 def parse_obs(data: bytes) -> ArenaObs | Rejected | dict:
     """A batch of readings, the memories a resumed world hands back, or the raw dict of a `stop` message.
     A memory message as `memory_message` writes it is read with its blobs as views of `data`: a DFT
-    robot's is MBs, and the agent must not hold it twice (issue 12's 80 MB)."""
+    robot's is MBs, and the agent must not hold it twice (an agent process's 80 MB budget)."""
     m = unpack(data, MAX_OBS_BYTES, views=data.startswith(_MEMORY_HEAD, 1))  # after the map's header byte
     if isinstance(m, Rejected) or m.get("type") in ("stop", "wake"):
         return m
