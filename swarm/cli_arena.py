@@ -62,7 +62,8 @@ def run_arena(args, scenario, viewer: str | None = None) -> int:
         from swarm.recording.arena import ArenaRecorder
 
         meta = {"run_id": Path(args.record).stem, "runtime": "in-process"}
-        recorder = ArenaRecorder(args.record, engine.world, meta, viewer=viewer, controllers=engine.controllers)
+        recorder = ArenaRecorder(args.record, engine.world, engine.goals, meta, viewer=viewer,
+                                 controllers=engine.controllers)  # fmt: skip
     summary = None
     try:
         summary = engine.run(progress=not args.json and sys.stderr.isatty(), recorder=recorder)

@@ -1,5 +1,5 @@
 """The world process (`swarm world`): the server of the scenario's world kind, lent what lives above
-the worlds (its recorder, the arena summary's L_o), run until the run ends."""
+the worlds (its recorder, the arena's goals and L_o), run until the run ends."""
 
 from __future__ import annotations
 
@@ -8,28 +8,27 @@ import json
 import sys
 import time
 
-from world_server.arena.server import ArenaServer
-from world_server.grid.server import GridServer
+from world_server.arena.server import ArenaKind
+from world_server.grid.server import GridKind
 from world_server.server import RunnerServices, WorldServer
 
 
 def services_for(scenario) -> RunnerServices:
     if getattr(scenario, "kind", "grid") == "arena":
-        from swarm.engines.arena import fill_optimum
+        from swarm.engines.goals import ArenaGoals
         from swarm.recording.arena import open_for_server
 
-        return RunnerServices(open_recorder=open_for_server, complete_summary=fill_optimum)
+        return RunnerServices(open_recorder=open_for_server, goals=ArenaGoals)
     from swarm.recording.grid import open_for_server
 
     return RunnerServices(open_recorder=open_for_server)
 
 
 def make_server(scenario, run_id: str, **kw) -> WorldServer:
-    """The server of the scenario's world kind, with this runner's services."""
+    """The world server holding the scenario's world kind, with this runner's services."""
     kw.setdefault("services", services_for(scenario))
-    if getattr(scenario, "kind", "grid") == "arena":
-        return ArenaServer(scenario, run_id, **kw)
-    return GridServer(scenario, run_id, **kw)
+    kind = ArenaKind if getattr(scenario, "kind", "grid") == "arena" else GridKind
+    return WorldServer(kind, scenario, run_id, **kw)
 
 
 def serve(scenario, run_id: str, summary_file: str | None = None, linger: float = 0.0, quiet: bool = False,

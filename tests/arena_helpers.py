@@ -49,10 +49,11 @@ def resumed_pair(scenario, ticks: int):
 
     a = ArenaEngine(scenario)
     a.step(ticks)
-    saved_world = a.world.snapshot()
+    saved_world, saved_goals = a.world.snapshot(), a.goals.snapshot()
     saved = [json.loads(json.dumps(c.snapshot())) for c in a.controllers]
     b = ArenaEngine(scenario)
     b.world.restore(saved_world)
+    b.goals.restore(saved_goals)
     for c, state in zip(b.controllers, saved, strict=True):
         c.restore(state)
     a.step(ticks)

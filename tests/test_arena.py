@@ -267,7 +267,7 @@ def test_the_arena_recording_holds_walls_robots_headings_and_the_plan(tmp_path):
 
     s = load_scenario("zmaze").with_overrides(max_ticks=50)
     engine = ArenaEngine(s)
-    rec = ArenaRecorder(tmp_path / "z.rrd", engine.world, {"run_id": "z", "runtime": "in-process"},
+    rec = ArenaRecorder(tmp_path / "z.rrd", engine.world, engine.goals, {"run_id": "z", "runtime": "in-process"},
                         controllers=engine.controllers)  # fmt: skip
     engine.run(recorder=rec)
     rec.close(engine.summary())

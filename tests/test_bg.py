@@ -97,7 +97,8 @@ def test_reloading_works_only_in_a_zone_of_its_kind():
     w.apply(np.array([[0.0, 0.0, 2.0]]))  # ReloadEp at the food
     ep = w.metabolism.potential[0]
     assert ep == pytest.approx(before[1] + 0.1 * w.scenario.control_period)
-    assert w.metabolism.ingest_tick[0] == 0 and w.robot_summaries(w.optimum)[0]["ingested"] == "food"
+    assert w.metabolism.ingest_tick[0] == 0
+    assert w.metabolism.summary(0, w.scenario.control_period, w.tick)["ingested"] == "food"
     w.apply(np.array([[0.0, 0.0, 1.0]]))  # ReloadE away from the digesting zone: nothing, counted
     assert w.metabolism.idle_acts[0] == 1 and w.metabolism.potential[0] == pytest.approx(ep)
 
@@ -519,7 +520,7 @@ def test_a_recording_holds_the_metabolism_the_channels_and_the_map(tmp_path):
     s = load_scenario("bg-exp1").with_overrides(max_ticks=80)
     engine = ArenaEngine(s)
     path = tmp_path / "bg.rrd"
-    recorder = ArenaRecorder(path, engine.world, {"run_id": "bg"}, controllers=engine.controllers)
+    recorder = ArenaRecorder(path, engine.world, engine.goals, {"run_id": "bg"}, controllers=engine.controllers)
     recorder.close(engine.run(recorder=recorder))
     rows = rrd_rows(path)
     for name in ("energy", "potential", "disorientation", "act", "direction", "motivation/E", "motivation/BKA"):

@@ -329,7 +329,7 @@ def test_release_raises_an_intention_ahead_the_robot_moves_and_satisfaction_form
                 seen_intention = True  # the intention peak lies just east of the robot, where it will go
         if seen_intention and c.engine.u("C_E")[f_i.shape[0] // 2 - 5 : f_i.shape[0] // 2 + 5].max() > 0:
             seen_satisfaction = True
-        if engine.world.done():
+        if engine.done():
             break
     assert seen_intention and seen_satisfaction
     robot = engine.summary()["robots"][0]
@@ -433,7 +433,7 @@ def test_a_recording_holds_the_fields_the_intentions_and_the_optimum(tmp_path):
     s = load_scenario("zmaze").with_overrides(controller="dft", max_ticks=60)
     engine = ArenaEngine(s)
     path = tmp_path / "dft.rrd"
-    recorder = ArenaRecorder(path, engine.world, {"run_id": "dft"}, controllers=engine.controllers)
+    recorder = ArenaRecorder(path, engine.world, engine.goals, {"run_id": "dft"}, controllers=engine.controllers)
     recorder.close(engine.run(recorder=recorder))
     rows = rrd_rows(path)
     for d in EBS:

@@ -470,7 +470,9 @@ def test_the_recording_holds_the_map_as_graph_nodes_and_edges(tmp_path):
     s = tour_scenario("office", "mapping", "low", 0)
     engine = ArenaEngine(s)
     path = tmp_path / "fp.rrd"
-    rec = ArenaRecorder(path, engine.world, {"run_id": "fp", "runtime": "in-process"}, controllers=engine.controllers)
+    rec = ArenaRecorder(
+        path, engine.world, engine.goals, {"run_id": "fp", "runtime": "in-process"}, controllers=engine.controllers
+    )
     engine.step(600, rec)
     rec.close()
     from rerun.chunk import RrdReader

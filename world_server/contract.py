@@ -27,7 +27,8 @@ class World(Protocol):
         """Validate and apply every agent's action, resolve one tick, tick += 1."""
 
     def done(self) -> bool:
-        """The run has reached its end condition."""
+        """The world has reached its own end (the grid: its `until` rule; the arena: its last tick or its
+        metabolism's rule).  A runner may end a run sooner: the arena's goals (swarm.engines.goals)."""
 
     def snapshot(self) -> dict[str, np.ndarray]:
         """The state a restarted world resumes from (arrays only)."""

@@ -10,8 +10,8 @@ code as the in-process engine.
 This module is the part every world kind shares: joins, presence, the
 lock-step barrier, real time, the state key, info, progress and the summary's
 runtime fields.  What a kind perceives, which actions it accepts, how it
-resolves a tick, persists and records are the hooks its subclass fills:
-`world_server.grid.server.GridServer` and `world_server.arena.server.ArenaServer`.
+resolves a tick, persists and reports, the server asks the world kind it holds
+(`WorldKind`: `world_server.grid.server.GridKind`, `world_server.arena.server.ArenaKind`).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import uuid
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 import zenoh
@@ -60,17 +60,89 @@ class RunnerServices:
 
     # (server, path, live viewer or None) -> the recorder of this run, when it is recorded
     open_recorder: Callable[[Any, Path, str | None], Any] | None = None
-    # world -> None: what the summary adds from outside the world (the arena's L_o, by A*)
-    complete_summary: Callable[[Any], None] | None = None
+    # scenario -> what the run asks of its robots, kept above the world (the arena's goals, routes, dwell, L_o)
+    goals: Callable[[Any], Any] | None = None
+
+
+class WorldKind(Protocol):
+    """What binds the world process to one world kind.  A kind is made with the server it serves
+    (`kind(server)`) and reads the server's slots, counts and session; the server asks it:
+
+    messages      declare, handle
+    persistence   resume, save
+    membership    admit, welcome, remove
+    a run         start, finish, close
+    a tick        observe, may_all_have_answered, barrier_passed, resolve
+    report        done, progress, summary
+    """
+
+    world: Any  # the kind's world (world_server.contract.World): what the recorder and the tests read
+
+    def declare(self, put: Callable[[tuple[str, Any]], None]) -> list:
+        """The kind's zenoh declarations: how action messages come in, and its shared key spaces.
+        Their events go through `put` as (event, item) and come back to `handle` on the world's thread."""
+
+    def handle(self, event: str, item: Any) -> None:
+        """An event of the kind's declarations: an action message, a shared key space's put or query."""
+
+    def resume(self) -> bool:
+        """Continue the run saved under this run id, if there is one (the server's `resume_membership`
+        takes the slots and counts): True when it did."""
+
+    def save(self) -> None:
+        """Persist the world, for a restarted world process to resume (kinds that can)."""
+
+    def admit(self, request: dict) -> np.ndarray | str:
+        """The slots this join request may take, in order (`WorldServer.free_slots`, or those of its
+        controller), or why it is refused."""
+
+    def welcome(self, agent: int, replacing: bool) -> dict:
+        """What a joining agent is told besides its id (its controller, parameters, memory);
+        `replacing`: it takes over a lost agent's slot, and starts afresh."""
+
+    def remove(self, agent: int) -> None:
+        """An agent is lost during the run: what becomes of its body."""
+
+    def start(self, resumed: bool) -> None:
+        """The agents that start the run have joined; the first tick is next.  A resumed run gives the
+        agents that survived the restart their controllers' memory at the saved tick."""
+
+    def finish(self) -> None:
+        """After the last tick, before the final save: what the last tick left to pass on."""
+
+    def close(self) -> None:
+        """The world process ends: release what the kind holds open."""
+
+    def observe(self, tick: int, groups: dict[str, np.ndarray]) -> list[tuple[str, bytes]]:
+        """Begin the tick: (group, observation message) for every agent process, by its active agents."""
+
+    def may_all_have_answered(self, agents: np.ndarray) -> bool:
+        """A cheap test before the server's, which the lock-step barrier would otherwise evaluate
+        after every message: False while some of `agents` surely still owe their action."""
+
+    def barrier_passed(self) -> None:
+        """Every answer of the tick is in, or its time is up: take in what has come."""
+
+    def resolve(self, tick: int, missed: np.ndarray) -> None:
+        """Resolve the tick (a null run, messaging only, leaves the world as it is); the agents in
+        `missed` did not answer and do nothing."""
+
+    def done(self) -> bool:
+        """The run has reached its end."""
+
+    def progress(self) -> dict:
+        """The kind's few numbers on the state key, ten times a second: cheap."""
+
+    def summary(self) -> dict:
+        """The kind's summary of the run so far (the server adds its runtime's fields)."""
 
 
 class WorldServer:
-    """The runtime around one world; subclasses bind it to a world kind."""
-
-    family = ""
+    """The runtime around one world; it holds the world kind (`WorldKind`) that binds it to its world."""
 
     def __init__(
-        self, scenario, run_id: str, listen: str | None = None, connect: str | None = None,
+        self, kind: Callable[[WorldServer], WorldKind], scenario, run_id: str, listen: str | None = None,
+        connect: str | None = None,
         deadline: float = 2.0, max_misses: int = 3, start_with: int | None = None, start_timeout: float = 60.0,
         until: str = "foraged", max_iterations: int = 1_000_000, null: bool = False,
         state_dir: str | None = None, persist_every: int = 50, resume_timeout: float = 30.0,
@@ -100,8 +172,8 @@ class WorldServer:
         self.resume_timeout = resume_timeout
         self.state_dir = state_dir
         self.services = services or RunnerServices()
-        self._make_world()
-        self.resumed = self._resume()
+        self.kind = kind(self)
+        self.resumed = self.kind.resume()
         self.recording_path: str | None = None
         self.recorder = None if null or not record else self._recorder(record, viewer)
         self._open_session(listen, connect)
@@ -136,46 +208,53 @@ class WorldServer:
         self._decls = [
             self.session.declare_queryable(k.join, lambda q: put(("join", q))),
             self.session.declare_queryable(k.info, lambda q: put(("info", q))),
-            self.session.declare_subscriber(k.acts, self._act_callback(put)),
             # history: tokens declared before this subscriber (agents back before a restarted world) count too
             self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s)), history=True),
-            *self._declare_shared(put),
+            *self.kind.declare(put),
         ]
         self._state_publisher = self.session.declare_publisher(k.state)
         self._next_state = 0.0  # when progress goes out on the state key next
 
-    # ----------------------------------------------------- hooks of a world kind
+    # --------------------------------------------------- what a world kind uses
 
-    def _make_world(self) -> None:
-        raise NotImplementedError
+    @property
+    def world(self):
+        """The kind's world (world_server.contract.World)."""
+        return self.kind.world
 
-    def _act_callback(self, put):
-        """What zenoh calls with an action message: by default it queues the
-        message for `_on_act` like every other event."""
-        return lambda sample: put(("act", sample))
-
-    def _declare_shared(self, put) -> list:
-        """Declarations of the kind's shared key spaces (events go through `put`)."""
-        return []
-
-    def _handle_shared(self, kind: str, item) -> None:
-        """An event of a shared key space."""
-
-    def _resume(self) -> bool:
-        return False
-
-    def _check_same_scenario(self, saved: str) -> None:
+    def check_same_scenario(self, saved: str, state_file: Path) -> None:
         """A run id names one run: a saved state of another scenario is refused (one line)."""
         if saved != self.scenario.describe():
-            raise ScenarioError(str(self.state_file), "run id", f"holds run {self.keys.run!r} of another scenario; "
+            raise ScenarioError(str(state_file), "run id", f"holds run {self.keys.run!r} of another scenario; "
                                 "use another --run-id or remove the file")  # fmt: skip
 
-    def save_state(self) -> None:
-        """Persist the world (kinds that can resume)."""
+    def membership(self) -> dict:
+        """What a saved state keeps of the run's membership and counts (the `stats` of its meta)."""
+        return {"joins": self.stats.joins, "agents_lost": self.stats.agents_lost, "rejected": self.stats.rejected,
+                "groups": {str(a): g for a, g in self.group_of.items()}}  # fmt: skip
 
-    def _saves_after(self, tick: int) -> bool:
+    def resume_membership(self, tick: int, slots: np.ndarray, stats: dict) -> None:
+        """A saved run's tick, slots and counts: the agents that were in come back when their
+        liveliness token reappears (a newcomer takes over one that does not)."""
+        self.tick = tick
+        self.slots[:] = np.where((slots == ACTIVE) | (slots == JOINING), JOINING, slots)
+        self.returning[:] = self.slots == JOINING
+        self.stats.joins = int(stats.get("joins", 0))
+        self.stats.agents_lost = int(stats.get("agents_lost", 0))
+        self.stats.rejected = dict(stats.get("rejected", {}))
+        for a, g in stats.get("groups", {}).items():
+            self.assign_group(int(a), g)
+
+    def saves_after(self, tick: int) -> bool:
         """Is the world saved once `tick` is resolved (controllers' memory is wanted with its actions)?"""
         return bool(self.persist_every) and self.state_dir is not None and (tick + 1) % self.persist_every == 0
+
+    def free_slots(self) -> np.ndarray:
+        """Slots a newcomer may take, in order: first those of a resumed run
+        whose agents have not come back (the newcomer continues that agent
+        exactly: its body and its controller's memory), then free ones."""
+        free = np.flatnonzero((self.slots == FREE) | (self.slots == LOST))
+        return np.concatenate([np.flatnonzero(self.returning), free])
 
     def _recorder(self, record: str, viewer: str | None):
         """A resumed run records into a new file from its resume tick: the
@@ -192,95 +271,21 @@ class WorldServer:
             raise ValueError("this world process was started without a recorder (swarm.world_process starts one)")
         return self.services.open_recorder(self, path, viewer)
 
-    def _join_refusal(self, request: dict) -> str | None:
-        """Why this join request cannot be served, or None."""
-        return None
-
-    def _free_slots(self, request: dict) -> np.ndarray:
-        """Slots a newcomer may take, in order: first those of a resumed run
-        whose agents have not come back (the newcomer continues that agent
-        exactly: its body and its controller's memory), then free ones."""
-        free = np.flatnonzero((self.slots == FREE) | (self.slots == LOST))
-        return np.concatenate([np.flatnonzero(self.returning), free])
-
-    def _welcome(self, agent: int) -> dict:
-        raise NotImplementedError
-
-    def _reuse(self, agent: int) -> None:
-        """A new agent takes over a lost agent's slot."""
-
-    def _remove(self, agent: int) -> None:
-        """An agent is lost during the run."""
-
-    def _starting(self) -> None:
-        """The agents that start the run have joined; the first tick is next."""
-
-    def _hand_back(self) -> None:
-        """A resumed run, before its first tick: give the agents back what their
-        controllers held at the saved tick (kinds whose controllers keep memory)."""
-
-    def _begin_tick(self) -> None:
-        """Before the tick's observations go out."""
-
-    def _finish(self) -> None:
-        """After the last tick, before the state is saved (what the last tick left to pass on)."""
-
-    def _observe(self, tick: int, agents: np.ndarray) -> bytes:
-        """The observation message of one agent process."""
-        raise NotImplementedError
-
-    def _observations(self, tick: int, groups: dict[str, np.ndarray]):
-        """(group, message) for every agent process; kinds that can perceive
-        every agent at once override this."""
-        return [(group, self._observe(tick, agents)) for group, agents in groups.items()]
-
-    def _on_act(self, sample) -> None:
-        raise NotImplementedError
-
-    def may_all_have_answered(self, agents: np.ndarray) -> bool:
-        """A cheap test before `answered`, which the lock-step barrier would
-        otherwise evaluate after every message: False while some of `agents`
-        surely still owe their action."""
-        return True
-
-    def answered(self, agents: np.ndarray) -> np.ndarray:
-        return self.acted[agents]
-
-    def barrier_passed(self) -> None:
-        """Every answer of the tick is in, or its time is up."""
-
-    def _missed(self, agent: int) -> None:
-        """An active agent did not answer this tick."""
-
-    def _resolve(self, tick: int) -> None:
-        raise NotImplementedError
-
-    def done(self) -> bool:
-        raise NotImplementedError
-
-    def progress_fields(self) -> dict:
-        return {}
-
-    def summary_fields(self) -> dict:
-        raise NotImplementedError
-
     # ---------------------------------------------------------------- messages
 
     def _handle(self, kind: str, item) -> None:
-        if kind == "act":
-            self._on_act(item)
-        elif kind == "join":
+        if kind == "join":
             self._on_join(item)
         elif kind == "info":
-            self._reply(item, self.keys.info, wire.pack(self.info()))
+            self.reply(item, self.keys.info, wire.pack(self.info()))
         elif kind == "alive":
             self._on_alive(item)
         elif kind == "wake":
             pass  # the barrier looks again (`may_all_have_answered`)
-        else:
-            self._handle_shared(kind, item)
+        else:  # the kind's: actions and its shared key spaces
+            self.kind.handle(kind, item)
 
-    def _reply(self, query, key: str, payload: bytes) -> None:
+    def reply(self, query, key: str, payload: bytes) -> None:
         try:
             query.reply(key, payload)
         finally:
@@ -291,36 +296,36 @@ class WorldServer:
         request = wire.parse_join(raw)
         if isinstance(request, wire.Rejected):
             self.stats.reject(f"join: {request.reason}")
-            self._reply(query, self.keys.join, wire.refuse_reply(request.reason))
+            self.reply(query, self.keys.join, wire.refuse_reply(request.reason))
             return
-        if (reason := self._join_refusal(request)) is not None:
-            self._reply(query, self.keys.join, wire.refuse_reply(reason))
+        if isinstance(free := self.kind.admit(request), str):
+            self.reply(query, self.keys.join, wire.refuse_reply(free))
             return
         if self.final is not None:
-            self._reply(query, self.keys.join, wire.refuse_reply(wire.ENDED))
+            self.reply(query, self.keys.join, wire.refuse_reply(wire.ENDED))
             return
         nonce = request["nonce"]
         agent = self.nonces.get(nonce)  # a retried join gets the same id
+        replacing = False
         if agent is None:
-            free = self._free_slots(request)
             if len(free) == 0:
-                self._reply(query, self.keys.join, wire.refuse_reply("the swarm is full"))
+                self.reply(query, self.keys.join, wire.refuse_reply("the swarm is full"))
                 return
             agent = int(free[0])
             if self.returning[agent]:
                 self.returning[agent] = False  # taken over where it was saved
-            elif self.slots[agent] == LOST:
-                self._reuse(agent)
+            else:
+                replacing = bool(self.slots[agent] == LOST)
             self.nonces[nonce] = agent
-            self._assign_group(agent, request["group"])
+            self.assign_group(agent, request["group"])
             self.slots[agent] = JOINING
             self.misses[agent] = 0
             self.stats.joins += 1
         info = {"run": self.keys.run, "seed": self.scenario.seed, "tick": self.tick,
-                "lockstep": self.mode == "lockstep", **self._welcome(agent)}  # fmt: skip
-        self._reply(query, self.keys.join, wire.join_reply(agent, nonce, info))
+                "lockstep": self.mode == "lockstep", **self.kind.welcome(agent, replacing)}  # fmt: skip
+        self.reply(query, self.keys.join, wire.join_reply(agent, nonce, info))
 
-    def _assign_group(self, agent: int, group: str) -> None:
+    def assign_group(self, agent: int, group: str) -> None:
         self.group_of[agent] = group
         self.group_ids[agent] = self.group_index.setdefault(group, len(self.group_index))
 
@@ -338,8 +343,8 @@ class WorldServer:
         self.slots[agent] = LOST
         self.returning[agent] = False
         self.stats.agents_lost += 1
-        if not self.done():  # after the run, agents leaving do not change the final world
-            self._remove(agent)
+        if not self.kind.done():  # after the run, agents leaving do not change the final world
+            self.kind.remove(agent)
         for nonce, a in list(self.nonces.items()):
             if a == agent:
                 del self.nonces[nonce]
@@ -350,7 +355,7 @@ class WorldServer:
         except ValueError:
             return None
 
-    def _receive(self, sample, parse, what: str):
+    def receive(self, sample, parse, what: str):
         """(message, sending group), or None after counting a rejection."""
         raw = sample.payload.to_bytes()
         self.bytes_in += len(raw)
@@ -360,13 +365,13 @@ class WorldServer:
             return None
         return msg, str(sample.key_expr).rsplit("/", 1)[1]
 
-    def _acting(self, a: int, group: str, tick: int) -> bool:
+    def acting(self, a: int, group: str, tick: int) -> bool:
         """May agent `a` of process `group` act for `tick` now?  Counts why not."""
         if not (0 <= a < len(self.slots)) or self.slots[a] != ACTIVE:
             self.stats.reject("act: unknown agent")
         elif self.group_of.get(a) != group:
             self.stats.reject("act: names an agent of another process")
-        elif not self._current(tick):
+        elif not self.current(tick):
             self.stats.late_actions += 1
             self.stats.reject("act: not for this tick")
         elif self.acted[a] and self.mode == "lockstep":  # in real time the latest action wins
@@ -375,7 +380,7 @@ class WorldServer:
             return True
         return False
 
-    def _window(self) -> tuple[int, int]:
+    def window(self) -> tuple[int, int]:
         """The ticks an action may be for now.  Lock-step: only this tick.  Real
         time: this tick or the two before (an agent may answer a slightly old
         observation)."""
@@ -383,8 +388,8 @@ class WorldServer:
             return self.tick, self.tick
         return self.tick - 2, self.tick
 
-    def _current(self, tick: int) -> bool:
-        first, last = self._window()
+    def current(self, tick: int) -> bool:
+        first, last = self.window()
         return first <= tick <= last
 
     def _drain(self, timeout: float) -> bool:
@@ -428,13 +433,12 @@ class WorldServer:
         tick = self.tick
         active = np.flatnonzero(self.slots == ACTIVE)
         self.acted[:] = False
-        self._begin_tick()
-        for group, payload in self._observations(tick, self._groups(active)):
+        for group, payload in self.kind.observe(tick, self.grouped(active)):
             self.bytes_out += len(payload)
-            self._publisher(group).put(payload)
+            self.publisher(group).put(payload)
         if self.mode == "lockstep":  # a barrier: until all have answered or the deadline
             deadline = time.monotonic() + self.deadline
-            while not (self.may_all_have_answered(active) and self.answered(active).all()):
+            while not (self.kind.may_all_have_answered(active) and self.acted[active].all()):
                 left = deadline - time.monotonic()
                 if left <= 0:
                     break
@@ -443,22 +447,22 @@ class WorldServer:
             deadline = started + self.period
             while (left := deadline - time.monotonic()) > 0:
                 self._drain(left)
-        self.barrier_passed()
-        answered = self.answered(active)
+        self.kind.barrier_passed()
+        answered = self.acted[active]
         self.agent_steps += int(answered.sum())
         self.misses[active[answered]] = 0
+        missed = []
         for a in active[~answered].tolist():  # a Python loop over the few that missed, not over everyone
             if self.slots[a] == ACTIVE:
                 self.misses[a] += 1
                 self.stats.missed_ticks += 1
-                self._missed(a)
+                missed.append(a)
                 if self.misses[a] >= self.max_misses:
                     self._lose(a)
-        if not self.null:
-            self._resolve(tick)
+        self.kind.resolve(tick, np.array(missed, np.int64))
         self.tick += 1
         if self.persist_every and self.tick % self.persist_every == 0:
-            self.save_state()
+            self.kind.save()
         self.tick_seconds.append(time.perf_counter() - started)
         present = self.slots == ACTIVE
         self.agents_peak = max(self.agents_peak, int(present.sum()))
@@ -469,7 +473,7 @@ class WorldServer:
             self._next_state = now + STATE_PERIOD
             self._state_publisher.put(wire.pack({"type": "state", **self.progress()}))
 
-    def _groups(self, agents: np.ndarray) -> dict[str, np.ndarray]:
+    def grouped(self, agents: np.ndarray) -> dict[str, np.ndarray]:
         """The active agents by agent process, worked out again only when
         the active set or the joins have changed since the last tick."""
         key = agents.tobytes()
@@ -484,25 +488,23 @@ class WorldServer:
             self._publishers.pop(gone).undeclare()
         return grouped
 
-    def _publisher(self, group: str):
+    def publisher(self, group: str):
         if (pub := self._publishers.get(group)) is None:
             pub = self._publishers[group] = self.session.declare_publisher(self.keys.obs(group))
         return pub
 
     def run(self) -> dict:
-        if not (self.resumed and self.done()):  # a finished run resumed has nothing left to do
+        if not (self.resumed and self.kind.done()):  # a finished run resumed has nothing left to do
             self.wait_for_agents()
-        self._starting()
-        if self.resumed:
-            self._hand_back()
+        self.kind.start(self.resumed)
         self.started = time.monotonic()
-        while not self.done() and self.tick < self.max_iterations:
+        while not self.kind.done() and self.tick < self.max_iterations:
             if not (self.slots == ACTIVE).any():
                 self._wait_for_any_agent()  # a world with nobody in it does not tick on alone
             self.step()
         self._drain(0.0)
-        self._finish()
-        self.save_state()
+        self.kind.finish()
+        self.kind.save()
         self.final = summary = self.summary()
         self._close_recording(summary)
         return summary
@@ -530,13 +532,13 @@ class WorldServer:
 
     def progress(self) -> dict:
         elapsed = time.monotonic() - self.started if self.started else 0.0
-        return {"tick": self.tick, **self.progress_fields(), "agents_alive": int((self.slots == ACTIVE).sum()),
+        return {"tick": self.tick, **self.kind.progress(), "agents_alive": int((self.slots == ACTIVE).sum()),
                 "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0}  # fmt: skip
 
     def summary(self) -> dict:
         elapsed = time.monotonic() - self.started if self.started else 0.0
         return {
-            **self.summary_fields(), "run_id": self.keys.run, "mode": self.mode,
+            **self.kind.summary(), "run_id": self.keys.run, "mode": self.mode,
             "rejected_messages": self.stats.rejected_total, "rejected_by_reason": dict(self.stats.rejected),
             "agents_lost": self.stats.agents_lost, "joins": self.stats.joins, "missed_ticks": self.stats.missed_ticks,
             "agents_peak": self.agents_peak,
@@ -560,6 +562,7 @@ class WorldServer:
             self._close_recording(self.summary())
         for d in [*self._decls, *self._publishers.values(), self._state_publisher]:
             d.undeclare()
+        self.kind.close()
         self.session.close()
 
 

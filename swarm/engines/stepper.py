@@ -18,10 +18,12 @@ from world_server.contract import World
 
 
 def step_world(world: World, decide: Callable[[Any, int], np.ndarray], n: int,
-               after: Callable[[], None] | None = None) -> int:  # fmt: skip
-    """Up to n ticks (fewer once `world.done()`); `after` runs after each tick.  Returns ticks run."""
+               after: Callable[[], None] | None = None, done: Callable[[], bool] | None = None) -> int:  # fmt: skip
+    """Up to n ticks (fewer once `done()`, by default `world.done()`); `after` runs after each tick.
+    Returns ticks run."""
+    done = done or world.done
     ran = 0
-    while ran < n and not world.done():
+    while ran < n and not done():
         world.apply_all(decide(world.perceive_all(), world.tick))
         if after is not None:
             after()

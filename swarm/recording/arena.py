@@ -33,7 +33,7 @@ import math
 import numpy as np
 
 from swarm.core.registry import resolve
-from swarm.engines.arena import _planner, fill_optimum
+from swarm.engines.goals import ArenaGoals, optimum_planner
 from swarm.recording.grid import FORMAT_VERSION, software_versions
 
 ARENA_METRICS = ("reached", "collisions", "distance", "agents_alive", "tick_ms", "rejected_messages")
@@ -47,12 +47,12 @@ def flip(xy: np.ndarray) -> np.ndarray:
     return out
 
 
-def arena_meta(scenario, world, run_id: str, runtime: str) -> dict:
+def arena_meta(scenario, world, goals: ArenaGoals, run_id: str, runtime: str) -> dict:
     """What a reader needs to interpret the recording: taken at the first tick
     recorded, when the robots that start the run are in the world (a robot
     that joins later has no start or L_o here, and no row in `swarm report`)."""
     inside = np.flatnonzero(world.in_world).tolist()
-    fill_optimum(world)
+    goals.fill_optimum(world)
     return {"kind": "arena", "run_id": run_id, "runtime": runtime, "scenario": scenario.describe(),
             "name": scenario.name, "controller": scenario.controller, "agents": scenario.agents,
             "seed": scenario.seed, "noise": scenario.noise.level, "control_period": scenario.control_period,
@@ -62,19 +62,19 @@ def arena_meta(scenario, world, run_id: str, runtime: str) -> dict:
             "walls": [{"shape": w.shape, "coords": list(w.coords), "colour": list(w.colour)} for w in scenario.walls],
             "obstacles": [{"rect": list(o.rect), "colour": list(o.colour), "name": o.name, "zone": o.zone,
                            "appear": o.appear, "vanish": o.vanish} for o in scenario.obstacles],
-            "goals": [None if not world.has_goal[a] else world.goal[a].round(6).tolist() for a in range(world.n)],
-            "optimal_lengths": [v if v is not None and math.isfinite(v) else None for v in world.optimum]}  # fmt: skip
+            "goals": [None if not goals.has_goal[a] else goals.goal[a].round(6).tolist() for a in range(world.n)],
+            "optimal_lengths": [v if v is not None and math.isfinite(v) else None for v in goals.optimum]}  # fmt: skip
 
 
 class ArenaRecorder:
-    def __init__(self, path, world, meta: dict, viewer: str | None = None, flush_every: int = 256,
+    def __init__(self, path, world, goals: ArenaGoals, meta: dict, viewer: str | None = None, flush_every: int = 256,
                  controllers=None):  # fmt: skip
-        """`meta`: run_id and runtime; the rest (arena_meta) is taken at the
-        first tick, when the robots that start the run are in the world."""
+        """`goals`: the run's (swarm.engines.goals); `meta`: run_id and runtime; the rest (arena_meta)
+        is taken at the first tick, when the robots that start the run are in the world."""
         import rerun as rr
         import rerun.blueprint as rrb
 
-        self.rr, self.world, self.flush_every = rr, world, flush_every
+        self.rr, self.world, self.goals, self.flush_every = rr, world, goals, flush_every
         self.controllers = controllers  # in-process: their planned paths are recorded
         from pathlib import Path
 
@@ -114,18 +114,19 @@ class ArenaRecorder:
     def _log_static(self) -> None:
         rr, rec, w, s = self.rr, self.rec, self.world, self.world.scenario
         self._static_done = True
-        built = arena_meta(s, w, self._meta_given.get("run_id", "run"), self._meta_given.get("runtime", "in-process"))
+        given = self._meta_given
+        built = arena_meta(s, w, self.goals, given.get("run_id", "run"), given.get("runtime", "in-process"))
         self.meta = {"format": FORMAT_VERSION, **built, **self._meta_given, "versions": software_versions()}
         rec.log("run/meta", rr.AnyValues(meta=json.dumps(self.meta)), rr.TextDocument(json.dumps(self.meta, indent=1)),
                 static=True)  # fmt: skip
         self._log_walls()
         self._log_zones()
-        goals = np.flatnonzero(w.has_goal & w.in_world)
+        goals = np.flatnonzero(self.goals.has_goal & w.in_world)
         if len(goals):
             rec.log(
                 "world/goals",
                 rr.Points2D(
-                    flip(w.goal[goals]),
+                    flip(self.goals.goal[goals]),
                     radii=s.goal_radius / 3,
                     colors=self.colours[goals],
                     labels=[f"goal {a}" for a in goals],
@@ -194,8 +195,8 @@ class ArenaRecorder:
         for a in robots:
             if routed[a]:
                 continue
-            planner = planner or _planner(s.size, s.walls)
-            length, points = planner.plan(tuple(w.start_pose[a, :2]), tuple(w.goal[a]))
+            planner = planner or optimum_planner(s.size, s.walls)
+            length, points = planner.plan(tuple(w.start_pose[a, :2]), tuple(self.goals.goal[a]))
             if np.isfinite(length) and len(points) > 1:
                 strip = self.rr.LineStrips2D([flip(points)], colors=[(160, 160, 160)], radii=0.0015, draw_order=2.5)
                 self.rec.log(f"world/optimum/{a}", strip, static=True)
@@ -208,10 +209,10 @@ class ArenaRecorder:
             self._log_static()
         self._ticks.append(tick)
         self._pose.append(w.pose.astype(np.float32).copy())
-        in_goal = np.zeros(w.n)
-        if w.has_goal.any():
-            dist = np.hypot(*(w.pose[:, :2] - np.nan_to_num(w.goal)).T)
-            in_goal = (w.has_goal & (dist < w.scenario.goal_radius)).astype(np.float64)
+        in_goal, goals = np.zeros(w.n), self.goals
+        if goals.has_goal.any():
+            dist = np.hypot(*(w.pose[:, :2] - np.nan_to_num(goals.goal)).T)
+            in_goal = (goals.has_goal & (dist < w.scenario.goal_radius)).astype(np.float64)
         for name, values in (("path_length", w.path_length), ("collisions", w.bodies.collisions), ("in_goal", in_goal),
                              ("finished", w.finished)):  # fmt: skip
             self._robots[name].append(np.asarray(values, np.float64).copy())
@@ -333,4 +334,5 @@ class ArenaRecorder:
 
 def open_for_server(server, path, viewer: str | None) -> ArenaRecorder:
     """The recorder of a world process's arena run (swarm.world_process lends it to the server)."""
-    return ArenaRecorder(path, server.world, {"run_id": server.keys.run, "runtime": server.mode}, viewer=viewer)
+    meta = {"run_id": server.keys.run, "runtime": server.mode}
+    return ArenaRecorder(path, server.world, server.kind.goals, meta, viewer=viewer)

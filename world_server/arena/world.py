@@ -5,12 +5,13 @@ differential-drive robots, behind the same world contract as the grid
 A tick is lock-step: every robot perceives the start-of-tick world (one ray
 pass for all sensors of all robots), the controllers decide, and `apply`
 validates every action and integrates the bodies for one control period.
+
+The world is bodies, sensing, zones and the metabolism; what a run asks of the
+robots (goals, routes, dwell, the A* optimum) is the runner's
+(swarm.engines.goals), which says when a robot is finished (`finish`).
 """
 
 from __future__ import annotations
-
-import math
-from typing import Any
 
 import numpy as np
 
@@ -50,7 +51,6 @@ class ArenaWorld:
         self._init_robot_models()
         self._init_geometry(index_cell)
         start = self._init_bodies(parked)
-        self._init_goals()
         self._init_progress(start)
 
     def _init_robot_models(self) -> None:
@@ -106,35 +106,13 @@ class ArenaWorld:
         self._obstacles_at(0)
         return start
 
-    def _init_goals(self) -> None:
-        """Goals and routes, tracked on ground truth for the summary; a routed robot's goal is its
-        route's last waypoint."""
-        s = self.scenario
-        self.goal = np.full((self.n, 2), np.nan)
-        self.route: list[np.ndarray | None] = [None] * self.n
-        for a, goal in enumerate(s.goals()):
-            if goal is not None:
-                self.goal[a] = goal
-        agent = 0
-        for g in s.groups:
-            for _ in range(g.count):
-                if g.route is not None:
-                    self.route[agent] = np.array(s.routes[g.route], np.float64).reshape(-1, 2)
-                    self.goal[agent] = self.route[agent][-1]
-                agent += 1
-
     def _init_progress(self, start: np.ndarray) -> None:
-        """Per-robot progress for the summary and checkpoints, the zones and the metabolism."""
+        """Per-robot counters and checkpoints, the zones and the metabolism."""
         s = self.scenario
-        self.waypoint = np.zeros(self.n, np.int64)  # next route waypoint per robot
-        self.has_goal = ~np.isnan(self.goal[:, 0])
-        self.reached_tick = np.full(self.n, -1, np.int64)
-        self.dwell = np.zeros(self.n, np.int64)
-        self.finished = np.zeros(self.n, np.bool_)
-        self.path_length = np.zeros(self.n)
+        self.finished = np.zeros(self.n, np.bool_)  # done for good (dead, or the run's goals say so): holds still
+        self.path_length = np.zeros(self.n)  # ground-truth distance travelled, the summary's L_p
         self.rejected = dict.fromkeys(REJECT_REASONS, 0)
-        self.optimum: list[float | None] = [None] * self.n  # L_o per robot: the runner's summary fills it once
-        self.start_pose = start.copy()
+        self.start_pose = start.copy()  # where each robot came into the world
         self.checkpointed: dict[str, np.ndarray] | None = None  # the snapshot of the last checkpoint
         self.zones = np.zeros(self.n, np.int64)
         self._update_zones()
@@ -294,7 +272,6 @@ class ArenaWorld:
         self.tick += 1
         self._obstacles_at(self.tick)
         self._update_zones()
-        self._track_goals()
         if self.tick % self.scenario.checkpoint == 0:  # the physics restarts from its saved state, in every runtime
             self.checkpointed = self.snapshot()
             self._rebuild_bodies(self.checkpointed)
@@ -322,30 +299,19 @@ class ArenaWorld:
                 near = np.hypot(xy[:, 0] - o.centre[0], xy[:, 1] - o.centre[1]) <= o.reach
                 self.zones |= np.where(near, 1 << ZONE_KINDS.index(o.zone), 0)
 
-    def _track_goals(self) -> None:
-        s = self.scenario
-        for a in np.flatnonzero(self.has_goal & ~self.finished & self.in_world):
-            x, y = self.pose[a, :2]
-            route = self.route[a]
-            if route is not None and self.waypoint[a] < len(route) - 1:
-                wx, wy = route[self.waypoint[a]]
-                if math.hypot(x - wx, y - wy) < s.goal_radius:
-                    self.waypoint[a] += 1
-                continue
-            if math.hypot(x - self.goal[a, 0], y - self.goal[a, 1]) < s.goal_radius:
-                if self.reached_tick[a] < 0:
-                    self.reached_tick[a] = self.tick
-                self.dwell[a] += 1
-                if self.dwell[a] >= s.goal_dwell:
-                    self.finished[a] = True
+    def finish(self, agents) -> None:
+        """These robots are done for good (the run's goals say so): from the next tick they hold still,
+        obstacles to the others.  A checkpoint taken this tick says so too (the world process saves it)."""
+        self.finished[agents] = True
+        if self.checkpointed is not None and int(self.checkpointed["tick"]) == self.tick:
+            self.checkpointed["finished"][agents] = True
 
     def done(self) -> bool:
+        """The world's own end: its last tick, or its metabolism's rule (a runner may end a run sooner:
+        swarm.engines.goals)."""
         if self.tick >= self.scenario.max_ticks:
             return True
-        if self.metabolism is not None:
-            return self.metabolism.done()
-        goals = self.has_goal & self.in_world
-        return bool(goals.any()) and bool(self.finished[goals].all())
+        return self.metabolism is not None and self.metabolism.done()
 
     def enter(self, agents) -> None:
         """Parked robots come in: at their given starts, or drawn (in this
@@ -363,8 +329,7 @@ class ArenaWorld:
 
     # ------------------------------------------------------------ persistence
 
-    STATE = ("in_world", "present", "finished", "reached_tick", "dwell", "waypoint", "start_pose", "path_length",
-             "zones")  # fmt: skip
+    STATE = ("in_world", "present", "finished", "start_pose", "path_length", "zones")
     BODY_STATE = ("distance", "collisions", "blocked_seconds", "contact", "motion")
 
     def snapshot(self) -> dict[str, np.ndarray]:
@@ -380,7 +345,6 @@ class ArenaWorld:
         out.update(self.bodies.contacts())
         out["tick"] = np.array(self.tick)
         out["sim_seconds"] = np.array(self.bodies.sim_seconds)
-        out["optimum"] = np.array([np.nan if v is None else v for v in self.optimum])
         out["rejected"] = np.array([self.rejected[k] for k in REJECT_REASONS])
         if self.metabolism is not None:
             out.update(self.metabolism.snapshot())
@@ -390,7 +354,6 @@ class ArenaWorld:
         for k in self.STATE:
             getattr(self, k)[...] = state[k]
         self.tick = int(state["tick"])
-        self.optimum = [None if np.isnan(v) else float(v) for v in state["optimum"]]
         self.rejected = dict.fromkeys(REJECT_REASONS, 0)
         self.rejected.update({k: int(v) for k, v in zip(REJECT_REASONS, state["rejected"], strict=False)})
         if self.metabolism is not None:
@@ -413,36 +376,6 @@ class ArenaWorld:
     def remove_agent(self, agent: int) -> None:
         """The agent is gone: its body stops where it is and stays an obstacle."""
         self.present[agent] = False
-
-    # -------------------------------------------------------------- summary
-
-    def robot_summaries(self, optimum: list[float | None]) -> list[dict[str, Any]]:
-        """One row per robot that has been in the world."""
-        s = self.scenario
-        out = []
-        controllers = [g.controller for g in s.groups for _ in range(g.count)]
-        for a in np.flatnonzero(self.in_world).tolist():
-            # reached: it dwelt at its goal (a robot pushed off it afterwards keeps that), or ends within the radius
-            near = math.hypot(*(self.pose[a, :2] - self.goal[a])) < s.goal_radius
-            reached = bool(self.has_goal[a]) and (bool(self.finished[a]) or near)
-            lo = math.inf if optimum[a] is None else optimum[a]
-            lp = float(self.path_length[a])
-            out.append({
-                "agent": a, "controller": controllers[a],
-                "start": [round(float(v), 4) for v in self.start_pose[a]],
-                "goal": None if not self.has_goal[a] else [round(float(v), 4) for v in self.goal[a]],
-                "reached": reached,
-                "ticks_to_goal": int(self.reached_tick[a]) if self.reached_tick[a] >= 0 else None,
-                "path_length": round(lp, 4),
-                "optimal_length": None if not math.isfinite(lo) else round(lo, 4),
-                "path_ratio": round(lp / lo, 4) if reached and math.isfinite(lo) and lo > 0 else None,
-                "collisions": int(self.bodies.collisions[a]),
-                "distance": round(float(self.bodies.distance[a]), 4),
-                "blocked_seconds": round(float(self.bodies.blocked_seconds[a]), 3),
-                "pose": [round(float(v), 5) for v in self.pose[a]],
-                **({} if self.metabolism is None else self.metabolism.summary(a, s.control_period, self.tick)),
-            })  # fmt: skip
-        return out
 
 
 def default_cell(s: ArenaScenario) -> float:

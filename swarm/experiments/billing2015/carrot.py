@@ -51,13 +51,13 @@ def zmaze_pairs() -> list[tuple[int, float, float, float, float]]:
 
 def random_pairs(name: str, count: int, seed: int) -> list[tuple[int, float, float, float, float]]:
     """`count` pairs in scenario `name`, each from its own stream of the seed."""
-    from swarm.engines.arena import _planner
+    from swarm.engines.goals import optimum_planner
     from swarm.scenario import load_scenario
     from world_server.arena.scenario import clearance_at
 
     s = load_scenario(name)
     rects, segs = s.wall_rects(), s.wall_segments()
-    planner = _planner(s.size, s.walls)
+    planner = optimum_planner(s.size, s.walls)
     pairs = []
     for k in range(count):
         rng = np.random.default_rng([seed, PAIR_STREAM, k])

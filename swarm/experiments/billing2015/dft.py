@@ -159,7 +159,7 @@ def run_case3(job: tuple) -> dict:
     engine = ArenaEngine(s)
     ys, speeds, on_robot, path = [], [], False, [engine.world.pose[0, :2].copy()]
     w = engine.world
-    while not w.done():
+    while not engine.done():
         before = w.pose[0, :2].copy()
         engine.step()
         ys.append(float(w.pose[0, 1]))
@@ -301,7 +301,7 @@ def run_together(job: tuple) -> dict:
     condition, noise, run, appear, duration, seed, max_ticks = job
     engine = ArenaEngine(together_scenario(condition, appear, duration, noise, seed, max_ticks))
     w, ys = engine.world, []
-    while not w.done():
+    while not engine.done():
         engine.step()
         ys.append(float(w.pose[0, 1]))
     summary = engine.summary()

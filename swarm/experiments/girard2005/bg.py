@@ -159,7 +159,7 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
     present = [o for o in s.obstacles if o.zone is not None and o.name not in absent]
     engine = ArenaEngine(s)
     nav, visited = engine.controllers[0].nav, set()
-    while not engine.world.done():
+    while not engine.done():
         engine.step(1)
         xy = engine.world.pose[0, :2]
         visited |= {o.name for o in present if math.hypot(xy[0] - o.centre[0], xy[1] - o.centre[1]) <= o.reach}
@@ -187,7 +187,7 @@ def run_test(job: tuple) -> dict:
               max_ticks=int(TEST_SECONDS / s.control_period))  # fmt: skip
     engine = ArenaEngine(s)
     first_branch = None
-    while not engine.world.done():
+    while not engine.done():
         engine.step(1)
         x = float(engine.world.pose[0, 0])
         if first_branch is None and experiment == "bg-tmaze" and float(engine.world.pose[0, 1]) > 3.1:
@@ -311,10 +311,10 @@ def _forget_summary(rows: list[dict], direct: float) -> tuple[list[dict], str]:
 def direct_seconds(name: str, stops: tuple[str, ...] = ("Ep2", "Ep1")) -> float:
     """The most direct path from the start through the reach of each of `stops` in turn (A*), at the animat's
     top speed: bg-forget's is start, Ep2, Ep1; a control's, start to Ep1."""
-    from swarm.engines.arena import _planner
+    from swarm.engines.goals import optimum_planner
 
     s = load_scenario(name)
-    planner = _planner(s.size, s.walls)
+    planner = optimum_planner(s.size, s.walls)
     res = {o.name: o for o in s.obstacles}
     here, metres = tuple(s.groups[0].starts[0][:2]), 0.0
     for k, stop in enumerate(stops):  # into each reach but the last, on from its centre
