@@ -191,8 +191,10 @@ def test_a_benchmarks_quick_run_reports_text(name):
 
 
 def test_the_sensors_keep_their_order_and_each_draws_from_its_own_noise_streams():
-    # The order of a robot's ray blocks and readings; a stream shared by two sensors would correlate their noise.
-    assert SENSORS.names() == ("camera", "sonar", "ir", "laser", "odometry", "compass", "position", "contact", "zones")
+    # The order of a robot's ray blocks and readings (a sensor added later may come anywhere among them); a stream
+    # shared by two sensors would correlate their noise.
+    papers = ("camera", "sonar", "ir", "laser", "odometry", "compass", "position", "contact", "zones")
+    assert tuple(n for n in SENSORS.names() if n in papers) == papers
     streams = [k for cls in SENSORS for k in cls.streams]
     assert len(streams) == len(set(streams)) and 0 not in streams, streams
     assert len({cls.rank for cls in SENSORS}) == len(SENSORS.names())

@@ -413,8 +413,8 @@ def _robot(value, source: str, where: str) -> RobotModel:
             changes[key] = float(_get(value, key, (int, float), source, where=f"{where}.{key}"))
     if "colour" in value:
         changes["colour"] = _colour(value["colour"], source, f"{where}.colour")
+    changes["sensors"] = _sensors(value, model.sensors, source, where)
     model = replace(model, **changes)
-    model = replace(model, sensors=_sensors(value, model.sensors, source, where))
     for spec in model.sensors:
         try:
             spec.check(model)
