@@ -9,7 +9,7 @@ import pytest
 from swarm.engines.arena import ArenaEngine
 from swarm.scenario import bundled_scenarios, is_arena, load_scenario
 from tests.arena_helpers import arena
-from world_server.arena.face.robots import ZONE_KINDS
+from world_server.arena.face.sensors.zones import ZONE_KINDS
 from world_server.arena.world import ArenaWorld
 
 ARENAS = [

@@ -56,7 +56,7 @@ def test_a_full_energy_lasts_33_minutes_then_the_animat_dies_and_stops():
 
 
 def test_a_metabolism_step_gives_the_numpy_formulas_numbers_to_the_bit():
-    from world_server.arena.face.robots import ZONE_KINDS
+    from world_server.arena.face.sensors.zones import ZONE_KINDS
     from world_server.arena.metabolism import Metabolism, MetabolismParams
 
     rng = np.random.default_rng(9)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tests.arena_helpers import arena
-from world_server.arena.face.robots import IR_DISTANCE, IR_VALUE
+from world_server.arena.face.sensors.ir import IR_DISTANCE, IR_VALUE
 from world_server.arena.raycast import NO_HIT, brute_force
 from world_server.arena.world import ArenaWorld
 

@@ -1,7 +1,7 @@
-"""Every entry of the three registries does what it declares: each controller in its example scenario, each
-experiment's smoke run, each benchmark's quick run.  The tests are parametrized over the registries
-(swarm/core/registry.py), so a new controller, experiment or benchmark is tested here as soon as its folder
-declares it."""
+"""Every entry of the registries does what it declares: each controller in its example scenario, each
+experiment's smoke run, each benchmark's quick run, each arena sensor's table and readings.  The tests are
+parametrized over the registries (swarm/core/registry.py), so a new controller, experiment, benchmark or
+sensor is tested here as soon as its folder (its module, for a sensor) declares it."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ from swarm.engines.arena import ArenaEngine
 from swarm.experiments import EXPERIMENTS
 from swarm.scenario import is_arena, load_scenario
 from tests.arena_helpers import arena
-from world_server.arena.face.robots import SENSOR_KINDS
+from world_server.arena.face.sensors import SENSORS
 from world_server.arena.scenario import controller_params
 from world_server.grid.face import layout
 
@@ -55,8 +55,8 @@ def test_a_controllers_entry_names_real_sensors_kernels_parts_and_a_scenario_it_
     assert spec.world in ("grid", "arena"), f"{name}: world {spec.world!r}"
     assert spec.description and "\n" not in spec.description
     if spec.world == "arena":
-        unknown = set(spec.requires) - set(SENSOR_KINDS)
-        assert not unknown, f"{name} requires {sorted(unknown)}, not sensors of the arena's robots ({SENSOR_KINDS})"
+        unknown = set(spec.requires) - set(SENSORS.names())
+        assert not unknown, f"{name} requires {sorted(unknown)}, not sensors of the arena's robots ({SENSORS.names()})"
     else:
         assert spec.requires == (), f"{name}: a grid robot carries no sensor suite"
     for module in spec.kernels:
@@ -185,3 +185,101 @@ def test_a_benchmarks_quick_run_reports_text(name):
     json.dumps(result)  # the command line prints it with --json
     text = resolve(spec.report)(result)
     assert isinstance(text, str) and text.strip()
+
+
+# ---------------------------------------------------------------------- sensors
+
+
+def test_the_sensors_keep_their_order_and_each_draws_from_its_own_noise_streams():
+    # The order of a robot's ray blocks and readings (a sensor added later may come anywhere among them); a stream
+    # shared by two sensors would correlate their noise.
+    papers = ("camera", "sonar", "ir", "laser", "odometry", "compass", "position", "contact", "zones")
+    assert tuple(n for n in SENSORS.names() if n in papers) == papers
+    streams = [k for cls in SENSORS for k in cls.streams]
+    assert len(streams) == len(set(streams)) and 0 not in streams, streams
+    assert len({cls.rank for cls in SENSORS}) == len(SENSORS.names())
+
+
+def test_the_sensors_load_no_numba():
+    """An agent process reads the sensors' specs (the face) without the world's kernels."""
+    import subprocess
+    import sys
+
+    child = ("import sys; from world_server.arena.face.sensors import SENSORS; list(SENSORS); "
+             "import world_server.arena.face.robots; "
+             "print(sorted({m.split('.')[0] for m in sys.modules} & {'numba', 'scipy', 'rerun'}))")  # fmt: skip
+    out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == "[]", out.stdout + out.stderr[-2000:]
+
+
+def _changed_table(cls) -> dict:
+    """A table that sets every field of the sensor to something other than its default."""
+    table = {}
+    for f in cls.field_names():
+        v = getattr(cls(), f)
+        table[f] = ([round(x * 0.5, 6) for x in v] if isinstance(v, tuple) else v + 1 if isinstance(v, int)
+                    else v * 0.5 if v else 0.02)  # fmt: skip
+    if "mounts" in table:  # one per bearing, inside an e-puck
+        table["mounts"] = [0.03] * len(table["bearings"])
+    return table
+
+
+def _sensor_robot(name: str, table: str = "", more: str = "") -> str:
+    """One group of two e-pucks that carry only sensor `name` (its table: `table`)."""
+    return (f'[[group]]\ncount = 2\ncontroller = "wander"\n{more}'
+            f'robot = {{ model = "epuck", sensors = ["{name}"]{table} }}\n')  # fmt: skip
+
+
+def _inline(table: dict) -> str:
+    return "{ " + ", ".join(f"{k} = {json.dumps(v)}" for k, v in table.items()) + " }"
+
+
+@pytest.mark.parametrize("name", SENSORS.names())
+def test_a_sensor_parses_its_spec_from_a_scenarios_table(name):
+    cls = SENSORS[name]
+    table = _changed_table(cls)
+    spec = cls.from_table(table)
+    for f, v in table.items():
+        assert getattr(spec, f) == (tuple(v) if isinstance(v, list) else v) != getattr(cls(), f), f
+    extra = f", {name} = {_inline(table)}" if table else ""
+    robot = arena(_sensor_robot(name, extra), noise="high").groups[0].robot
+    assert robot.sensors.names() == [name] and getattr(robot.sensors, name) == spec
+
+
+@pytest.mark.parametrize("name", SENSORS.names())
+def test_a_bad_sensor_table_is_refused_in_one_line_that_names_the_field(name):
+    cls = SENSORS[name]
+    bad = {'sensors = ["radar"]': "group 1.robot.sensors", f"{name} = {{ nonsense = 1 }}": f"robot.{name}"}
+    if not cls.field_names():  # a sensor without fields has no table
+        bad[f"{name} = {{ nonsense = 1 }}"] = "robot"
+    else:
+        first = cls.field_names()[0]
+        bad[f'{name} = {{ {first} = "many" }}'] = f"group 1.robot.{name}.{first}"
+    for body, where in bad.items():
+        text = '[[group]]\ncount = 1\ncontroller = "wander"\nrobot = { model = "epuck", ' + body + " }\n"
+        with pytest.raises(ScenarioError) as err:
+            arena(text)
+        assert where in err.value.where and "\n" not in str(err.value), (body, str(err.value))
+
+
+@pytest.mark.parametrize("name", SENSORS.names())
+def test_a_sensor_reads_what_it_declares_in_a_small_arena_run(name):
+    """Each reading has the declared shape and dtype, at every tick, and crosses the wire as it is."""
+    from world_server.arena.face.wire import observations, parse_obs
+    from world_server.arena.world import ArenaWorld
+
+    starts = "starts = [[0.4, 0.45, 0.0], [0.4, 0.55, 0.3]]\n"  # facing a wall, near each other
+    world = ArenaWorld(
+        arena("[[wall]]\nrect = [0.45, 0.3, 0.5, 0.7]\n" + _sensor_robot(name, more=starts), noise="high")
+    )
+    declared = getattr(world.scenario.groups[0].robot.sensors, name).readings()
+    for tick in range(3):
+        perceptions = world.perceive()
+        received = parse_obs(observations(tick, [0, 1], perceptions)).perceptions
+        for p, q in zip(perceptions, received, strict=True):
+            assert list(p) == list(declared), (list(p), list(declared))
+            for key, (shape, dtype) in declared.items():
+                value = np.asarray(p[key])
+                assert value.shape == shape and value.dtype.str == dtype, (key, value.shape, value.dtype.str)
+                assert np.isfinite(value.astype(np.float64)).all() and np.array_equal(q[key], value), key
+        world.apply(np.full((2, 2), 0.05))

@@ -141,10 +141,14 @@ E = TypeVar("E", bound=Entry)
 class Registry(Generic[E]):
     """The entries of one kind of part, found in the subpackages of `package` (each declares
     `attribute`: an entry or a tuple of entries), folder by folder in name order, each folder's
-    entries in the order it declares them."""
+    entries in the order it declares them.  With `modules`, a plain module of `package` may
+    declare entries too (one module per part); with `key`, the entries are in its order instead
+    (a part that declares its own place: the arena's sensors)."""
 
-    def __init__(self, what: str, package: str, attribute: str):
+    def __init__(self, what: str, package: str, attribute: str, *, modules: bool = False,
+                 key: Callable[[E], Any] | None = None):  # fmt: skip
         self.what, self.package, self.attribute = what, package, attribute
+        self.modules, self.key = modules, key
         self._entries: dict[str, E] | None = None
 
     def _found(self) -> dict[str, E]:
@@ -152,13 +156,15 @@ class Registry(Generic[E]):
             found: dict[str, E] = {}
             root = importlib.import_module(self.package)
             for info in pkgutil.iter_modules(root.__path__, f"{self.package}."):
-                if not info.ispkg:
+                if not (info.ispkg or self.modules):
                     continue
                 declared = getattr(importlib.import_module(info.name), self.attribute, ())
                 for entry in declared if isinstance(declared, tuple) else (declared,):
                     if entry.name in found:
                         raise RuntimeError(f"two {self.what}s named {entry.name!r}: {info.name} and another")
                     found[entry.name] = entry
+            if self.key is not None:
+                found = {e.name: e for e in sorted(found.values(), key=self.key)}
             self._entries = found
         return self._entries
 

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from world_server.arena.face.robots import ZONE_KINDS
+from world_server.arena.face.sensors.zones import ZONE_KINDS
 
 ACTS = ("none", "ReloadE", "ReloadEp")
 ACT_ZONE = {1: "digesting", 2: "ingesting"}  # the zone kind each act needs

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -32,18 +32,9 @@ import numpy as np
 from swarm.core.errors import ScenarioError
 from swarm.core.registry import ControllerSpec
 from swarm.core.tables import no_unknown, typed
-from world_server.arena.face.robots import (
-    IR,
-    MODELS,
-    ZONE_KINDS,
-    Camera,
-    Compass,
-    Laser,
-    Odometry,
-    Position,
-    RobotModel,
-    Sonar,
-)
+from world_server.arena.face.robots import MODELS, RobotModel
+from world_server.arena.face.sensors import SENSORS, Sensors
+from world_server.arena.face.sensors.zones import ZONE_KINDS
 from world_server.arena.metabolism import MetabolismParams
 from world_server.arena.sensors import NOISE_LEVELS, Noise
 
@@ -350,8 +341,11 @@ _TOP = {
     "routes",
     "metabolism",
 }
-_SENSORS = {"camera": Camera, "sonar": Sonar, "ir": IR, "laser": Laser, "odometry": Odometry, "compass": Compass,
-            "position": Position}  # fmt: skip
+
+
+def _tabled() -> tuple[str, ...]:
+    """The sensors a scenario's [robot.<name>] and [noise] tables may name: those with fields."""
+    return SENSORS.names(lambda cls: bool(cls.field_names()))
 
 
 def parse_arena(data: dict, source: str, default_name: str, controllers: Mapping[str, ControllerSpec]) -> ArenaScenario:
@@ -410,7 +404,7 @@ def _robot(value, source: str, where: str) -> RobotModel:
     if not isinstance(value, dict):
         raise ScenarioError(source, where, "expected a model name or a [robot] table")
     allowed = {"model", "name", "radius", "axle", "max_wheel_speed", "max_speed", "max_turn_rate", "colour",
-               "sensors", *_SENSORS}  # fmt: skip
+               "sensors", *_tabled()}  # fmt: skip
     no_unknown(value, allowed, source, f"[{where}]")
     model = _robot(value.get("model", "epuck"), source, f"{where}.model")
     changes: dict[str, Any] = {"name": _get(value, "name", str, source, model.name, f"{where}.name")}
@@ -419,34 +413,36 @@ def _robot(value, source: str, where: str) -> RobotModel:
             changes[key] = float(_get(value, key, (int, float), source, where=f"{where}.{key}"))
     if "colour" in value:
         changes["colour"] = _colour(value["colour"], source, f"{where}.colour")
+    changes["sensors"] = _sensors(value, model.sensors, source, where)
     model = replace(model, **changes)
-    sensors = model.sensors
+    for spec in model.sensors:
+        try:
+            spec.check(model)
+        except ValueError as exc:
+            field_name, _, message = str(exc).partition(": ")
+            raise ScenarioError(source, f"{where}.{spec.name}.{field_name}", message) from None
+    return model
+
+
+def _sensors(value: dict, sensors: Sensors, source: str, where: str) -> Sensors:
+    """A [robot] table's sensors: its `sensors` list (each named one kept or at its defaults, the
+    others left out), then each [robot.<name>] table over that sensor's spec (adding it)."""
     if "sensors" in value:
-        names = value["sensors"]
-        kinds = {*_SENSORS, "contact", "zones"}
+        names, kinds = value["sensors"], SENSORS.names()
         if not isinstance(names, list) or not all(isinstance(n, str) and n in kinds for n in names):
             raise ScenarioError(source, f"{where}.sensors", f"expected a list of {', '.join(sorted(kinds))}")
-        sensors = replace(
-            sensors,
-            **{k: (getattr(sensors, k) or _SENSORS[k]()) if k in names else None for k in _SENSORS},
-            contact="contact" in names,
-            zones="zones" in names,
-        )
-    for key, cls in _SENSORS.items():
+        sensors = Sensors(**{k: (getattr(sensors, k) or True) if k in names else None for k in kinds})
+    for key in _tabled():
         if key in value:
             table = _table(value, key, source, f"{where}.{key}")
-            no_unknown(table, {f.name for f in fields(cls)}, source, f"[{where}.{key}]")
-            base = getattr(sensors, key) or cls()
-            typed = {k: tuple(float(x) for x in v) if isinstance(v, list) else
-                     (int(v) if isinstance(getattr(base, k), int) and not isinstance(getattr(base, k), bool)
-                      else float(v)) for k, v in table.items()}  # fmt: skip
-            sensors = replace(sensors, **{key: replace(base, **typed)})
-    model = replace(model, sensors=sensors)
-    try:
-        model.ir_mounts()
-    except ValueError as exc:
-        raise ScenarioError(source, f"{where}.ir.mounts", str(exc).partition(": ")[2]) from None
-    return model
+            cls = SENSORS[key]
+            no_unknown(table, set(cls.field_names()), source, f"[{where}.{key}]")
+            try:
+                sensors = sensors.changed(**{key: cls.from_table(table, getattr(sensors, key))})
+            except ValueError as exc:
+                field_name, _, message = str(exc).partition(": ")
+                raise ScenarioError(source, f"{where}.{key}.{field_name}", message) from None
+    return sensors
 
 
 def _noise(value, source: str) -> Noise:
@@ -462,9 +458,9 @@ def _noise(value, source: str) -> Noise:
     for k in value:
         if k == "level":
             continue
-        if k not in {*_SENSORS, "map"}:
+        if k not in {*_tabled(), "map"}:
             raise ScenarioError(source, f"noise.{k}", f"unknown sensor; expected level or one of "
-                                f"{', '.join(sorted(_SENSORS))}")  # fmt: skip
+                                f"{', '.join(sorted(_tabled()))}")  # fmt: skip
         scales.append((k, float(_get(value, k, (int, float), source, where=f"noise.{k}"))))
     return replace(base, scale=tuple(scales))
 
@@ -606,7 +602,7 @@ def check_arena(s: ArenaScenario, source: str) -> None:
                                 "wheel speed and turn rate")  # fmt: skip
         if g.count < 1:
             raise ScenarioError(source, f"group {gi + 1}.count", f"expected at least 1, got {g.count}")
-        missing = [k for k in s.known_controllers[g.controller].requires if not getattr(m.sensors, k)]
+        missing = [k for k in s.known_controllers[g.controller].requires if k not in m.sensors]
         if missing:
             raise ScenarioError(source, f"group {gi + 1}.robot", f"{g.controller} needs the {' and '.join(missing)} "
                                 f"sensor(s), which the {m.name} lacks; add them: robot = {{ model = \"{m.name}\", "
@@ -733,9 +729,7 @@ def controller_params(s: ArenaScenario, agent: int) -> dict[str, Any]:
             "max_wheel_speed": m.max_wheel_speed,
             "max_speed": m.max_speed,
             "max_turn_rate": m.max_turn_rate,
-            "laser_range": m.sensors.laser.range if m.sensors.laser else None,
-            "ir_bearings": list(m.sensors.ir.bearings) if m.sensors.ir else None,
-            "ir_mounts": m.ir_mounts().tolist() if m.sensors.ir else None,
+            **{k: v for cls in SENSORS for k, v in cls.tells(getattr(m.sensors, cls.name), m).items()},
         },
         "control_period": s.control_period,
         "noise": s.noise.level,

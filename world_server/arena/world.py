@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from world_server.arena.drive import DiffDrive
-from world_server.arena.face.robots import ZONE_KINDS
+from world_server.arena.face.sensors.zones import ZONE_KINDS
 from world_server.arena.metabolism import ACTS, Metabolism
 from world_server.arena.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
 from world_server.arena.scenario import ArenaScenario
@@ -167,7 +167,7 @@ class ArenaWorld:
             if keep.any():
                 ranges[keep], what[keep] = self.cast(*(part[keep] for part in joined[:3]),
                                                      (joined[3][keep], joined[4][keep]), joined[5][keep])  # fmt: skip
-        rgb = self.hit_colours(what) if any(s.model.sensors.camera for s in self.suites) else None
+        rgb = self.hit_colours(what) if any(s.colours for s in self.suites) else None
         out, k = [], 0
         for suite in self.suites:
             n, per = len(suite.robots), suite.per_robot

@@ -25,7 +25,7 @@ from agents.controllers.bg.places import DIRECTIONS, WAYS, Navigator, NavParams
 from agents.controllers.bg.saliences import SALIENCES, Drives, saliences
 from agents.controllers.bg.senses import RESOURCES, Reflex, sense
 from swarm.core.tables import params_from_table
-from world_server.arena.face.robots import ZONE_KINDS
+from world_server.arena.face.sensors.zones import ZONE_KINDS
 
 USABLE_ZONE = {"DA": "dangerous", "Ep": "ingesting", "E": "digesting"}
 USABLE_BITS = {r: 1 << ZONE_KINDS.index(z) for r, z in USABLE_ZONE.items()}  # in the world's `zones` reading

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from world_server.arena.face.robots import IR_DISTANCE, IR_VALUE
+from world_server.arena.face.sensors.ir import IR_DISTANCE, IR_VALUE
 
 NEVER = -1
 MAX_CELLS = 4096  # most cells one publication may name

@@ -21,7 +21,7 @@ import numpy as np
 
 from swarm.core.rng_scalar import draw_unit
 from swarm.core.tables import params_from_table
-from world_server.arena.face.robots import IR_DISTANCE, IR_VALUE
+from world_server.arena.face.sensors.ir import IR_DISTANCE, IR_VALUE
 
 
 @dataclass(frozen=True)

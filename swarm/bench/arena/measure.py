@@ -20,7 +20,9 @@ from statistics import median
 
 import numpy as np
 
-from world_server.arena.face.robots import ANIMAT, EPUCK, Laser, RobotModel, Sensors
+from world_server.arena.face.robots import ANIMAT, EPUCK, RobotModel
+from world_server.arena.face.sensors import Sensors
+from world_server.arena.face.sensors.laser import Laser
 from world_server.arena.scenario import ArenaScenario, Group, Wall
 from world_server.arena.world import ArenaWorld
 
