@@ -1,11 +1,15 @@
 """The architecture's numbers: import cycles, upward imports, generic modules that name a controller,
-and functions over 60 lines.
+generic modules that branch on a world kind, and functions over 60 lines.
 
     python scripts/architecture_report.py          # a table; tests/test_layers.py enforces the first two
 
 Generic modules are the ones every controller passes through: the world process and servers, the
 agent runtimes, the engines, the recorder, the review, the command line and the scenario loader.
-A module "names a controller" when a controller's name appears in it as a string literal.
+A module "names a controller" when a controller's name appears in it as a string literal.  A module
+"branches on a world kind" when it compares with a kind's name (`kind == "arena"`, `kind in (...)`) or
+tests a predicate named after a kind (`is_arena(...)`); a world kind's own modules (its folder
+world_server/<kind>/, and the modules named after it: swarm/engines/<kind>.py, agents/<kind>_runtime.py,
+swarm/cli_<kind>.py, ...) are left out, since they are that kind's.
 Kernels (functions compiled with numba) are left out of the length count: one loop each by design.
 """
 
@@ -22,7 +26,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 GENERIC = ("world_server/server.py", "world_server/grid/server.py", "world_server/arena/server.py",
            "agents/runtime.py", "agents/grid_runtime.py", "agents/arena_runtime.py", "agents/runtimes.py",
            "swarm/world_process.py", "swarm/engines", "swarm/launcher.py", "swarm/monitor.py", "swarm/recording",
-           "swarm/review", "swarm/cli.py", "swarm/cli_arena.py", "swarm/cli_reproduce.py",
+           "swarm/review", "swarm/cli.py", "swarm/cli_arena.py", "swarm/cli_grid.py", "swarm/cli_reproduce.py",
            "swarm/scenario.py")  # fmt: skip
 LONG = 60
 
@@ -61,6 +65,38 @@ def generic_naming_controllers() -> list[str]:
     return out
 
 
+def is_kinds_own(rel: str, kinds: set[str]) -> bool:
+    """A module of one world kind: in its folder, or named after it (grid.py, arena_runtime.py, cli_arena.py)."""
+    parts = rel.removesuffix(".py").split("/")
+    return (parts[0] == "world_server" and len(parts) > 2 and parts[1] in kinds) or bool(
+        kinds & set(parts[-1].split("_"))
+    )
+
+
+def generic_branching_on_a_kind() -> list[str]:
+    from world_server import WORLD_KINDS
+
+    kinds = set(WORLD_KINDS.names())
+    predicates = {f"is_{k}" for k in kinds}
+    out = []
+    for path in python_files():
+        rel = path.relative_to(ROOT).as_posix()
+        if not any(rel == g or rel.startswith(g + "/") for g in GENERIC) or is_kinds_own(rel, kinds):
+            continue
+        found = []
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Compare):
+                sides = [node.left, *node.comparators]
+                named = {c.value for side in sides for c in ast.walk(side) if isinstance(c, ast.Constant)} & kinds
+                found += [f"{node.lineno}: compares with {', '.join(sorted(named))}"] if named else []
+            elif isinstance(node, ast.Call):
+                name = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
+                found += [f"{node.lineno}: {name}()"] if name in predicates else []
+        if found:
+            out.append(f"{rel} ({'; '.join(found)})")
+    return out
+
+
 def main() -> None:
     import grimp
     from test_layers import PACKAGES, imports, upward
@@ -79,11 +115,13 @@ def main() -> None:
         cycles = f"at least 1: {' -> '.join(exc.args[1])}"
     ups = sorted(upward(graph))
     generic = generic_naming_controllers()
+    branching = generic_branching_on_a_kind()
     longs = long_functions()
     print(f"modules: {len(graph.modules)}")
     print(f"import cycles (function-level imports included): {cycles}")
     print(f"upward imports: {len(ups)}" + "".join(f"\n  {m} -> {t}" for m, t in ups))
     print(f"generic modules naming a controller: {len(generic)}" + "".join(f"\n  {g}" for g in generic))
+    print(f"generic modules that branch on a world kind: {len(branching)}" + "".join(f"\n  {b}" for b in branching))
     print(f"non-kernel functions over {LONG} lines: {len(longs)}" + "".join(f"\n  {n} {w}" for n, w in longs))
 
 

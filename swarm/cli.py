@@ -9,21 +9,13 @@ import sys
 from pathlib import Path
 
 from agents.controllers import CONTROLLERS as CONTROLLER_REGISTRY
-from swarm.cli_arena import (
-    add_arena_run_args,
-    add_sense_parser,
-    arena_overrides,
-    arena_world_args,
-    cmd_sense,
-    print_arena_summary,
-    run_arena,
-)
 from swarm.cli_reproduce import add_reproduce_parser, cmd_reproduce
 from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_interrupt
 from swarm.core.registry import Option, Registry, resolve
 from swarm.core.tables import positive, seed
-from swarm.scenario import PRESET_HELP, bundled_scenarios, is_arena, load_scenario
-from world_server.grid.scenario import DEFAULT_CONTROLLER, check_until
+from swarm.scenario import PRESET_HELP, bundled_scenarios, load_scenario
+from world_server import WORLD_KINDS, kind_of
+from world_server.grid.scenario import DEFAULT_CONTROLLER
 
 CONTROLLERS = CONTROLLER_REGISTRY.names()
 
@@ -71,7 +63,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_status(sub)
     _add_router(sub)
     _add_prepare(sub)
-    add_sense_parser(sub)
+    for kind in WORLD_KINDS:  # a world kind's own commands (swarm sense); each sets its handler
+        for add_command in kind.commands:
+            resolve(add_command)(sub)
     sub.add_parser("scenarios", help="list presets and bundled scenarios")
     return parser
 
@@ -90,8 +84,8 @@ def _add_run(sub) -> None:
     run.add_argument("--agents", type=positive, help="number of agents (default: the scenario's)")
     run.add_argument("--controller", choices=CONTROLLERS, help="controller to run")
     run.add_argument("--seed", type=seed, help="seed of the map and of every random choice")
-    _physics_args(run)
-    add_arena_run_args(run)
+    _kind_options(run, titled=False)
+    _kind_options(run, titled=True)
     _record_args(run, "write a rerun recording of the run to FILE (.rrd)")
     run.add_argument(
         "--until",
@@ -354,11 +348,12 @@ def _viewer_url(viewer: str | None) -> str | None:
     return "rerun+http://127.0.0.1:9876/proxy"
 
 
-def _physics_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--physics", choices=["ideal", "physical"],
-                   help="robot bodies: ideal = instant cell-to-cell moves, the paper's (default); physical = pymunk "
-                   "discs that drive between cell centres, collide and queue")  # fmt: skip
-    p.add_argument("--body-diameter", type=float, metavar="D", help="physical bodies' diameter in cells (default 0.4)")
+def _kind_options(p: argparse.ArgumentParser, titled: bool) -> None:
+    """The world kinds' run options: those without a title of their own among the command's
+    options, or those with one, each kind's in its own section."""
+    for kind in WORLD_KINDS:
+        if kind.options is not None and (kind.options_title is not None) == titled:
+            resolve(kind.options)(p.add_argument_group(kind.options_title) if titled else p)
 
 
 def _scenario_args(p: argparse.ArgumentParser) -> None:
@@ -366,11 +361,11 @@ def _scenario_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--agents", type=positive, help="number of agents (default: the scenario's)")
     p.add_argument("--controller", choices=CONTROLLERS, help="controller to run")
     p.add_argument("--seed", type=seed, help="seed of the map and of every random choice")
-    _physics_args(p)
+    _kind_options(p, titled=False)
     p.add_argument("--until", choices=["foraged", "converged", "both"], default="foraged", help="when the run ends")
     p.add_argument("--max-iterations", type=positive, default=1_000_000, metavar="M", help="stop after M ticks")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
-    add_arena_run_args(p)
+    _kind_options(p, titled=True)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -381,7 +376,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     signal.signal(signal.SIGTERM, raise_interrupt)
     try:
-        return COMMANDS[args.command](args)
+        return (COMMANDS.get(args.command) or args.handler)(args)
     except (ScenarioError, RecordingError) as exc:
         print(f"swarm: error: {exc}", file=sys.stderr)
         return 2
@@ -393,44 +388,24 @@ def main(argv: list[str] | None = None) -> int:
         return 130
 
 
-def _print_summary(summary: dict, as_json: bool, until: str) -> int:
-    if as_json:
-        print(json.dumps(summary))
-    else:
-        state = "finished" if summary["finished"] else f"NOT finished ({until})"
-        print(
-            f"{summary['scenario']}: {summary['controller']} x{summary['agents']}, seed {summary['seed']}: "
-            f"{state} after {summary['iterations']} iterations\n"
-            f"  delivered {summary['delivered']}/{summary['total']}, explored "
-            f"{summary['explored_cells']}/{summary['reachable_cells']} cells, optimal marks "
-            f"{summary['optimal_cells']}/{summary['reachable_cells']} (APF optimal: {summary['apf_optimal']})"
-        )
-        if "agents_lost" in summary:
-            print(
-                f"  {summary['ticks_per_second']} ticks/s, rejected messages {summary['rejected_messages']}, "
-                f"agents joined {summary['joins']} (at most {summary.get('agents_peak')} at once), "
-                f"lost {summary['agents_lost']}, missed ticks {summary['missed_ticks']}"
-            )
-    return 0 if summary["finished"] else 1
-
-
 def _scenario(args):
     scenario = load_scenario(args.scenario)
     common = {"agents": args.agents, "controller": args.controller, "seed": args.seed}
-    if is_arena(scenario):
-        return scenario.with_overrides(**common, **arena_overrides(args))
-    if args.controller is not None and CONTROLLER_REGISTRY[args.controller].world == "arena":
-        raise ScenarioError("command line", "controller", f"{args.controller} drives arena robots; pick an arena "
-                            "scenario (zmaze, large-maze, ...) or a grid controller")  # fmt: skip
-    return scenario.with_overrides(**common, physics=args.physics, body_diameter=args.body_diameter)
+    return resolve(kind_of(scenario).overrides)(scenario, args, common)
+
+
+def _check(scenario, until: str) -> None:
+    """A run the world kind refuses before its processes start (the grid: an end rule its controller
+    cannot reach)."""
+    if (check := kind_of(scenario).check) is not None:
+        resolve(check)(scenario, until)
 
 
 def cmd_world(args) -> int:
     from swarm.world_process import serve
 
     scenario = _scenario(args)
-    if not is_arena(scenario):
-        check_until(scenario, args.until)
+    _check(scenario, args.until)
     summary = serve(scenario, args.run_id, args.summary_file, quiet=args.quiet,
                     listen=None if args.connect else args.listen,
                     connect=args.connect, deadline=args.deadline, max_misses=args.max_misses, until=args.until,
@@ -465,50 +440,31 @@ def cmd_up(args) -> int:
     from world_server.server import new_run_id
 
     scenario = _scenario(args)
-    if not is_arena(scenario):
-        check_until(scenario, args.until)
+    _check(scenario, args.until)
     run_id = args.run_id or new_run_id()
     record = None if args.no_record else (args.record or f"runs/{run_id}.rrd")
-    arena = is_arena(scenario)
-    summary = swarm_up(args.scenario, scenario.agents, args.controller if arena else scenario.controller, args.seed,
-                       run_id, args.listen, args.until, args.max_iterations, args.deadline,
+    kind_options = resolve(kind_of(scenario).up_options)(scenario, args)  # its controller, bodies, world options
+    summary = swarm_up(args.scenario, scenario.agents, seed=args.seed, run_id=run_id, listen=args.listen,
+                       until=args.until, max_iterations=args.max_iterations, deadline=args.deadline,
                        progress=not args.json and sys.stderr.isatty(), mode=args.mode, rate=args.rate,
-                       physics=None if arena else scenario.physics, record=record, viewer=args.viewer,
-                       world_args=arena_world_args(args))  # fmt: skip
+                       record=record, viewer=args.viewer, **kind_options)  # fmt: skip
     if summary.get("recording"):
         _point_at_recording(summary["recording"])
     return _print_any(summary, args.json, args.until)
 
 
 def _print_any(summary: dict, as_json: bool, until: str) -> int:
-    if summary.get("kind") == "arena":
-        return print_arena_summary(summary, as_json)
-    return _print_summary(summary, as_json, until)
+    """The summary as its world kind prints it; the exit status (0: finished)."""
+    return resolve(kind_of(summary).print_summary)(summary, as_json, until)
 
 
 def cmd_run(args) -> int:
-    from swarm.engines.grid import Engine
-
     scenario = _scenario(args)
-    if is_arena(scenario):
-        return run_arena(args, scenario, _viewer_url(args.viewer) if args.record else None)
-    engine = Engine(scenario)
-    recorder = None
+    kind = kind_of(scenario)
+    summary = resolve(kind.run)(scenario, args, _viewer_url(args.viewer) if args.record else None)
     if args.record:
-        from swarm.recording.grid import Recorder, run_meta
-
-        meta = run_meta(scenario, engine.world, Path(args.record).stem, args.until, "in-process")
-        recorder = Recorder(args.record, engine.world, meta, viewer=_viewer_url(args.viewer))
-    summary = None
-    try:
-        summary = engine.run(args.until, args.max_iterations, progress=not args.json and sys.stderr.isatty(),
-                             recorder=recorder).summary  # fmt: skip
-    finally:
-        if recorder is not None:
-            recorder.close(summary)
-    if recorder is not None:
         _point_at_recording(args.record)
-    return _print_summary(summary, args.json, args.until)
+    return resolve(kind.print_summary)(summary, args.json, args.until)
 
 
 def _point_at_recording(path: str) -> None:
@@ -580,8 +536,8 @@ def cmd_status(args) -> int:
         print(f"router at {args.connect}: up")
     else:
         state = "ended" if info.get("ended") else "running"
-        done = (f"reached {info['reached']}/{info['with_goal']}" if info.get("kind") == "arena"
-                else f"delivered {info['delivered']}/{info['total']}")  # fmt: skip
+        done, total = kind_of(info).progress
+        done = f"{done} {info[done]}/{info[total]}"
         print(f"run {args.run_id}: {state} at tick {info['iterations']}, {done}, {info['agents_alive']} agents alive")
     return 0
 
@@ -596,7 +552,7 @@ def cmd_router(args) -> int:
 def cmd_prepare(args) -> int:
     from swarm.launcher import prepare
 
-    aot_built = prepare(progress=True, engine=True, arena=True)
+    aot_built = prepare(progress=True, engine=True, every_kind=True)
     print(f"swarm: kernels compiled; agents' ahead-of-time step: {'built' if aot_built else 'MISSING (JIT fallback)'}")
     return 0 if aot_built or not args.require_aot else 1
 
@@ -610,7 +566,7 @@ def cmd_scenarios(args) -> int:
 COMMANDS = {"run": cmd_run, "experiment": cmd_experiment, "bench": cmd_bench, "scenarios": cmd_scenarios,
             "world": cmd_world, "agent": cmd_agent, "up": cmd_up, "replay": cmd_replay,
             "report": cmd_report, "monitor": cmd_monitor, "status": cmd_status, "router": cmd_router,
-            "prepare": cmd_prepare, "sense": cmd_sense, "reproduce": cmd_reproduce}  # fmt: skip
+            "prepare": cmd_prepare, "reproduce": cmd_reproduce}  # fmt: skip
 
 
 if __name__ == "__main__":

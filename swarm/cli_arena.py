@@ -1,4 +1,5 @@
-"""The arena's side of the `swarm` command: run options, the summary, `swarm sense`."""
+"""The arena's side of the `swarm` command (its world kind's entry names these): run options,
+`swarm run` in one process, the summary, `swarm sense`."""
 
 from __future__ import annotations
 
@@ -25,8 +26,8 @@ def _floats(n_min: int, n_max: int, what: str):
     return parse
 
 
-def add_arena_run_args(p: argparse.ArgumentParser) -> None:
-    g = p.add_argument_group("arena scenarios")
+def add_arena_run_args(g) -> None:
+    """The arena's run options, into their own section of --help (the entry's options_title)."""
     g.add_argument("--start", type=_floats(2, 3, "X,Y or X,Y,THETA (metres, radians)"), metavar="X,Y[,THETA]",
                    help="start pose of a one-robot run")  # fmt: skip
     g.add_argument("--goal", type=_floats(2, 2, "X,Y (metres)"), metavar="X,Y", help="goal of a one-robot run")
@@ -34,8 +35,17 @@ def add_arena_run_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--max-ticks", type=int, metavar="T", help="stop after T control periods")
 
 
-def arena_overrides(args) -> dict:
-    return {k: getattr(args, k, None) for k in ("start", "goal", "noise", "max_ticks")}
+def arena_overrides(scenario, args, common: dict):
+    """The scenario with the command line's values (`common`: agents, controller, seed)."""
+    return scenario.with_overrides(
+        **common, **{k: getattr(args, k, None) for k in ("start", "goal", "noise", "max_ticks")}
+    )
+
+
+def arena_up_options(scenario, args) -> dict:
+    """swarm_up's keywords for an arena run: the controller asked for (None: each group's own) and
+    the arena options for the world process."""
+    return {"controller": args.controller, "world_args": arena_world_args(args)}
 
 
 def arena_world_args(args) -> list[str]:
@@ -51,7 +61,8 @@ def arena_world_args(args) -> list[str]:
     return out
 
 
-def run_arena(args, scenario, viewer: str | None = None) -> int:
+def run_arena(scenario, args, viewer: str | None = None) -> dict:
+    """`swarm run` of an arena scenario: the engine, recorded with --record; its summary."""
     from pathlib import Path
 
     from swarm.engines.arena import ArenaEngine
@@ -70,13 +81,10 @@ def run_arena(args, scenario, viewer: str | None = None) -> int:
     finally:
         if recorder is not None:
             recorder.close(summary)
-    if recorder is not None:
-        print(f"recording: {args.record}\n  open it:           swarm replay {args.record}   (or --web)\n"
-              f"  summary and plots: swarm report {args.record}", file=sys.stderr)  # fmt: skip
-    return print_arena_summary(summary, args.json)
+    return summary
 
 
-def print_arena_summary(summary: dict, as_json: bool) -> int:
+def print_arena_summary(summary: dict, as_json: bool, until: str | None = None) -> int:
     if as_json:
         print(json.dumps(summary))
     else:
@@ -140,10 +148,11 @@ def sense(scenario, pose: tuple[float, ...], group: int = 0) -> dict:
 
 
 def cmd_sense(args) -> int:
-    from swarm.scenario import is_arena, load_scenario
+    from swarm.scenario import load_scenario
+    from world_server import kind_of
 
     scenario = load_scenario(args.scenario)
-    if not is_arena(scenario):
+    if kind_of(scenario).name != "arena":
         raise ScenarioError(args.scenario, "kind", "swarm sense is for arena scenarios")
     if args.noise:
         scenario = scenario.with_overrides(noise=args.noise)
@@ -163,6 +172,7 @@ def cmd_sense(args) -> int:
 
 
 def add_sense_parser(sub) -> None:
+    """`swarm sense`, a command of the arena's (its entry's commands)."""
     p = sub.add_parser("sense", help="print what a robot senses at a pose (arena scenarios)",
                        description="Place one robot of the scenario at a pose, alone, and print every reading of "
                        "its sensors at tick 0: a debugging aid, and a way to check a sensor by hand.")  # fmt: skip
@@ -172,3 +182,4 @@ def add_sense_parser(sub) -> None:
     p.add_argument("--group", type=int, default=1, help="whose robot model (the scenario's group number, default 1)")
     p.add_argument("--noise", choices=["none", "low", "high"], help="noise level (default: the scenario's)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(handler=cmd_sense)

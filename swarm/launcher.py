@@ -24,13 +24,13 @@ import time
 from pathlib import Path
 
 from agents.controllers import aot
-from agents.controllers.grid.envelope import warm_up
 from swarm.core import wire
 from swarm.core.bus import open_client
 from swarm.core.errors import RunError, raise_interrupt
-from swarm.scenario import is_arena, load_scenario
+from swarm.core.registry import resolve
+from swarm.scenario import load_scenario
+from world_server import WORLD_KINDS, kind_of, progress_keys, world_kind
 from world_server.grid.scenario import PhysicsParams
-from world_server.grid.world import GridWorld
 
 
 def _terminate(procs: list[subprocess.Popen], grace: float = 5.0) -> None:
@@ -78,12 +78,13 @@ def swarm_up(
         signal.signal(signal.SIGTERM, previous)
 
 
-def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = False, arena: bool = False) -> bool:
+def prepare(scenario_ref: str | None = None, progress: bool = True, engine: bool = False,
+            every_kind: bool = False) -> bool:  # fmt: skip
     """Compile everything a run needs before it starts: the agents' ahead-of-time
-    step (in a subprocess, in parallel), the controller and world kernels, and
-    with `engine` the in-process engine loop; the arena's ray pass, drive and
-    A* for an arena scenario or with `arena`.  Returns whether the
-    ahead-of-time build exists.  Container images run it at build time."""
+    step (in a subprocess, in parallel) and what the scenario's world kind warms
+    up (its world and controller kernels; with `engine` its in-process engine);
+    with `every_kind`, every world kind's, on its example scenario.  Returns
+    whether the ahead-of-time build exists.  Container images run it at build time."""
     builder = None
     if aot.built() is None:  # agent processes run this build without numba (~35 MB instead of ~150)
         if progress:
@@ -91,20 +92,13 @@ def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = 
                   file=sys.stderr)  # fmt: skip
         builder = subprocess.Popen([sys.executable, "-m", "agents.controllers.aot"], stdout=subprocess.DEVNULL,
                                    stderr=subprocess.PIPE, text=True)  # fmt: skip
-    warm_up()  # once here, so N agents starting together find the kernels in the cache,
-    scenario = load_scenario(scenario_ref)
-    if arena or is_arena(scenario):  # the ray pass and A* (arena agents plan with it)
-        from swarm.engines.arena import ArenaEngine
-
-        ArenaEngine(scenario if is_arena(scenario) else load_scenario("zmaze")).step(1)
-    if is_arena(scenario):
-        scenario = load_scenario("setup2")
-    scenario = scenario.with_overrides(agents=2)
-    GridWorld(scenario).warm_up()  # and so does the world
-    if engine:
-        from swarm.engines.grid import Engine
-
-        Engine(scenario).step(2)
+    # once here, so N agents starting together find the kernels in the cache
+    if every_kind:
+        for kind in WORLD_KINDS:
+            resolve(kind.warm_up)(load_scenario(kind.example), engine)
+    else:
+        scenario = load_scenario(scenario_ref or world_kind().example)
+        resolve(kind_of(scenario).warm_up)(scenario, engine)
     if builder is not None and builder.wait() != 0:
         print(f"swarm: note: the ahead-of-time build failed, agents use the JIT (more memory):\n"
               f"{builder.stderr.read()[-1500:]}", file=sys.stderr)  # fmt: skip
@@ -113,15 +107,9 @@ def prepare(scenario_ref: str = "setup2", progress: bool = True, engine: bool = 
 
 def _agent_counts(scenario_ref: str, agents: int, controller: str | None) -> list[tuple[str, int]]:
     """(controller, agents) for every kind of agent process the run needs."""
-    scenario = load_scenario(scenario_ref)
-    if controller is not None or not is_arena(scenario):
-        return [(controller or scenario.controller, agents)]
-    if len(scenario.groups) == 1:
-        return [(scenario.groups[0].controller, agents)]
-    counts: dict[str, int] = {}
-    for g in scenario.groups:
-        counts[g.controller] = counts.get(g.controller, 0) + g.count
-    return list(counts.items())
+    if controller is not None:
+        return [(controller, agents)]
+    return load_scenario(scenario_ref).agent_processes(agents)
 
 
 def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null) -> dict:
@@ -259,8 +247,9 @@ def _follow(session, keys: wire.Keys, children: _Children, agents: int, progress
                     raise children.failure(failed)
                 for p in procs[1:]:
                     rss[p.pid] = max(rss.get(p.pid, 0), _rss_kb(p.pid))
-            bar.total = msg.get("total", msg.get("with_goal"))
-            bar.n = msg.get("delivered", msg.get("reached", 0))
+            done, total = progress_keys(msg)
+            bar.total = msg.get(total)
+            bar.n = msg.get(done, 0)
             bar.set_postfix(tick=msg.get("tick"), alive=f"{msg.get('agents_alive')}/{agents}",
                             tps=msg.get("ticks_per_second"))  # fmt: skip
             bar.refresh()

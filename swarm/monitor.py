@@ -18,6 +18,7 @@ import time
 from swarm.core import wire
 from swarm.core.bus import open_client, open_router
 from swarm.core.wire import world_info
+from world_server import progress_keys
 
 
 def status(connect: str, run_id: str, router_only: bool = False, timeout: float = 3.0) -> dict | None:
@@ -84,20 +85,20 @@ def monitor(connect: str, run_id: str, progress: bool, log_every: float = 5.0, s
             if state is None:
                 continue
             waiting = state.get("tick", 0) == 0 and info is not None  # the world waits for its first agents
+            done, total = progress_keys(state)
             if progress:
                 bar.set_description(f"waiting for agents {info['agents_alive']}/{info['start_with']}"
                                     if waiting else "done")  # fmt: skip
-                bar.total = state.get("total", state.get("with_goal"))
-                bar.n = state.get("delivered", state.get("reached", 0))
+                bar.total = state.get(total)
+                bar.n = state.get(done, 0)
                 bar.set_postfix(tick=state.get("tick"), alive=state.get("agents_alive"),
                                 tps=state.get("ticks_per_second"))  # fmt: skip
                 bar.refresh()
             elif time.monotonic() - last_log >= log_every:
                 last_log = time.monotonic()
-                done = (f"delivered {state.get('delivered')}/{state.get('total')}" if "total" in state
-                        else f"reached {state.get('reached')}/{state.get('with_goal')}")  # fmt: skip
                 line = (f"waiting for agents: {info['agents_alive']} of {info['start_with']} joined" if waiting else
-                        f"tick {state.get('tick')}: {done}, {state.get('agents_alive')} agents, "
+                        f"tick {state.get('tick')}: {done} {state.get(done)}/{state.get(total)}, "
+                        f"{state.get('agents_alive')} agents, "
                         f"{state.get('ticks_per_second')} ticks/s")  # fmt: skip
                 print(line, file=sys.stderr, flush=True)
     finally:

@@ -1,8 +1,8 @@
 """Scenarios: a preset, a bundled name or a TOML file, read into its world kind's scenario.
 
-`kind = "grid"` (the default: the c-marking paper's worlds, world_server/grid/scenario.py)
-or `kind = "arena"` (world_server/arena/scenario.py).  Every error is a
-ScenarioError naming the file and the field.
+A file's `kind` names its world kind (world_server.WORLD_KINDS; a file without one is of the
+default kind, the grid), and the kind parses the rest (world_server/<kind>/scenario.py).  Every
+error is a ScenarioError naming the file and the field.
 """
 
 from __future__ import annotations
@@ -14,13 +14,12 @@ from typing import TYPE_CHECKING
 
 from agents.controllers import CONTROLLERS
 from swarm.core.errors import ScenarioError
-from world_server.grid.scenario import Scenario, paper_setup, parse_grid
+from swarm.core.registry import UnknownPart, resolve
+from world_server import world_kind
+from world_server.grid.scenario import Scenario, paper_setup
 
 if TYPE_CHECKING:
     from world_server.arena.scenario import ArenaScenario
-
-WORLD_KINDS = ("grid", "arena")
-
 
 PRESET_HELP = "setup1, setup2, setup3-<size> (paper sizes 12, 25, 50, 100, 200)"
 BUNDLED_DIR = Path(__file__).parent / "scenarios"
@@ -53,42 +52,22 @@ def load_scenario(ref: str) -> Scenario:
     return parse_scenario_text(path.read_text(encoding="utf-8", errors="replace"), str(path))
 
 
-def is_arena(scenario) -> bool:
-    return getattr(scenario, "kind", "grid") == "arena"
-
-
-def parse_scenario_text(text: str, source: str = "<string>"):
-    """A grid Scenario, or an ArenaScenario when the file says kind = "arena"."""
+def parse_scenario_text(text: str, source: str = "<string>", kind: str | None = None, name: str | None = None):
+    """The scenario of the world kind the file names (`kind = ...`; the default kind's when it names
+    none), or of `kind` (the file may then leave it out), named `name` (default: the file's stem)
+    unless the file says.  Each kind parses its own section (world_server.WORLD_KINDS)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(source, "TOML", f"not valid TOML ({exc})") from None
-    kind = data.get("kind", "grid")
-    if kind not in WORLD_KINDS:
-        raise ScenarioError(source, "kind", f"unknown world kind {kind!r}; expected one of {', '.join(WORLD_KINDS)}")
-    if kind == "arena":
-        return parse_arena_tables(data, source, Path(source).stem)
-    data.pop("kind", None)
-    return parse_grid(data, text, source)
-
-
-def arena_controllers() -> dict:
-    """The registry's arena controllers, by name: what an arena scenario's groups may name."""
-    return {c.name: c for c in CONTROLLERS if c.world == "arena"}
+    try:
+        spec = world_kind(kind or data.get("kind", world_kind().name))
+    except UnknownPart as exc:
+        raise ScenarioError(source, "kind", str(exc)) from None
+    controllers = {c.name: c for c in CONTROLLERS if c.world == spec.name}  # what its groups may name
+    return resolve(spec.parse)(data, text, source, name or Path(source).stem, controllers)
 
 
 def parse_arena_text(text: str, source: str = "<string>", default_name: str = "arena") -> ArenaScenario:
     """An arena scenario from TOML text (kind = "arena" may be left out)."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(source, "TOML", f"not valid TOML ({exc})") from None
-    return parse_arena_tables(data, source, default_name)
-
-
-def parse_arena_tables(data: dict, source: str, default_name: str) -> ArenaScenario:
-    # Imported here, not above: the arena's sensors load numba, and `swarm agent` (an agent
-    # process, which reads no scenario) must start without it to stay under 80 MB.
-    from world_server.arena.scenario import parse_arena
-
-    return parse_arena(data, source, default_name, arena_controllers())
+    return parse_scenario_text(text, source, "arena", default_name)

@@ -8,27 +8,23 @@ import json
 import sys
 import time
 
-from world_server.arena.server import ArenaKind
-from world_server.grid.server import GridKind
+from swarm.core.registry import resolve
+from world_server import kind_of
 from world_server.server import RunnerServices, WorldServer
 
 
 def services_for(scenario) -> RunnerServices:
-    if getattr(scenario, "kind", "grid") == "arena":
-        from swarm.engines.goals import ArenaGoals
-        from swarm.recording.arena import open_for_server
-
-        return RunnerServices(open_recorder=open_for_server, goals=ArenaGoals)
-    from swarm.recording.grid import open_for_server
-
-    return RunnerServices(open_recorder=open_for_server)
+    """What the world process lends the server of the scenario's world kind: its recorder, its
+    goals bookkeeping (world_server.WORLD_KINDS)."""
+    kind = kind_of(scenario)
+    return RunnerServices(open_recorder=kind.open_recorder and resolve(kind.open_recorder),
+                          goals=kind.goals and resolve(kind.goals))  # fmt: skip
 
 
 def make_server(scenario, run_id: str, **kw) -> WorldServer:
     """The world server holding the scenario's world kind, with this runner's services."""
     kw.setdefault("services", services_for(scenario))
-    kind = ArenaKind if getattr(scenario, "kind", "grid") == "arena" else GridKind
-    return WorldServer(kind, scenario, run_id, **kw)
+    return WorldServer(resolve(kind_of(scenario).server), scenario, run_id, **kw)
 
 
 def serve(scenario, run_id: str, summary_file: str | None = None, linger: float = 0.0, quiet: bool = False,

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from swarm.engines.arena import ArenaEngine
-from swarm.scenario import bundled_scenarios, is_arena, load_scenario
+from swarm.scenario import bundled_scenarios, load_scenario
 from tests.arena_helpers import arena
+from world_server import kind_of
 from world_server.arena.face.sensors.zones import ZONE_KINDS
 from world_server.arena.world import ArenaWorld
 
@@ -30,7 +31,7 @@ def test_every_bundled_arena_loads_and_ticks():
     assert set(ARENAS) <= set(bundled_scenarios())
     for name in ARENAS:
         s = load_scenario(name)
-        assert is_arena(s), name
+        assert kind_of(s).name == "arena", name
         e = ArenaEngine(s.with_overrides(max_ticks=3))
         assert e.step(3) == 3, name
 

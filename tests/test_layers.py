@@ -4,7 +4,8 @@ Layers, bottom to top (docs/architecture.md):
 
     core      swarm.core: random numbers, compile cache, kernels, errors, zenoh, the generic wire, tables
     worlds    world_server: one folder per world kind (its world, server, controller face), the world process
-    agents    agents: the controllers and the agent process; of the worlds only a kind's face
+    agents    agents: the controllers and the agent process; of the worlds only a kind's face and the
+              world kinds' declarations (world_server.WORLD_KINDS: plain data, found by the runtimes)
     runners   engines, launcher, monitor, recording, review, scenario loading
     top       experiments, benchmarks, the command line
 
@@ -16,6 +17,7 @@ from __future__ import annotations
 import importlib
 import pkgutil
 from graphlib import CycleError, TopologicalSorter
+from pathlib import Path
 
 import grimp
 import pytest
@@ -38,6 +40,7 @@ LAYERS = {  # module prefix -> layer (the longest prefix wins)
     "swarm.cli": 4,
     "swarm.cli_arena": 4,
     "swarm.cli_reproduce": 4,
+    "swarm.cli_grid": 4,
     "swarm.__main__": 4,
 }
 NAMES = ("core", "worlds", "agents", "runners", "top")
@@ -54,6 +57,18 @@ def is_face(module: str) -> bool:
     """A world kind's controller face (world_server.<kind>.face...): what its controllers may import."""
     parts = module.split(".")
     return len(parts) >= 3 and parts[0] == "world_server" and parts[2] == "face"
+
+
+def is_declaration(module: str) -> bool:
+    """The world kinds' registry (world_server) or a kind's declaration (world_server.<kind>, its
+    package's __init__: a WorldKindSpec, plain data): what the agent runtimes may read to find theirs."""
+    parts = module.split(".")
+    return parts == ["world_server"] or (
+        len(parts) == 2 and parts[0] == "world_server" and (WORLDS / parts[1] / "__init__.py").is_file()
+    )
+
+
+WORLDS = Path(__file__).resolve().parent.parent / "world_server"
 
 
 @pytest.fixture(scope="module")
@@ -75,7 +90,7 @@ def upward(graph) -> set[tuple[str, str]]:
     found = set()
     for m, t in imports(graph):
         lm, lt = layer_of(m), layer_of(t)
-        if lt > lm or (NAMES[lm] == "agents" and NAMES[lt] == "worlds" and not is_face(t)):
+        if lt > lm or (NAMES[lm] == "agents" and NAMES[lt] == "worlds" and not (is_face(t) or is_declaration(t))):
             found.add((m, t))
     return found
 
@@ -120,6 +135,8 @@ def test_the_layer_table_checks_what_it_claims(graph):
     assert layer_of("swarm.core.rng") == 0 and layer_of("swarm.cli") == 4 and layer_of("swarm") == 0
     assert is_face("world_server.grid.face.layout") and not is_face("world_server.grid.world")
     assert ("agents.controllers.grid.dispatch", "world_server.grid.face.layout") not in upward(graph)
+    assert is_declaration("world_server") and is_declaration("world_server.arena")
+    assert not is_declaration("world_server.arena.world") and not is_declaration("world_server.server")
 
 
 def test_the_compile_cache_is_keyed_on_every_source_file():
@@ -137,6 +154,8 @@ def test_an_agent_process_starts_without_numba_or_scipy():
     import sys
 
     child = ("import sys, swarm.cli, agents.runtimes, agents.controllers; agents.controllers.CONTROLLERS.names(); "
+             "import world_server; [world_server.WORLD_KINDS[k.name] for k in world_server.WORLD_KINDS]; "
+             "swarm.cli.build_parser(); "
              "print(sorted({m.split('.')[0] for m in sys.modules} & {'numba', 'scipy', 'rerun'}))")  # fmt: skip
     out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0 and out.stdout.strip() == "[]", out.stdout + out.stderr[-2000:]

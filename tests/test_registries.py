@@ -1,13 +1,15 @@
-"""Every entry of the registries does what it declares: each controller in its example scenario, each
-experiment's smoke run, each benchmark's quick run, each arena sensor's table and readings.  The tests are
-parametrized over the registries (swarm/core/registry.py), so a new controller, experiment, benchmark or
-sensor is tested here as soon as its folder (its module, for a sensor) declares it."""
+"""Every entry of the registries does what it declares: each controller in its example scenario, each world
+kind's parts on its example scenario, each experiment's smoke run, each benchmark's quick run, each arena sensor's
+table and readings.  The tests are parametrized over the registries (swarm/core/registry.py), so a new
+controller, world kind, experiment, benchmark or sensor is tested here as soon as its folder (its module, for a
+sensor) declares it."""
 
 from __future__ import annotations
 
 import importlib
 import inspect
 import json
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -23,8 +25,9 @@ from swarm.core.kernels import EXPORTS
 from swarm.core.registry import resolve
 from swarm.engines.arena import ArenaEngine
 from swarm.experiments import EXPERIMENTS
-from swarm.scenario import is_arena, load_scenario
+from swarm.scenario import BUNDLED_DIR, bundled_scenarios, load_scenario, parse_scenario_text
 from tests.arena_helpers import arena
+from world_server import WORLD_KINDS, kind_of, world_kind
 from world_server.arena.face.sensors import SENSORS
 from world_server.arena.scenario import controller_params
 from world_server.grid.face import layout
@@ -66,7 +69,7 @@ def test_a_controllers_entry_names_real_sensors_kernels_parts_and_a_scenario_it_
     for reference in _references(spec):
         assert resolve(reference) is not None, reference
     scenario = load_scenario(spec.example).with_overrides(controller=name)  # its robots carry what it requires
-    assert is_arena(scenario) == (spec.world == "arena") and scenario.controller == name
+    assert kind_of(scenario).name == spec.world and scenario.controller == name
 
 
 def _copy(perception: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -283,3 +286,63 @@ def test_a_sensor_reads_what_it_declares_in_a_small_arena_run(name):
                 assert value.shape == shape and value.dtype.str == dtype, (key, value.shape, value.dtype.str)
                 assert np.isfinite(value.astype(np.float64)).all() and np.array_equal(q[key], value), key
         world.apply(np.full((2, 2), 0.05))
+
+
+# ------------------------------------------------------------------ world kinds
+
+
+def _kind_references(spec) -> list[str]:
+    parts = (spec.parse, spec.server, spec.runtime, spec.run, spec.warm_up, spec.review, spec.plots, spec.metrics,
+             spec.print_summary, spec.overrides, spec.up_options, spec.open_recorder, spec.goals,
+             spec.options, spec.check, *spec.commands)  # fmt: skip
+    return [r for r in parts if r]
+
+
+def test_the_world_kinds_come_default_first_and_an_unknown_one_is_named_in_one_line():
+    assert WORLD_KINDS.names() == ("grid", "arena")
+    assert world_kind().name == "grid" and [k.name for k in WORLD_KINDS if k.default] == ["grid"]
+    with pytest.raises(ScenarioError, match=r"x.toml: kind: unknown world kind 'x'; expected one of grid, arena$"):
+        parse_scenario_text('kind = "x"', "x.toml")
+    assert kind_of({}) is world_kind() and kind_of({"kind": "arena"}) is WORLD_KINDS["arena"]
+
+
+@pytest.mark.parametrize("name", WORLD_KINDS.names())
+def test_a_world_kinds_entry_resolves_and_parses_its_bundled_scenarios(name):
+    from agents.runtime import AgentRuntime
+
+    spec = WORLD_KINDS[name]
+    assert spec.description and "\n" not in spec.description
+    for reference in _kind_references(spec):
+        assert resolve(reference) is not None, reference
+    assert isinstance(resolve(spec.server), type) and issubclass(resolve(spec.runtime), AgentRuntime)
+    assert kind_of(load_scenario(spec.example)) is spec
+    controllers = {c.name: c for c in CONTROLLERS if c.world == name}
+    ours = [b for b in bundled_scenarios() if kind_of(load_scenario(b)) is spec]
+    assert ours or name == world_kind().name, f"no bundled scenario of the {name} kind"
+    for bundled in ours:  # its parser, called as the scenario loader calls it
+        path = BUNDLED_DIR / f"{bundled}.toml"
+        text = path.read_text()
+        parsed = resolve(spec.parse)(tomllib.loads(text), text, str(path), bundled, controllers)
+        assert kind_of(parsed) is spec and parsed.describe() == load_scenario(bundled).describe(), bundled
+
+
+@pytest.mark.parametrize("name", WORLD_KINDS.names())
+def test_a_world_kind_runs_its_example_recorded_and_reviews_the_recording(name, tmp_path, capsys):
+    from swarm.cli import build_parser
+    from swarm.review.report import report
+
+    spec = WORLD_KINDS[name]
+    rrd = tmp_path / "run.rrd"
+    args = build_parser().parse_args(["run", spec.example, "--max-iterations", "20", "--max-ticks", "20",
+                                      "--record", str(rrd), "--json"])  # fmt: skip
+    common = {"agents": None, "controller": None, "seed": 1}
+    scenario = resolve(spec.overrides)(load_scenario(spec.example), args, common)
+    summary = resolve(spec.run)(scenario, args, None)
+    done, total = spec.progress
+    assert kind_of(summary) is spec and done in summary and total in summary
+    assert resolve(spec.print_summary)(summary, True, args.until) in (0, 1)
+    assert json.loads(capsys.readouterr().out) == summary
+    result = report(rrd, tmp_path / "report")
+    assert kind_of(result["summary"]) is spec and result["summary"][done] == summary[done]
+    assert result["plots"] and all(Path(p).is_file() for p in result["plots"])
+    assert set(result["metrics"]) <= set(resolve(spec.metrics))

@@ -6,7 +6,8 @@ references that are imported only when asked for.  Reading a registry therefore 
 controller, kernel or numba: an agent process can look its controller up for the price of a few
 small modules.  A registry finds its entries by importing every subpackage of one package and
 reading one attribute of it (an entry, or a tuple of entries), so adding a part is adding its
-folder.  The registries themselves live in the layer of their parts (agents.controllers.CONTROLLERS).
+folder.  The registries themselves live in the layer of their parts (agents.controllers.CONTROLLERS,
+world_server.WORLD_KINDS).
 """
 
 from __future__ import annotations
@@ -131,6 +132,62 @@ class PaperSpec:
     page: str
 
 
+@dataclass(frozen=True)
+class WorldKindSpec:
+    """Everything the project needs to know of one world kind, declared in its folder
+    (world_server/<kind>/__init__.py).
+
+    Like an ARGoS plugin, the entry names its parts wherever they live: the world's own ones
+    (its scenario section, its server) in its folder, and the parts that live above the worlds
+    (the agent runtime, the engine run, the recorder, the review, the command line's options) in
+    the layers that own them.  Every part is a "module:attribute" reference, imported only when
+    it is used, so declaring a kind imports nothing upward and reading the registry loads no
+    world (an agent process finds its runtime for the price of two small modules); the import
+    graph stays one-way because the references are strings, resolved by whoever calls them.
+
+    Called as (each "module:function"):
+      parse(data, text, source, name, controllers) -> scenario: its section of a scenario file
+          (`data`: the TOML tables, `name`: the default name, `controllers`: the registry's
+          controllers of this kind, by name);
+      server: the WorldKind class the world process's server holds (world_server.server.WorldKind);
+      runtime(run_id, controller, connect, count, **options) -> an agent process's runtime;
+      open_recorder(server, path, viewer) and goals(scenario): what the world process
+          is lent (world_server.server.RunnerServices);
+      run(scenario, args, viewer) -> summary: `swarm run`, in one process (recorded with --record);
+      warm_up(scenario, engine): compile what its runs need (`swarm prepare`, `swarm up`);
+      review(recording) -> summary and plots(recording, folder) -> files: `swarm report`;
+      options(parser): its command-line options; overrides(scenario, args, common) -> scenario:
+          their values (with `common`: agents, controller, seed); check(scenario, until): a run
+          the command line refuses before it starts; up_options(scenario, args) -> keywords of
+          swarm.launcher.swarm_up; print_summary(summary, as_json, until) -> exit status;
+      commands: functions that add a subcommand to `swarm` (add(subparsers) -> (name, handler))."""
+
+    name: str  # the scenario file's `kind`
+    description: str  # one line
+    example: str  # a bundled scenario or preset of this kind: `swarm prepare` warms it up, the tests run it
+    parse: str
+    server: str
+    runtime: str
+    run: str
+    warm_up: str
+    review: str
+    plots: str
+    print_summary: str
+    overrides: str
+    up_options: str
+    # (done, total): the keys of its progress and summary that count the run's progress (the status
+    # line "delivered 3/10", the progress bars); a recording's series `done` has one value per tick.
+    progress: tuple[str, str]
+    metrics: str  # "module:NAME": the names of the scalar series its recording keeps
+    default: bool = False  # the kind of a scenario file, a summary or a recording that names none
+    open_recorder: str | None = None
+    goals: str | None = None
+    options: str | None = None
+    options_title: str | None = None  # its options' own section of --help (None: among the command's own)
+    check: str | None = None
+    commands: tuple[str, ...] = ()
+
+
 class Entry(Protocol):
     name: str
 
@@ -170,7 +227,7 @@ class Registry(Generic[E]):
 
     def __getitem__(self, name: str) -> E:
         entries = self._found()
-        if name not in entries:
+        if not isinstance(name, str) or name not in entries:
             raise UnknownPart(f"unknown {self.what} {name!r}; expected one of {', '.join(entries)}")
         return entries[name]
 

@@ -94,3 +94,9 @@ class ArenaEngine:
                 robot["shared"] = shared
         out["rejected_shared"] = self.refused_shared
         return out
+
+
+def warm_up(scenario: ArenaScenario, engine: bool = False) -> None:
+    """Compile, or load from the cache, what an arena run needs (world_server.WORLD_KINDS): the ray
+    pass, the drive and A* (arena agents plan with it), by one tick of this engine."""
+    ArenaEngine(scenario).step(1)

@@ -230,3 +230,15 @@ class Engine:
             "agent_steps_per_second": round(steps / self.wall_seconds) if self.wall_seconds else None,
             **w.bodies.summary(s.agents),
         }
+
+
+def warm_up(scenario: Scenario, engine: bool = False) -> None:
+    """Compile, or load from the cache, what a grid run needs (world_server.WORLD_KINDS): the
+    controllers' step, the world's tick kernels, with `engine` this engine's loop."""
+    from agents.controllers.grid.envelope import warm_up as warm_up_controllers
+
+    warm_up_controllers()
+    scenario = scenario.with_overrides(agents=2)
+    GridWorld(scenario).warm_up()
+    if engine:
+        Engine(scenario).step(2)

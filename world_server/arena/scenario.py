@@ -194,6 +194,16 @@ class ArenaScenario:
         check_arena(new, "command line")
         return new
 
+    def agent_processes(self, agents: int) -> list[tuple[str, int]]:
+        """(controller, robots) for every kind of agent process a run of `agents` robots needs: each
+        group's robots run its own controller."""
+        if len(self.groups) == 1:
+            return [(self.groups[0].controller, agents)]
+        counts: dict[str, int] = {}
+        for g in self.groups:
+            counts[g.controller] = counts.get(g.controller, 0) + g.count
+        return list(counts.items())
+
     def describe(self) -> dict[str, Any]:
         return {"name": self.name, "kind": "arena", "seed": self.seed, "size": list(self.size),
                 "agents": self.agents, "controller": self.controller, "noise": self.noise.level,
@@ -346,6 +356,12 @@ _TOP = {
 def _tabled() -> tuple[str, ...]:
     """The sensors a scenario's [robot.<name>] and [noise] tables may name: those with fields."""
     return SENSORS.names(lambda cls: bool(cls.field_names()))
+
+
+def parse_section(data: dict, text: str, source: str, name: str,
+                  controllers: Mapping[str, ControllerSpec]) -> ArenaScenario:  # fmt: skip
+    """The kind's scenario parser (world_server.WORLD_KINDS): parse_arena (`text` is not needed)."""
+    return parse_arena(data, source, name, controllers)
 
 
 def parse_arena(data: dict, source: str, default_name: str, controllers: Mapping[str, ControllerSpec]) -> ArenaScenario:

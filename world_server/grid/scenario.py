@@ -13,6 +13,7 @@ resource is rejected.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -128,6 +129,10 @@ class Scenario:
         _check_physics(new.physics, "command line")
         return new
 
+    def agent_processes(self, agents: int) -> list[tuple[str, int]]:
+        """(controller, robots) for every kind of agent process a run of `agents` robots needs."""
+        return [(self.controller, agents)]
+
     def layout(self) -> Layout:
         if self.ascii_map is not None:
             return _layout_from_ascii(self)
@@ -184,13 +189,21 @@ _TOP_KEYS = {"name", "seed", "agents", "controller", "q_max", "quantity", "map",
 _TOP_KEYS |= {"ant", "cmarking", "physics"}
 
 
-def parse_grid(data: dict, text: str, source: str) -> Scenario:
-    """The grid Scenario of a scenario file's tables (`text` only to point at the map's lines)."""
+def parse_section(data: dict, text: str, source: str, name: str, controllers: Mapping) -> Scenario:
+    """The kind's scenario parser (world_server.WORLD_KINDS): the grid Scenario of a file's tables,
+    named `name` unless the file says."""
+    data.pop("kind", None)
+    return parse_grid(data, text, source, name)
+
+
+def parse_grid(data: dict, text: str, source: str, name: str | None = None) -> Scenario:
+    """The grid Scenario of a scenario file's tables (`text` only to point at the map's lines),
+    named `name` (default: the file's stem) unless the file says."""
     no_unknown(data, _TOP_KEYS, source, "top level")
     has_map, has_gen = "map" in data, "generator" in data
     if has_map == has_gen:
         raise ScenarioError(source, "map/generator", "give exactly one of [map] (ascii = ...) or [generator]")
-    kw: dict[str, Any] = {"name": Path(source).stem, "source": source}
+    kw: dict[str, Any] = {"name": name or Path(source).stem, "source": source}
     if "name" in data:
         kw["name"] = typed(data, "name", str, source)
     for key in ("seed", "agents", "q_max", "quantity"):
