@@ -13,7 +13,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from swarm.experiments.stats import Comparison, Estimate
+from swarm.experiments.stats import Comparison
 
 DEVELOPMENT_SEEDS = range(0, 10_000)
 CONFIRMATION_SEEDS = range(10_000, 20_000)
@@ -89,11 +89,6 @@ def claims_table(claims: Sequence[Claim]) -> str:
         lines.append(f"| {c.text} | {c.paper} | {c.ours} | {test[1]} | {test[0]} | {test[2]} | {test[3]} | "
                      f"{c.verdict} |")  # fmt: skip
     return "\n".join(lines) + "\n"
-
-
-def estimates_line(label: str, estimates: Sequence[Estimate]) -> str:
-    """'label: a [lo, hi] (n), b [lo, hi] (n)': several estimates on one line."""
-    return f"{label}: " + ", ".join(f"{e.text()} (n = {e.n})" for e in estimates)
 
 
 def _p(p: float) -> str:

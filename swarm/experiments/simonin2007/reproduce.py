@@ -58,7 +58,7 @@ def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = N
     claims = [c for _, _, cs in sections for c in cs]
     for name in TABLES:
         EXPERIMENTS[name].plot([r for r in rows if r["experiment"] == name], out_ / f"{name}.png")
-    text = _report(sections, reps, quick)
+    text = _report(sections, claims, reps, quick)
     result = out_.finish([_claim_row(c) for c in claims], text)
     (out_ / "report.md").write_text(text)
     return result | {"claims": len(claims), "verdicts": _tally(claims)}
@@ -177,7 +177,7 @@ def _ants(rows: list[dict]):
 # ------------------------------------------------------------------- report
 
 
-def _report(sections, reps: dict[str, int], quick: bool) -> str:
+def _report(sections, claims: list[P.Claim], reps: dict[str, int], quick: bool) -> str:
     first = P.CONFIRMATION_SEEDS.start
     head = [
         "# Simonin, Charpillet & Thierry (2007): the reproduction",
@@ -193,7 +193,7 @@ def _report(sections, reps: dict[str, int], quick: bool) -> str:
         "",
         "## Claims",
         "",
-        P.claims_table([c for _, _, cs in sections for c in cs]),
+        P.claims_table(claims),
     ]
     for title, table, _ in sections:
         head += [f"## {title}", "", table, ""]
