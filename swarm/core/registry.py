@@ -42,7 +42,9 @@ class ControllerSpec:
     `requires`: the sensors its robot must carry.  `shares`: the key space it writes
     (swarm/<run>/<share>/<agent>), if any.  `kernels`: modules whose `exported` kernels the
     agents' ahead-of-time build must compile.  `records`: the logs an arena recording keeps of
-    its record() (its map, its fields, its channels).  `example`: a bundled scenario it runs in
+    its record() (its map, its fields, its channels).  `parameters`: its parameter classes
+    ("module:Class", each field declared with its provenance: swarm.core.params).  `example`: a
+    bundled scenario it runs in
     (`swarm run EXAMPLE --controller NAME`; the tests run every controller there).  What a robot
     publishes on its share at tick t, every other robot of the same share receives before it steps
     tick t + 1."""
@@ -56,6 +58,7 @@ class ControllerSpec:
     shares: str | None = None
     kernels: tuple[str, ...] = ()
     records: tuple[str, ...] = ()  # "module:Class" of the logs that show what explains its choices (swarm.core.series)
+    parameters: tuple[str, ...] = ()  # "module:Class" of its parameter dataclasses (swarm.core.params)
     example: str = "setup1"
 
     def make(self) -> Any:

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from swarm.core.params import OURS, PAPER, declared
 from world_server.arena.face.sensors.zones import ZONE_KINDS
 
 ACTS = ("none", "ReloadE", "ReloadEp")
@@ -68,13 +69,39 @@ def _metabolise(acts: np.ndarray, zone_bits: np.ndarray, moving: np.ndarray, ali
 
 @dataclass(frozen=True)
 class MetabolismParams:
-    energy: float = 1.0  # E at the start
-    potential: float = 1.0  # Ep at the start
-    lifetime: float = 1980.0  # seconds a full E lasts (the paper: 33 min)
-    ingest_rate: float = 0.1  # Ep gained per second of ReloadEp in an ingesting zone (ours)
-    digest_rate: float = 0.1  # E gained (and Ep spent) per second of ReloadE in a digesting zone (ours)
-    danger_rate: float = 0.01  # extra E lost per second within a dangerous area's reach (ours)
-    stop_at: str = "death"  # the run ends when every robot is dead; "ingest": when each has reloaded Ep once
+    """E and Ep of Girard et al. (2005), section 3.1: the paper gives the 33-minute lifetime and
+    nothing else (docs/bg.md, Metabolism)."""
+
+    energy: float = declared(1.0, source=PAPER, where="section 3.1: a full load of Energy; section 4.3.1: E = 1")
+    potential: float = declared(
+        1.0,
+        source=OURS,
+        reason="Ep at the start: the paper gives none for experiment 1 (experiment 3.1 only Ep < 1); full, as E",
+    )
+    lifetime: float = declared(1980.0, source=PAPER, where="section 3.1: a full load of Energy lasts 33 min (1980 s)")
+    ingest_rate: float = declared(
+        0.1,
+        source=OURS,
+        reason="Ep gained per second of ReloadEp in an ingesting zone: "
+        "a full load in 10 s of eating; the paper gives no rate (docs/bg.md)",
+    )
+    digest_rate: float = declared(
+        0.1,
+        source=OURS,
+        reason="E gained (and Ep spent) per second of ReloadE in a digesting zone, likewise (docs/bg.md, Metabolism)",
+    )
+    danger_rate: float = declared(
+        0.01,
+        source=OURS,
+        reason="extra E lost per second within a dangerous area's reach: "
+        "crossing one costs about 4% of E, worth avoiding, not fatal (docs/bg.md)",
+    )
+    stop_at: str = declared(
+        "death",
+        source=OURS,
+        reason="the run ends when every robot is dead (experiment 1 "
+        "measures survival); experiments 2 and 3 set 'ingest'",
+    )
 
     @classmethod
     def from_table(cls, table: dict[str, Any]) -> MetabolismParams:

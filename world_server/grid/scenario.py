@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from swarm.core.errors import ScenarioError
+from swarm.core.params import OURS, PAPER, declared
 from swarm.core.tables import no_unknown, section_of, typed
 from world_server.grid.face.layout import CONTROLLERS
 
@@ -44,16 +45,41 @@ class Generator:
 
 @dataclass(frozen=True)
 class AntParams:
-    diffusion: float = 0.95
-    evaporation: float = 0.005
-    deposit: float = 1.0
-    threshold: float = 0.3
-    detour: float = 8
+    """The pheromone ant baseline (section 5.5; docs/cmarking.md, "The ant baseline")."""
+
+    diffusion: float = declared(0.95, source=PAPER, where="section 5.5: the diffusion rate is set to 95%")
+    evaporation: float = declared(0.005, source=PAPER, where="section 5.5: the evaporation rate to 0.5%")
+    deposit: float = declared(
+        1.0,
+        source=OURS,
+        reason="the paper gives no amount; only its ratio to `threshold` "
+        "matters, so one unit per cell crossed (docs/cmarking.md, the ant baseline)",
+    )
+    threshold: float = declared(
+        0.3,
+        source=OURS,
+        reason="the paper does not give its ant model's rule; the best of "
+        "0.001-10 in a sweep, as the paper tuned its model (docs/cmarking.md)",
+    )
+    detour: float = declared(
+        8,
+        source=OURS,
+        reason="random steps when both compass directions are walled: without "
+        "them ants freeze forever in concave pockets (Figure 11.a; docs/cmarking.md)",
+    )
 
 
 @dataclass(frozen=True)
 class CMarkingParams:
-    climb_patience: int = 20
+    """The c-marking agents' one open number (docs/cmarking.md, choice 9)."""
+
+    climb_patience: int = declared(
+        20,
+        source=OURS,
+        reason="a climber circling a loop of trail cells (two parallel "
+        "trails make 2x2 loops) livelocks under the literal rules; after this many climb "
+        "steps without a higher mark it wipes and erases (docs/cmarking.md, choice 9)",
+    )
 
 
 PHYSICS_MODES = ("ideal", "physical")
@@ -63,12 +89,27 @@ PHYSICS_MODES = ("ideal", "physical")
 class PhysicsParams:
     """Robot bodies (world_server/grid/bodies.py).  Lengths in cells, times in seconds."""
 
-    mode: str = "ideal"  # ideal: instant cell-to-cell moves (the paper); physical: pymunk discs
-    diameter: float = 0.4  # body diameter (two fit side by side in a corridor)
-    speed: float = 2.0  # top speed, cells per second
-    timeout: float = 2.0  # longest simulated time one tick may take
-    dt: float = 0.05  # physics step
-    arrive: float = 0.2  # a body has reached a cell when its centre is this close to the cell's centre
+    mode: str = declared(
+        "ideal",
+        source=PAPER,
+        where="section 5.1: one iteration, each agent moves to a "
+        "neighbouring cell (ideal: instant cell-to-cell moves; physical: pymunk discs, ours)",
+    )
+    diameter: float = declared(
+        0.4, source=OURS, reason="body diameter in cells: two fit side by side in a corridor (docs/physics.md)"
+    )
+    speed: float = declared(2.0, source=OURS, reason="top speed, cells per second (docs/physics.md)")
+    timeout: float = declared(
+        2.0,
+        source=OURS,
+        reason="longest simulated time one tick may take: a cell is crossed in 0.5 s at top speed (docs/physics.md)",
+    )
+    dt: float = declared(0.05, source=OURS, reason="physics step, s (docs/physics.md)")
+    arrive: float = declared(
+        0.2,
+        source=OURS,
+        reason="a body has reached a cell when its centre is this close to the cell's centre (docs/physics.md)",
+    )
 
 
 @dataclass(frozen=True)

@@ -24,6 +24,7 @@ from agents.controllers.bg.gpr import BasalGanglia, select_dorsal, select_ventra
 from agents.controllers.bg.places import DIRECTIONS, WAYS, Navigator, NavParams
 from agents.controllers.bg.saliences import SALIENCES, Drives, saliences
 from agents.controllers.bg.senses import RESOURCES, Reflex, sense
+from swarm.core.params import OURS, PAPER, declared
 from swarm.core.tables import params_from_table
 from world_server.arena.face.sensors.zones import ZONE_KINDS
 
@@ -34,20 +35,75 @@ DORSAL_ACTS = ("ReloadE", "ReloadEp")  # channel order; world_server.arena.metab
 
 @dataclass(frozen=True)
 class BgParams:
-    saliences: str = "survival"  # survival (eqs. 15-17) | fear (eq. 18) | tmaze (eqs. 19-20)
-    planning: bool = True  # condition A (taxon + topological); False: condition B (taxon only)
-    w_plan: float = 0.65
-    w_taxon: float = 0.55
-    fear: float = 0.2  # F, m(DA)
-    dorsal_threshold: float = 0.9  # disinhibition an act needs to start (it goes on while above 0: docs/bg.md) ...
-    usable_threshold: float = 0.9  # ... and where it works (A(res)); lower, an act nearly selected there starts
-    ventral_threshold: float = -0.6  # ... a direction channel needs to join the vector sum (EP/SNr below 1.6 x rest)
-    too_close: float = 0.45  # m from the centre: the sonar reflex takes over
-    reflex_hold: float = 2.0  # s the reflex drives straight on once the front is clear
-    align: float = math.radians(30)  # heading error beyond which the animat turns on the spot
-    learn_map: bool = True  # keep mapping (False: a loaded map stays as it is; the animat localizes on it)
-    share: bool = False  # a colony: publish the map and what its places hold on swarm/<run>/map/**, merge the others'
-    map: str = ""  # a saved map (BgController.map_data() as JSON) to start from; "" none
+    saliences: str = declared(
+        "survival",
+        source=PAPER,
+        where="appendix A.2.1, eqs. 15-17 (experiments 1 and 2); fear: eq. 18 (exp. 3.1); tmaze: eqs. 19-20 (exp. 3.2)",
+    )
+    planning: bool = declared(
+        True,
+        source=PAPER,
+        where="section 4.1: condition A, taxon and topological navigation (False: condition B, taxon only)",
+    )
+    w_plan: float = declared(0.65, source=PAPER, where="appendix A.2.1, after eq. 17: W_plan = 0.65")
+    w_taxon: float = declared(0.55, source=PAPER, where="appendix A.2.1, after eq. 17: W_taxon(Ep) = 0.55")
+    fear: float = declared(0.2, source=PAPER, where="section 4.3.1 (experiment 3.1): F = 0.2, m(DA)")
+    # disinhibition an act needs to start (it goes on while above 0: docs/bg.md) ...
+    dorsal_threshold: float = declared(
+        0.9,
+        source=OURS,
+        reason="the paper's selection has no threshold; lower (0.3, "
+        "0.5) the 0.6 mProx(E) m(E) term of eq. 15 starts ReloadE far from E and "
+        "most animats die so (docs/bg.md, Selection)",
+    )
+    # ... and where it works (A(res)); lower, an act nearly selected there starts
+    usable_threshold: float = declared(
+        0.9,
+        source=OURS,
+        reason="the dorsal threshold, kept where the act's zone "
+        "is usable; a scenario may lower it (docs/bg.md, Selection)",
+    )
+    # ... a direction channel needs to join the vector sum (EP/SNr below 1.6 x rest)
+    ventral_threshold: float = declared(
+        -0.6,
+        source=OURS,
+        reason="in a 36-channel loop the diffuse STN lifts every "
+        "output, so the winner hardly drops below rest; a dorsal selection lifts "
+        "them to 1.6-2.2 x rest (docs/bg.md, Selection)",
+    )
+    too_close: float = declared(
+        0.45,
+        source=OURS,
+        reason="m from the centre: the paper's sonar reflex (section 3.2) "
+        "has no distance; the bg corridors are 0.8 m for a 0.3 m body (docs/bg.md)",
+    )
+    reflex_hold: float = declared(
+        2.0,
+        source=OURS,
+        reason="s the reflex drives straight on once the front is clear, past the obstacle (docs/bg.md, Sonar reflex)",
+    )
+    align: float = declared(
+        math.radians(30),
+        source=OURS,
+        reason="heading error beyond which the animat turns on "
+        "the spot; the paper gives no steering (docs/bg.md, Steering)",
+    )
+    learn_map: bool = declared(
+        True,
+        source=OURS,
+        reason="a switch of ours: the paper's animat always maps; False "
+        "keeps a loaded map as it is and only localizes on it",
+    )
+    share: bool = declared(
+        False,
+        source=OURS,
+        reason="a colony (publish and merge maps on swarm/<run>/map/**) is ours; the paper has one animat",
+    )
+    map: str = declared(
+        "",
+        source=OURS,
+        reason="a saved map (BgController.map_data() as JSON) to start from; the paper's animat starts with none",
+    )
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> BgParams:

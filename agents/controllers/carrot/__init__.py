@@ -9,6 +9,7 @@ CONTROLLERS = ControllerSpec(
     description="A* on the given map, then follow the carrot (the DFT paper's baseline)",
     example="zmaze",
     factory="agents.controllers.carrot.controller:CarrotController",
+    parameters=("agents.controllers.carrot.controller:CarrotParams",),
     table="agents.controllers.carrot.controller:CarrotParams.from_table",
     requires=("position", "compass"),
     kernels=("agents.controllers.navigation.astar",),

@@ -16,18 +16,49 @@ import numpy as np
 
 from agents.controllers.navigation.astar import Planner
 from agents.controllers.navigation.follow import CarrotFollower
+from swarm.core.params import OURS, PAPER, declared
 from swarm.core.tables import params_from_table
 
 
 @dataclass(frozen=True)
 class CarrotParams:
-    cell: float = 0.01  # A* grid (paper: 1 cm)
-    clearance: float = 0.04  # minimum obstacle distance (paper: 4 cm)
-    k_fic: float = 3.0  # steering gain, 1/s (not in the paper)
-    k_look: float = 0.01  # look-ahead distance (paper: 1 cm)
-    speed: float = 0.05  # cruise speed, m/s (about the DFT robot's: docs/arena.md)
-    window: int = 40  # path points searched ahead of the last carrot
-    arrive: float = 0.02  # stop within this distance of the end (by the sensor)
+    """Follow the carrot, the DFT paper's baseline (Appendix B; docs/arena.md, the carrot controller)."""
+
+    cell: float = declared(
+        0.01, source=PAPER, where="Appendix B: A* over an eight neighbor grid with a cell size of 1 cm"
+    )
+    clearance: float = declared(0.04, source=PAPER, where="Appendix B: a minimum obstacle distance of 4 cm")
+    k_fic: float = declared(
+        3.0,
+        source=OURS,
+        reason=(
+            "steering gain, 1/s: Appendix B's phi_fic = k_fic (phi_c - phi_h) gives no value; phi is "
+            "our turn rate (docs/arena.md)"
+        ),
+    )
+    k_look: float = declared(
+        0.01, source=PAPER, where="Appendix B, eq. 18: the look ahead point at distance k_look = 1 cm"
+    )
+    speed: float = declared(
+        0.05,
+        source=OURS,
+        reason="cruise speed, m/s, not given: about the DFT robot's straight-ahead 5.5 cm/s (docs/arena.md)",
+    )
+    window: int = declared(
+        40,
+        source=OURS,
+        reason=(
+            "path points searched ahead of the last carrot: never back, never across a fold of the path (docs/arena.md)"
+        ),
+    )
+    arrive: float = declared(
+        0.02,
+        source=OURS,
+        reason=(
+            "stop within this distance of the end by the sensor; the paper's goal test is the "
+            "supervisor's (docs/arena.md)"
+        ),
+    )
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> CarrotParams:

@@ -12,6 +12,13 @@ CONTROLLERS = ControllerSpec(
     records=("agents.controllers.dft.recording:FieldLog",),
     example="zmaze",
     factory="agents.controllers.dft.controller:DftController",
+    parameters=(
+        "agents.controllers.dft.controller:DftParams",
+        "agents.controllers.dft.controller:MapNoise",
+        "agents.controllers.dft.architecture:SpaParams",
+        "agents.controllers.dft.robot:Interface",
+        "agents.controllers.dft.robot:SensorLayout",
+    ),
     table="agents.controllers.dft.controller:check_table",
     requires=("position", "compass", "ir"),
     shares="context",

@@ -12,24 +12,67 @@ from dataclasses import dataclass
 import numpy as np
 
 from agents.controllers.dft.architecture import ANGLES, EBS, HEADING
+from swarm.core.params import CODE, PAPER, declared
 
-# Field cell (1-based, 1..100 over [-pi, pi)) of each proximity sensor ps0..ps7, and its weight
-# (the rear and side sensors ps2..ps5 count half in the original code).
-IR_CELLS = np.array([55, 65, 90, 100, 1, 10, 35, 45], np.float64)
-IR_WEIGHT = np.array([1.0, 1.0, 0.5, 0.5, 0.5, 0.5, 1.0, 1.0])
+
+@dataclass(frozen=True)
+class SensorLayout:
+    """Where each proximity sensor ps0..ps7 writes into the proximity field, and how much it counts
+    (IR_CELLS and IR_WEIGHT are taken from it)."""
+
+    cells: tuple[int, ...] = declared(
+        (55, 65, 90, 100, 1, 10, 35, 45),
+        source=PAPER,
+        where="Table 2: x_r = 0.1, "
+        "0.3, 0.8, 1.0, -1.0, -0.8, -0.3, -0.1 pi, = (cell / 50 - 1) pi: 1-based cells "
+        "of the 100 over [-pi, pi) (the code agrees: EPuckController.m, parameters.md "
+        "section 10)",
+    )
+    weight: tuple[float, ...] = declared(
+        (1.0, 1.0, 0.5, 0.5, 0.5, 0.5, 1.0, 1.0),
+        source=CODE,
+        where="EPuckController.m: the rear and side sensors ps2..ps5 count half "
+        "(parameters.md section 10; not in the paper)",
+    )
+
+
+IR_CELLS = np.array(SensorLayout().cells, np.float64)
+IR_WEIGHT = np.array(SensorLayout().weight)
 CELL = np.arange(1, ANGLES + 1, dtype=np.float64)  # 1-based cells of the angular fields
 ANGLE = -math.pi + (CELL - 1) * 2 * math.pi / ANGLES  # the wheel profile's axis
 
 
 @dataclass(frozen=True)
 class Interface:
-    heading_gain: float = 4.0  # S_H peak
-    heading_sigma: float = 30.0  # cells
-    prox_strength: float = 5.0  # c_prox: strength = c_prox * ln(1 + p / 50)
-    prox_sigma: float = 3.0  # cells
-    v: float = 500.0  # wheel units (equation 10)
-    alpha: float = math.pi / 3
-    turn_limit: float = 400.0  # |left - right| at most this (original code)
+    """The e-puck's face to the fields (equations 8-11, 16-17; parameters.md sections 8-10)."""
+
+    heading_gain: float = declared(
+        4.0,
+        source=CODE,
+        where="turnField.m: S_H peak 4, fed directly (no head-direction field; parameters.md section 8)",
+    )
+    heading_sigma: float = declared(
+        30.0, source=CODE, where="turnField.m: S_H's Gaussian, 30 cells (parameters.md section 8)"
+    )
+    prox_strength: float = declared(
+        5.0,
+        source=PAPER,
+        where="Table 2 and eq. 17: c_prox = 5, strength c_prox ln(1 + p / 50) (the code agrees: EPuckController.m)",
+    )
+    prox_sigma: float = declared(
+        3.0, source=PAPER, where="Table 2: sigma_prox = 3 cells (the code agrees: EPuckController.m)"
+    )
+    v: float = declared(
+        500.0, source=PAPER, where="Table 2 and eq. 10: v = 500 wheel units (the code agrees: createTurnField.m)"
+    )
+    alpha: float = declared(
+        math.pi / 3, source=PAPER, where="Table 2: alpha = pi/3 (the code agrees: createTurnField.m)"
+    )
+    turn_limit: float = declared(
+        400.0,
+        source=CODE,
+        where="EPuckController.m: |left - right| at most 400 (parameters.md section 9; not in the paper)",
+    )
 
     def heading_images(self, yaw: float) -> dict[str, np.ndarray]:
         """Each action field's head-direction input: a Gaussian whose centre, cell 50, means 'facing the

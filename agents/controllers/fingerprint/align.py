@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from swarm.core.kernels import exported, njit
+from swarm.core.params import OURS, declared
 from swarm.core.tables import params_from_table
 
 HUES = 16  # symbols 0..15: hue bins 'A'..'P'
@@ -68,16 +69,48 @@ def from_string(text: str) -> np.ndarray:
 
 @dataclass(frozen=True)
 class AlignParams:
-    miss_hue: float = 0.02  # chance that a colour patch is missed or spurious
-    miss_edge: float = 0.5  # a vertical edge
-    miss_corner: float = 0.5  # a laser corner
-    miss_space: float = 0.5  # one empty-space quantum more or less
-    hue_near: float = 1.2  # a hue patch read one bin off
-    wrong: float = 4.0  # any other substitution (more than a gap of either feature)
-    # Probability of matching: logistic in the cost per character of the longer string,
-    # P = 1 / (1 + exp((d - centre) / width)); calibrated on office (docs/fingerprint.md).
-    centre: float = 0.544
-    width: float = 0.122
+    """Global alignment with uncertainty: the paper names the method ([26], after Needleman-Wunsch) without its
+    constants; ours are negative log-probabilities of what makes two views of one place differ, chosen by
+    the area under the ROC curve of same- against different-place pairs (docs/fingerprint.md, Matching).
+    """
+
+    miss_hue: float = declared(
+        0.02, source=OURS, reason="chance that a colour patch is missed or spurious (docs/fingerprint.md, Matching)"
+    )
+    miss_edge: float = declared(
+        0.5, source=OURS, reason="chance that a vertical edge is missed or spurious (docs/fingerprint.md, Matching)"
+    )
+    miss_corner: float = declared(
+        0.5, source=OURS, reason="chance that a laser corner is missed or spurious (docs/fingerprint.md, Matching)"
+    )
+    miss_space: float = declared(
+        0.5, source=OURS, reason="chance of one empty-space quantum more or less (docs/fingerprint.md, Matching)"
+    )
+    hue_near: float = declared(
+        1.2, source=OURS, reason="cost of a hue patch read one bin off (docs/fingerprint.md, Matching)"
+    )
+    wrong: float = declared(
+        4.0,
+        source=OURS,
+        reason=(
+            "any other substitution: more than a gap of either feature, so one missing feature costs "
+            "less than one wrong one"
+        ),
+    )
+    centre: float = declared(
+        0.544,
+        source=OURS,
+        reason=(
+            "P(match) = 1 / (1 + exp((d - centre) / width)), d the cost per character of the longer "
+            "string: fitted by logistic regression on office (swarm experiment fingerprint-calibrate,"
+            " docs/fingerprint.md)"
+        ),
+    )
+    width: float = declared(
+        0.122,
+        source=OURS,
+        reason="the logistic's width, fitted with centre on office (docs/fingerprint.md, Probability)",
+    )
 
     @classmethod
     def from_table(cls, table: dict | None) -> AlignParams:

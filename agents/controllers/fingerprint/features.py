@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from agents.controllers.fingerprint.align import HUES, MAX_RUN, C, N, V, paper_length, to_string
+from swarm.core.params import OURS, declared
 from swarm.core.tables import params_from_table
 
 TWO_PI = 2 * math.pi
@@ -32,16 +33,62 @@ TWO_PI = 2 * math.pi
 
 @dataclass(frozen=True)
 class FeatureParams:
-    saturation: float = 0.35  # a sector has a hue when its HSV saturation is at least this
-    min_patch: int = 2  # sectors (degrees, on the scout) a colour patch must span
-    colour_step: float = 30.0  # an edge where adjacent sectors differ this much in some RGB channel
-    depth_step: float = 0.25  # or where the camera's range jumps this much (metres) ...
-    depth_ratio: float = 0.15  # ... and this share of the nearer range
-    merge: float = math.radians(3.0)  # edges (or corners) closer than this are one
-    break_range: float = 0.3  # the laser scan breaks into stretches at range jumps above this (metres)
-    epsilon: float = 0.06  # Douglas-Peucker tolerance (metres)
-    min_segment: float = 0.4  # segments shorter than this give no corners (metres)
-    quantum: float = math.radians(20.0)  # one `n` per this much empty angle
+    """The feature extraction's numbers: the paper names the features (section 3) without any threshold; all
+    ours (docs/fingerprint.md, Features).
+    """
+
+    saturation: float = declared(
+        0.35,
+        source=OURS,
+        reason="a sector has a hue when its HSV saturation is at least this (docs/fingerprint.md, Features)",
+    )
+    min_patch: int = declared(
+        2,
+        source=OURS,
+        reason="sectors (degrees, on the scout) a colour patch must span (docs/fingerprint.md, Features)",
+    )
+    colour_step: float = declared(
+        30.0,
+        source=OURS,
+        reason="an edge where adjacent sectors differ this much in some RGB channel (docs/fingerprint.md, Features)",
+    )
+    depth_step: float = declared(
+        0.25,
+        source=OURS,
+        reason=(
+            "or where the camera's range jumps this much (metres): door frames, furniture sides, what"
+            " light and shade draw in a real image"
+        ),
+    )
+    depth_ratio: float = declared(
+        0.15, source=OURS, reason="... and this share of the nearer range (docs/fingerprint.md, Features)"
+    )
+    merge: float = declared(
+        math.radians(3.0),
+        source=OURS,
+        reason="edges (or corners) closer than this are one (docs/fingerprint.md, Features)",
+    )
+    break_range: float = declared(
+        0.3,
+        source=OURS,
+        reason="the laser scan breaks into stretches at range jumps above this (metres) before Douglas-Peucker",
+    )
+    epsilon: float = declared(
+        0.06,
+        source=OURS,
+        reason="Douglas-Peucker tolerance (metres): the paper names the algorithm (section 3) without its tolerance",
+    )
+    min_segment: float = declared(
+        0.4, source=OURS, reason="segments shorter than this give no corners (metres; docs/fingerprint.md, Features)"
+    )
+    quantum: float = declared(
+        math.radians(20.0),
+        source=OURS,
+        reason=(
+            "one `n` per this much empty angle: the paper's 'n' gives the angular distance between "
+            "features without a unit (section 3)"
+        ),
+    )
 
     @classmethod
     def from_table(cls, table: dict | None) -> FeatureParams:

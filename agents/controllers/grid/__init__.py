@@ -6,6 +6,9 @@ module of pure functions over the grid face's flat rows (world_server/grid/face/
 from swarm.core.registry import ControllerSpec
 
 _KERNELS = ("swarm.core.rng",)
+_RULE = "world_server.grid.face.marks:MarkingRule"
+_SCENARIO = "world_server.grid.scenario"
+_BODIES = f"{_SCENARIO}:PhysicsParams"  # the robots' bodies, ideal (the paper) or physical
 
 CONTROLLERS = (
     ControllerSpec(
@@ -13,6 +16,7 @@ CONTROLLERS = (
         world="grid",
         description="c-marking agents: marks that converge to the distance from the base, and trails (Simonin 2007)",
         factory="world_server.grid.face.layout:CMARKING",
+        parameters=(_RULE, f"{_SCENARIO}:CMarkingParams", _BODIES),
         kernels=_KERNELS,
     ),
     ControllerSpec(
@@ -20,6 +24,7 @@ CONTROLLERS = (
         world="grid",
         description="the marking agents alone: marks and their descent, no trails",
         factory="world_server.grid.face.layout:MARKING",
+        parameters=(_RULE, _BODIES),
         kernels=_KERNELS,
     ),
     ControllerSpec(
@@ -27,6 +32,7 @@ CONTROLLERS = (
         world="grid",
         description="the pheromone ant baseline: pheromone laid and followed, evaporating and diffusing",
         factory="world_server.grid.face.layout:ANT",
+        parameters=(f"{_SCENARIO}:AntParams", _BODIES),
         kernels=_KERNELS,
     ),
 )

@@ -9,5 +9,6 @@ CONTROLLERS = ControllerSpec(
     description="a reactive explorer: drive ahead, turn away from what is in front, now and then at random",
     example="zmaze",
     factory="agents.controllers.wander.controller:WanderController",
+    parameters=("agents.controllers.wander.controller:WanderParams",),
     table="agents.controllers.wander.controller:WanderParams.from_table",
 )

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from swarm.core.params import OURS, declared
 from swarm.core.rng_scalar import draw_unit
 from swarm.core.tables import params_from_table
 from world_server.arena.face.sensors.ir import IR_DISTANCE, IR_VALUE
@@ -26,10 +27,20 @@ from world_server.arena.face.sensors.ir import IR_DISTANCE, IR_VALUE
 
 @dataclass(frozen=True)
 class WanderParams:
-    speed: float = 0.6  # share of the wheel limit
-    avoid: float = 3.0  # react to obstacles this many robot radii from the centre
-    turn_chance: float = 0.05  # per tick
-    turn_ticks: int = 15  # longest random turn
+    """A reactive explorer of ours, for no paper: every value is ours."""
+
+    speed: float = declared(
+        0.6, source=OURS, reason="share of the wheel limit: fast enough to explore, slow enough to turn away in time"
+    )
+    avoid: float = declared(
+        3.0,
+        source=OURS,
+        reason="react to obstacles this many robot radii from the centre: room to turn on the spot before touching",
+    )
+    turn_chance: float = declared(
+        0.05, source=OURS, reason="per tick: a random turn about every 20 ticks, so straight runs cross a room"
+    )
+    turn_ticks: int = declared(15, source=OURS, reason="longest random turn, in ticks")
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> WanderParams:
