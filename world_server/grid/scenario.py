@@ -47,12 +47,23 @@ class AntParams:
     evaporation: float = 0.005
     deposit: float = 1.0
     threshold: float = 0.3
+    ceiling: float = 12.0
+    wiggle: float = 40
     detour: float = 8
 
 
 @dataclass(frozen=True)
 class CMarkingParams:
     climb_patience: int = 20
+    # Rule 5 of docs/cmarking.md: a returner that loaded on a coloured cell "mend"s the trail home (ours) or,
+    # read literally, "descend"s the marks without colouring.
+    return_on_trail: str = "mend"
+    # Rule 6: after unloading, the agent "remember"s the cell it came from (the paper's text) or "forget"s it.
+    at_base: str = "remember"
+
+
+RETURN_ON_TRAIL = ("mend", "descend")
+AT_BASE = ("remember", "forget")
 
 
 PHYSICS_MODES = ("ideal", "physical")
@@ -182,6 +193,7 @@ def paper_setup(number: int, size: int | None = None) -> Scenario:
 
 _TOP_KEYS = {"name", "seed", "agents", "controller", "q_max", "quantity", "map", "generator"}
 _TOP_KEYS |= {"ant", "cmarking", "physics"}
+_CMARKING_TEXTS = ("return_on_trail", "at_base")
 
 
 def parse_grid(data: dict, text: str, source: str) -> Scenario:
@@ -209,7 +221,8 @@ def parse_grid(data: dict, text: str, source: str) -> Scenario:
     if "cmarking" in data:
         section = section_of(data, "cmarking", source)
         no_unknown(section, set(CMarkingParams.__dataclass_fields__), source, "[cmarking]")
-        kw["cmarking"] = CMarkingParams(**{k: typed(section, k, int, source, f"cmarking.{k}") for k in section})
+        kw["cmarking"] = CMarkingParams(**{k: typed(section, k, str if k in _CMARKING_TEXTS else int, source,
+                                                     f"cmarking.{k}") for k in section})  # fmt: skip
     if "physics" in data:
         section = section_of(data, "physics", source)
         no_unknown(section, set(PhysicsParams.__dataclass_fields__), source, "[physics]")
@@ -318,11 +331,22 @@ def check_scenario(s: Scenario) -> None:
         raise ScenarioError(src, "ant.deposit", f"expected a positive amount, got {a.deposit}")
     if not (a.threshold >= 0 and np.isfinite(a.threshold)):
         raise ScenarioError(src, "ant.threshold", f"expected an amount >= 0, got {a.threshold}")
+    if not (a.ceiling > a.threshold and np.isfinite(a.ceiling)):
+        raise ScenarioError(src, "ant.ceiling", f"expected an amount above threshold ({a.threshold}), got {a.ceiling}")
+    if not (0 <= a.wiggle <= 180 and a.wiggle == int(a.wiggle)):
+        raise ScenarioError(src, "ant.wiggle", f"expected whole degrees from 0 to 180, got {a.wiggle}")
     if not 0 <= a.detour <= 10_000:
         raise ScenarioError(src, "ant.detour", f"expected 0 to 10000 steps, got {a.detour}")
     _check_physics(s.physics, src)
     if s.cmarking.climb_patience < 1:
         raise ScenarioError(src, "cmarking.climb_patience", "expected a step count >= 1")
+    if s.cmarking.return_on_trail not in RETURN_ON_TRAIL:
+        raise ScenarioError(src, "cmarking.return_on_trail", f"expected one of {', '.join(RETURN_ON_TRAIL)}, "
+                            f"got {s.cmarking.return_on_trail!r}")  # fmt: skip
+    if s.cmarking.at_base not in AT_BASE:
+        raise ScenarioError(
+            src, "cmarking.at_base", f"expected one of {', '.join(AT_BASE)}, got {s.cmarking.at_base!r}"
+        )
     if s.generator is not None:
         g = s.generator
         for key, value in (("width", g.width), ("height", g.height)):
