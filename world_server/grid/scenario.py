@@ -46,8 +46,10 @@ class AntParams:
     diffusion: float = 0.95
     evaporation: float = 0.005
     deposit: float = 1.0
-    threshold: float = 0.3
-    ceiling: float = 12.0
+    # threshold, ceiling and wiggle: the best of 25 settings in `swarm experiment tuning` (development seeds,
+    # the same budget as c-marking's climb_patience); the window's ceiling is 40 x threshold, NetLogo's [0.05, 2)
+    threshold: float = 0.001
+    ceiling: float = 0.04
     wiggle: float = 40
     detour: float = 8
 
