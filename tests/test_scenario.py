@@ -71,6 +71,11 @@ def test_good_minimal_file():
         ("[generator]\nwidth=2\nheight=5\nobstacle_density=0.1\nresources=1\n", "generator.width: expected 3 to 4096"),
         (GOOD + "[ant]\ndiffusion = 2.0\n", "ant.diffusion: expected a rate in [0, 1]"),
         (GOOD + "[ant]\ndeposit = nan\n", "ant.deposit: expected a positive amount"),
+        (GOOD + "[ant]\nwiggle = 200\n", "ant.wiggle: expected whole degrees from 0 to 180"),
+        (GOOD + "[ant]\nthreshold = 1.0\nceiling = 0.5\n", "ant.ceiling: expected an amount above threshold"),
+        (GOOD + '[cmarking]\nreturn_on_trail = "repaint"\n', "cmarking.return_on_trail: expected one of mend, descend"),
+        (GOOD + '[cmarking]\nat_base = "stay"\n', "cmarking.at_base: expected one of remember, forget"),
+        (GOOD + "[cmarking]\nat_base = 1\n", "cmarking.at_base: expected str"),
     ],
 )  # fmt: skip
 def test_bad_scenarios_say_where_and_what(text, expected):

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from swarm.core.errors import ScenarioError
-from swarm.core.params import OURS, PAPER, declared
+from swarm.core.params import CODE, OURS, PAPER, declared
 from swarm.core.tables import no_unknown, section_of, typed
 from world_server.grid.face.layout import CONTROLLERS
 
@@ -45,7 +45,7 @@ class Generator:
 
 @dataclass(frozen=True)
 class AntParams:
-    """The pheromone ant baseline (section 5.5; docs/cmarking.md, "The ant baseline")."""
+    """The pheromone ant baseline: NetLogo's Ants model (section 5.5; docs/cmarking.md, "The ant baseline")."""
 
     diffusion: float = declared(0.95, source=PAPER, where="section 5.5: the diffusion rate is set to 95%")
     evaporation: float = declared(0.005, source=PAPER, where="section 5.5: the evaporation rate to 0.5%")
@@ -56,10 +56,20 @@ class AntParams:
         "matters, so one unit per cell crossed (docs/cmarking.md, the ant baseline)",
     )
     threshold: float = declared(
-        0.3,
+        0.001,
         source=OURS,
-        reason="the paper does not give its ant model's rule; the best of "
-        "0.001-10 in a sweep, as the paper tuned its model (docs/cmarking.md)",
+        reason="the paper does not give its ant model's rule; the best of 25 settings of "
+        "`swarm experiment tuning` on development seeds, the budget c-marking's climb_patience had",
+    )
+    ceiling: float = declared(
+        0.04,
+        source=OURS,
+        reason="NetLogo's window [0.05, 2) is 40 x its floor; kept at 40 x threshold",
+    )
+    wiggle: float = declared(
+        40,
+        source=CODE,
+        where="NetLogo Ants model: `rt random 40 lt random 40` each step; also the tuning's best",
     )
     detour: float = declared(
         8,
@@ -71,7 +81,7 @@ class AntParams:
 
 @dataclass(frozen=True)
 class CMarkingParams:
-    """The c-marking agents' one open number (docs/cmarking.md, choice 9)."""
+    """The c-marking agents' open numbers and the two rules the paper leaves open (docs/cmarking.md)."""
 
     climb_patience: int = declared(
         20,
@@ -80,6 +90,22 @@ class CMarkingParams:
         "trails make 2x2 loops) livelocks under the literal rules; after this many climb "
         "steps without a higher mark it wipes and erases (docs/cmarking.md, choice 9)",
     )
+    return_on_trail: str = declared(
+        "mend",
+        source=OURS,
+        reason="rule 5: a returner that loaded on a coloured cell mends the trail home; "
+        "the literal reading `descend` leaves gaps (the report's ablation shows both)",
+    )
+    at_base: str = declared(
+        "remember",
+        source=OURS,
+        reason="rule 6: the literal reading of 'coloured neighbours different from the previous "
+        "position' right after unloading; `forget` is the alternative (the report's ablation shows both)",
+    )
+
+
+RETURN_ON_TRAIL = ("mend", "descend")
+AT_BASE = ("remember", "forget")
 
 
 PHYSICS_MODES = ("ideal", "physical")
@@ -228,6 +254,7 @@ def paper_setup(number: int, size: int | None = None) -> Scenario:
 
 _TOP_KEYS = {"name", "seed", "agents", "controller", "q_max", "quantity", "map", "generator"}
 _TOP_KEYS |= {"ant", "cmarking", "physics"}
+_CMARKING_TEXTS = ("return_on_trail", "at_base")
 
 
 def parse_section(data: dict, text: str, source: str, name: str, controllers: Mapping) -> Scenario:
@@ -263,7 +290,8 @@ def parse_grid(data: dict, text: str, source: str, name: str | None = None) -> S
     if "cmarking" in data:
         section = section_of(data, "cmarking", source)
         no_unknown(section, set(CMarkingParams.__dataclass_fields__), source, "[cmarking]")
-        kw["cmarking"] = CMarkingParams(**{k: typed(section, k, int, source, f"cmarking.{k}") for k in section})
+        kw["cmarking"] = CMarkingParams(**{k: typed(section, k, str if k in _CMARKING_TEXTS else int, source,
+                                                     f"cmarking.{k}") for k in section})  # fmt: skip
     if "physics" in data:
         section = section_of(data, "physics", source)
         no_unknown(section, set(PhysicsParams.__dataclass_fields__), source, "[physics]")
@@ -372,11 +400,22 @@ def check_scenario(s: Scenario) -> None:
         raise ScenarioError(src, "ant.deposit", f"expected a positive amount, got {a.deposit}")
     if not (a.threshold >= 0 and np.isfinite(a.threshold)):
         raise ScenarioError(src, "ant.threshold", f"expected an amount >= 0, got {a.threshold}")
+    if not (a.ceiling > a.threshold and np.isfinite(a.ceiling)):
+        raise ScenarioError(src, "ant.ceiling", f"expected an amount above threshold ({a.threshold}), got {a.ceiling}")
+    if not (0 <= a.wiggle <= 180 and a.wiggle == int(a.wiggle)):
+        raise ScenarioError(src, "ant.wiggle", f"expected whole degrees from 0 to 180, got {a.wiggle}")
     if not 0 <= a.detour <= 10_000:
         raise ScenarioError(src, "ant.detour", f"expected 0 to 10000 steps, got {a.detour}")
     _check_physics(s.physics, src)
     if s.cmarking.climb_patience < 1:
         raise ScenarioError(src, "cmarking.climb_patience", "expected a step count >= 1")
+    if s.cmarking.return_on_trail not in RETURN_ON_TRAIL:
+        raise ScenarioError(src, "cmarking.return_on_trail", f"expected one of {', '.join(RETURN_ON_TRAIL)}, "
+                            f"got {s.cmarking.return_on_trail!r}")  # fmt: skip
+    if s.cmarking.at_base not in AT_BASE:
+        raise ScenarioError(
+            src, "cmarking.at_base", f"expected one of {', '.join(AT_BASE)}, got {s.cmarking.at_base!r}"
+        )
     if s.generator is not None:
         g = s.generator
         for key, value in (("width", g.width), ("height", g.height)):

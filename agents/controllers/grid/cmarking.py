@@ -21,7 +21,8 @@ leaves open are fixed here and explained in docs/cmarking.md:
 * a climber that has climbed `climb_patience` steps without reaching a higher
   mark than it has already seen is circling: it erases the fragment it stands on.
 
-Params: params[P_CLIMB_PATIENCE].
+Params: params[P_CLIMB_PATIENCE], params[P_DESCEND_ON_TRAIL], params[P_FORGET_AT_BASE] (rules 5 and 6 of
+docs/cmarking.md; 0, 0: ours).
 """
 
 from numba import njit
@@ -47,6 +48,8 @@ from world_server.grid.face.layout import (
     N_DIRS,
     OBST,
     P_CLIMB_PATIENCE,
+    P_DESCEND_ON_TRAIL,
+    P_FORGET_AT_BASE,
     RES,
     RETURN,
     RETURN_COLOUR,
@@ -66,7 +69,7 @@ def new_trail_id(tick, agent):
 
 
 @njit(cache=True, inline="always")
-def begin_return(pi, mem, tick, agent):
+def begin_return(pi, mem, params, tick, agent):
     """LOADING, read one tick after the LOAD: choose the kind of return from
     what is left on the cell (the world resolved every agent's load)."""
     mem[M_LOADING] = 0
@@ -76,8 +79,11 @@ def begin_return(pi, mem, tick, agent):
         mem[M_MODE] = SEARCH  # someone else emptied the cell first
     elif pi[RES] != 0:
         if pi[TRAIL] != 0:
-            mem[M_MODE] = RETURN_MEND  # already on a trail: follow it home, mending gaps
-            mem[M_TRAIL] = pi[TRAIL]
+            if params[P_DESCEND_ON_TRAIL] != 0:
+                mem[M_MODE] = RETURN  # rule 5 read literally: plain descent, no colour
+            else:
+                mem[M_MODE] = RETURN_MEND  # already on a trail: follow it home, mending gaps
+                mem[M_TRAIL] = pi[TRAIL]
         else:
             mem[M_MODE] = RETURN_COLOUR
             mem[M_TRAIL] = new_trail_id(tick, agent)
@@ -199,7 +205,7 @@ def cmarking_step(pi, pf, mem, act, params, seed, agent, tick):
     reset_action(act)
     act[A_MARK] = update_value(pi)
     if mem[M_LOADING]:
-        begin_return(pi, mem, tick, agent)
+        begin_return(pi, mem, params, tick, agent)
     settle_mode(pi, mem)
     mode = mem[M_MODE]
     if mode == ERASE:
@@ -211,4 +217,6 @@ def cmarking_step(pi, pf, mem, act, params, seed, agent, tick):
         if not unload_if_home(pi, mem, act):
             returning_step(pi, mem, act, params, seed, agent, tick)
             return
+        if params[P_FORGET_AT_BASE] != 0:
+            mem[M_PREV] = -1  # rule 6's alternative: climb from the base as if arriving fresh
     search_step(pi, mem, act, params, seed, agent, tick)

@@ -17,7 +17,7 @@ import numpy as np
 from swarm.experiments import protocol as P
 from swarm.experiments import stats as S
 from swarm.experiments.runner import Outputs, batch_run
-from swarm.experiments.simonin2007 import paper
+from swarm.experiments.simonin2007 import paper, rules
 from swarm.experiments.simonin2007.tables import (
     ANT_SIZES,
     EXPERIMENTS,
@@ -29,36 +29,56 @@ from swarm.experiments.simonin2007.tables import (
 )
 
 # runs per condition: the full report, and --quick (a check that everything runs, not evidence)
-REPS = {"table1": 1000, "table2": 5000, "table3": 100, "ants": 100}  # table 2: the paper's 5000
-QUICK_REPS = {"table1": 8, "table2": 40, "table3": 3, "ants": 3}
-TABLES = tuple(REPS)
+REPS = {"table1": 1000, "table2": 5000, "table3": 100, "ants": 100, "rules": 200}  # table 2: the paper's 5000
+QUICK_REPS = {"table1": 8, "table2": 40, "table3": 3, "ants": 3, "rules": 3}
+TABLES = ("table1", "table2", "table3", "ants")
 
 
-def plan(reps: dict[str, int]) -> list[RunSpec]:
-    """Every run of the report: each table's conditions × its first n confirmation seeds, biggest first."""
-    specs = [
+def plan(reps: dict[str, int]) -> list[RunSpec | tuple]:
+    """Every run of the report: each table's conditions × its first n confirmation seeds, and the rules'
+    ablation (rules.jobs), biggest first."""
+    specs: list[RunSpec | tuple] = [
         RunSpec(name, c.scenario, c.size, c.agents, c.controller, c.physics, seed, EXPERIMENTS[name].max_iterations)
         for name in TABLES
         for c in EXPERIMENTS[name].configs()
         for seed in P.seeds(reps[name], confirm=True)
     ]
-    return sorted(specs, key=expected_work, reverse=True)
+    specs += rules.jobs(P.seeds(reps["rules"], confirm=True))
+    return sorted(specs, key=_work, reverse=True)
+
+
+def _work(job: RunSpec | tuple) -> float:
+    if isinstance(job, RunSpec):
+        return expected_work(job)
+    return 100.0**2 * 5 if job[0] == "setup3-100" else 40.0**2  # the literal rule 5 is up to 5x slower
+
+
+def run_job(job: RunSpec | tuple) -> dict:
+    """A table's run (RunSpec) or an ablation's (rules.jobs)."""
+    return run_one(job) if isinstance(job, RunSpec) else rules.run_rule(job)
 
 
 def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = None, progress: bool = True) -> dict:
     reps = QUICK_REPS if quick else REPS
     out_ = Outputs(out if out is not None else Path("results") / "reproduce" / "simonin2007", "simonin2007")
     specs = plan(reps)
-    physics = sorted({s.physics for s in specs})
-    rows = batch_run(run_one, specs, jobs=jobs, desc="simonin2007", progress=progress, warm_up=warm_up,
-                     warm_args=(physics,), chunksize=4)  # fmt: skip
+    physics = sorted({s.physics for s in specs if isinstance(s, RunSpec)})
+    every = batch_run(run_job, specs, jobs=jobs, desc="simonin2007", progress=progress, warm_up=warm_up,
+                      warm_args=(physics,), chunksize=4)  # fmt: skip
+    rows = [r for r in every if r["experiment"] != "rules"]
     rows.sort(key=lambda r: (TABLES.index(r["experiment"]), r["size"], r["agents"], r["controller"], r["seed"]))
+    ablation = [r for r in every if r["experiment"] == "rules"]
+    ablation.sort(key=lambda r: (r["scenario"], r["agents"], r["return_on_trail"], r["at_base"], r["seed"]))
+    out_.runs(ablation, rules.FIELDS, file="rules.csv")
     out_.runs(rows, RUN_FIELDS)
     sections = [_table1(rows), _table2(rows), _table3(rows), _ants(rows)]
     claims = [c for _, _, cs in sections for c in cs]
     for name in TABLES:
         EXPERIMENTS[name].plot([r for r in rows if r["experiment"] == name], out_ / f"{name}.png")
-    text = _report(sections, claims, reps, quick)
+    text = _report(sections, claims, reps, quick) + "
+## {}
+
+{}".format(*rules.section(ablation))
     result = out_.finish([_claim_row(c) for c in claims], text)
     (out_ / "report.md").write_text(text)
     return result | {"claims": len(claims), "verdicts": _tally(claims)}

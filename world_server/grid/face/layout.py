@@ -79,6 +79,7 @@ M_CLIMB_STALL = 4  # climb steps since that maximum last rose
 M_CLIMBING = 5  # 1 if the last move was a climb along a trail
 M_LOADING = 6  # 1 if the last action was LOAD (the outcome is read this tick)
 M_DETOUR = 7  # ants: random steps left after the compass way home was blocked
+M_HEADING = M_CLIMB_MAX  # ants (which never climb a trail): heading + 1 in degrees clockwise from north, 0 unset
 MEM_LEN = 8
 
 # Controller modes (shared names so the recorder can label them).
@@ -99,8 +100,12 @@ ANT = 2
 CONTROLLERS: dict[str, int] = {"cmarking": CMARKING, "marking": MARKING, "ant": ANT}
 N_PARAMS = 4  # length of the controllers' float parameter vector (the world sends it in the welcome)
 P_CLIMB_PATIENCE = 0  # cmarking: ticks a climber may stall on a trail before it erases it ([cmarking])
+P_DESCEND_ON_TRAIL = 1  # cmarking: 1 when a returner that loaded on a trail descends without colouring (rule 5)
+P_FORGET_AT_BASE = 2  # cmarking: 1 when an agent forgets the cell it came from once it unloads (rule 6)
 P_THRESHOLD = 0  # ant: the pheromone an ant follows ([ant])
 P_DETOUR = 1  # ant: ticks of random walk after losing the pheromone ([ant])
+P_WIGGLE = 2  # ant: its heading turns by up to this many degrees each way every step ([ant])
+P_CEILING = 3  # ant: it sniffs for a stronger scent only below this pheromone on its cell ([ant])
 
 
 def controller_kind(name: str) -> int:
@@ -115,9 +120,13 @@ def controller_params(scenario) -> np.ndarray:
     params = np.zeros(N_PARAMS, dtype=np.float64)
     if scenario.controller == "cmarking":
         params[P_CLIMB_PATIENCE] = scenario.cmarking.climb_patience
+        params[P_DESCEND_ON_TRAIL] = scenario.cmarking.return_on_trail == "descend"
+        params[P_FORGET_AT_BASE] = scenario.cmarking.at_base == "forget"
     elif scenario.controller == "ant":
         params[P_THRESHOLD] = scenario.ant.threshold
         params[P_DETOUR] = scenario.ant.detour
+        params[P_WIGGLE] = scenario.ant.wiggle
+        params[P_CEILING] = scenario.ant.ceiling
     return params
 
 
