@@ -94,11 +94,11 @@ class Outputs:
         self.rows = rows
         write_csv(self.folder / file, rows, fields)
 
-    def finish(self, summary: list[dict] | None, text: str) -> dict:
-        """summary.csv (where the experiment summarises its runs in rows) and table.md; the result
-        `swarm experiment` prints."""
+    def finish(self, summary: list[dict] | None, text: str, file: str = "table.md") -> dict:
+        """summary.csv (where the experiment summarises its runs in rows) and the markdown `text`
+        (table.md; a reproduction's is its report.md); the result `swarm experiment` prints."""
         if summary is not None:
             write_csv(self.folder / "summary.csv", summary)
-        (self.folder / "table.md").write_text(text)
+        (self.folder / file).write_text(text)
         return {"name": self.name, "out": str(self.folder), "runs": len(self.rows), "summary": summary,
                 "markdown": text}  # fmt: skip

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from swarm.experiments import protocol as P
+from swarm.experiments import report as R
 from swarm.experiments import stats as S
 from swarm.experiments.runner import Outputs, batch_run
 from swarm.experiments.simonin2007 import paper, rules
@@ -32,6 +33,10 @@ from swarm.experiments.simonin2007.tables import (
 REPS = {"table1": 1000, "table2": 5000, "table3": 100, "ants": 100, "rules": 200}  # table 2: the paper's 5000
 QUICK_REPS = {"table1": 8, "table2": 40, "table3": 3, "ants": 3, "rules": 3}
 TABLES = ("table1", "table2", "table3", "ants")
+DESIGN = (
+    "A seed is a map, shared by every condition of a table, so comparisons are paired. Intervals are 95% "
+    "(bootstrap BCa for means, percentile for ratios; Kaplan-Meier for capped runs)."
+)
 
 
 def plan(reps: dict[str, int]) -> list[RunSpec | tuple]:
@@ -75,13 +80,10 @@ def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = N
     claims = [c for _, _, cs in sections for c in cs]
     for name in TABLES:
         EXPERIMENTS[name].plot([r for r in rows if r["experiment"] == name], out_ / f"{name}.png")
-    text = _report(sections, claims, reps, quick) + "
-## {}
-
-{}".format(*rules.section(ablation))
-    result = out_.finish([_claim_row(c) for c in claims], text)
-    (out_ / "report.md").write_text(text)
-    return result | {"claims": len(claims), "verdicts": _tally(claims)}
+    parts = [(title, table) for title, table, _ in sections] + [rules.section(ablation)]
+    text = R.report_text("Simonin, Charpillet & Thierry (2007)", DESIGN, claims, parts, reps, quick)
+    result = out_.finish([R.claim_row(c) for c in claims], text, file="report.md")
+    return result | {"claims": len(claims), "verdicts": R.tally(claims)}
 
 
 # ----------------------------------------------------------------- sections
@@ -120,7 +122,7 @@ def _table1(rows: list[dict]):
         paper_ratio = paper.TABLE1[m][0] / paper.TABLE1[n][0]
         claims.append(P.Claim(f"setup 1: doubling {n} to {m} agents at least halves the time (T({m})/T({n}) <= 0.5)",
                               f"{paper_ratio:.2f}", est.text(3), test, expected=-1))  # fmt: skip
-    table = _md(["agents", "ours: iterations (95% CI)", "ours: std", "paper: mean", "paper: std"], lines)
+    table = R.markdown_table(["agents", "ours: iterations (95% CI)", "ours: std", "paper: mean", "paper: std"], lines)
     return "Table 1: setup 1 (40x40, 30% obstacles, 20 resources), agents 5 to 160", table, claims
 
 
@@ -142,7 +144,7 @@ def _table2(rows: list[dict]):
     claims.append(P.Claim("setup 2: the saving T(1)/n - T(n) falls as n grows from 2 to 8",
                           "+23.7 to -12.4", "see the table", S.spearman(np.concatenate(ns[1:]),
                           np.concatenate(savings[1:])), expected=-1))  # fmt: skip
-    table = _md(["agents", "ours: iterations (95% CI)", "ours: T(1)/n - T(n) (95% CI)", "paper: mean",
+    table = R.markdown_table(["agents", "ours: iterations (95% CI)", "ours: T(1)/n - T(n) (95% CI)", "paper: mean",
                  "paper: projected - experimental"], lines)  # fmt: skip
     return "Table 2: setup 2 (20x20, 5% obstacles, 2 resources), super-linearity", table, claims
 
@@ -163,7 +165,9 @@ def _table3(rows: list[dict]):
     est, test = S.ratio_of_means(big, mid, paired=False, null=2.0)
     claims.append(P.Claim("setup 3: beyond 100x100, R (the time ratio per quadrupled area) rises above 2",
                           f"{paper.TABLE3[200] / paper.TABLE3[100]:.2f}", est.text(3), test))  # fmt: skip
-    table = _md(["size", "ours: iterations (95% CI)", "ours: R (95% CI)", "paper: mean", "paper: R"], lines)
+    table = R.markdown_table(
+        ["size", "ours: iterations (95% CI)", "ours: R (95% CI)", "paper: mean", "paper: R"], lines
+    )
     return "Table 3: setup 3 (5% obstacles, 20 resources, 50 agents), sizes 12 to 200", table, claims
 
 
@@ -190,49 +194,7 @@ def _ants(rows: list[dict]):
     claims.append(P.Claim("section 5.5: the gap 1 - c-marking/ants shrinks as the environment grows",
                           " -> ".join(f"{g}%" for g in paper.ANT_GAP_PERCENT), "see the table",
                           S.spearman(np.concatenate(sizes), np.concatenate(gaps)), expected=-1))  # fmt: skip
-    table = _md(["size", "c-marking: iterations (95% CI)", "ants: iterations (95% CI)", "gap (95% CI)"], lines)
+    table = R.markdown_table(
+        ["size", "c-marking: iterations (95% CI)", "ants: iterations (95% CI)", "gap (95% CI)"], lines
+    )
     return "Section 5.5: c-marking against the ant model (setup 3, 50 agents)", table, claims
-
-
-# ------------------------------------------------------------------- report
-
-
-def _report(sections, claims: list[P.Claim], reps: dict[str, int], quick: bool) -> str:
-    first = P.CONFIRMATION_SEEDS.start
-    head = [
-        "# Simonin, Charpillet & Thierry (2007): the reproduction",
-        "",
-        ("**Quick run: too few runs to be evidence; it checks that everything runs.**\n" if quick else "")
-        + "Seeds from the confirmation range only ("
-        + ", ".join(f"{name}: {first}..{first + n - 1}" for name, n in reps.items())
-        + "); a seed is a map, shared by every condition of a table, so comparisons are paired. "
-        "Intervals are 95% (bootstrap BCa for means, percentile for ratios; Kaplan-Meier for capped runs). "
-        "Verdicts follow one rule (swarm/experiments/protocol.py): the expected direction with p < 0.05 is "
-        "*reproduced*, without it *same direction, not significant*; the opposite direction with p < 0.05 "
-        "is *reversed*, without it *not reproduced*.",
-        "",
-        "## Claims",
-        "",
-        P.claims_table(claims),
-    ]
-    for title, table, _ in sections:
-        head += [f"## {title}", "", table, ""]
-    return "\n".join(head)
-
-
-def _md(header: list[str], lines: list[list[str]]) -> str:
-    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    return "\n".join(out + ["| " + " | ".join(line) + " |" for line in lines]) + "\n"
-
-
-def _claim_row(c: P.Claim) -> dict:
-    t = c.test
-    return {"claim": c.text, "paper": c.paper, "ours": c.ours, "test": t.name if t else "", "n": t.n if t else "",
-            "p": t.p if t else "", "effect": t.effect if t else "", "verdict": c.verdict}  # fmt: skip
-
-
-def _tally(claims: list[P.Claim]) -> dict[str, int]:
-    tally: dict[str, int] = {}
-    for c in claims:
-        tally[c.verdict] = tally.get(c.verdict, 0) + 1
-    return tally

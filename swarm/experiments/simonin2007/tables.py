@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from swarm.core.plots import pyplot, save_figure
+from swarm.experiments.report import markdown_table
 from swarm.experiments.runner import Outputs, batch_run, cross
 from swarm.experiments.simonin2007 import paper
 
@@ -94,15 +95,6 @@ def _fmt(x: float, digits: int = 1) -> str:
     return "n/a" if x != x else f"{x:,.{digits}f}"
 
 
-def _md(header: list[str], lines: list[list[str]]) -> str:
-    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    out += ["| " + " | ".join(line) + " |" for line in lines]
-    return "\n".join(out)
-
-
-# --------------------------------------------------------------------- table 1
-
-
 def _table1_configs():
     return [Config("setup1", 40, n) for n in paper.TABLE1]
 
@@ -118,7 +110,7 @@ def _table1_report(rows):
                         "ratio_to_paper": round(mean / p_mean, 3), "ratio_to_previous": round(halving, 3)})  # fmt: skip
         lines.append([str(n), _fmt(mean), _fmt(std), str(p_mean), str(p_std), f"{mean / p_mean:.2f}",
                       _fmt(halving, 2), f"{unfinished}/{count}"])  # fmt: skip
-    md = _md(["agents", "ours: mean", "ours: std", "paper: mean", "paper: std", "ours/paper",
+    md = markdown_table(["agents", "ours: mean", "ours: std", "paper: mean", "paper: std", "ours/paper",
               "ours: T(n)/T(n/2)", "unfinished"], lines)  # fmt: skip
     return summary, md
 
@@ -159,7 +151,7 @@ def _table2_report(rows):
                         "ratio_to_paper": round(mean / p_exp, 3)})  # fmt: skip
         lines.append([str(n), f"{_fmt(mean)} ± {_fmt(sem)}", _fmt(proj), _fmt(proj - mean),
                       _fmt(p_exp), _fmt(p_proj), _fmt(p_proj - p_exp), f"{mean / p_exp:.2f}"])  # fmt: skip
-    md = _md(["agents", "ours: mean ± s.e.", "ours: projected", "ours: proj-exp", "paper: mean",
+    md = markdown_table(["agents", "ours: mean ± s.e.", "ours: projected", "ours: proj-exp", "paper: mean",
               "paper: projected", "paper: proj-exp", "ours/paper"], lines)  # fmt: skip
     return summary, md
 
@@ -199,7 +191,7 @@ def _table3_report(rows):
                         "paper_R": round(p_r, 3), "ratio_to_paper": round(mean / p_mean, 3)})  # fmt: skip
         lines.append([f"{size}x{size}", _fmt(mean), _fmt(std), _fmt(r, 2), str(p_mean), _fmt(p_r, 2),
                       f"{mean / p_mean:.2f}", f"{unfinished}/{count}"])  # fmt: skip
-    md = _md(["size", "ours: mean", "ours: std", "ours: R", "paper: mean", "paper: R", "ours/paper",
+    md = markdown_table(["size", "ours: mean", "ours: std", "ours: R", "paper: mean", "paper: R", "ours/paper",
               "unfinished"], lines)  # fmt: skip
     return summary, md
 
@@ -236,7 +228,7 @@ def _ants_report(rows):
                         "ant_unfinished": ant_unf, "runs": cm_n, "cmarking_wins": bool(cm < ant)})  # fmt: skip
         lines.append([f"{size}x{size}", _fmt(cm), _fmt(ant), f"{gap:.0f}%", "yes" if cm < ant else "NO",
                       f"{cm_unf}+{ant_unf}/{cm_n + ant_n}"])  # fmt: skip
-    md = _md(["size", "c-marking: mean", "ant: mean", "gap 1-cm/ant", "c-marking faster",
+    md = markdown_table(["size", "c-marking: mean", "ant: mean", "gap 1-cm/ant", "c-marking faster",
               "unfinished"], lines)  # fmt: skip
     md += (f"\n\nPaper (section 5.5, Figure 9): the gap shrinks "
            f"{' -> '.join(f'{g}%' for g in paper.ANT_GAP_PERCENT)} as the environment grows.")  # fmt: skip
@@ -281,7 +273,7 @@ def _congestion_report(rows):
                         "physical_ticks_per_second": round(rate), "paper_mean": paper.TABLE1[n][0]})  # fmt: skip
         lines.append([str(n), str(paper.TABLE1[n][0]), _fmt(ideal, 0), _fmt(phys, 0), _fmt(phys / ideal, 2),
                       _fmt(share, 3), _fmt(moves, 0), _fmt(rate, 0), f"{phys_unf}/{len(bodies)}"])  # fmt: skip
-    md = _md(["agents", "paper (Table 1): mean", "ideal: mean", "physical: mean", "physical / ideal",
+    md = markdown_table(["agents", "paper (Table 1): mean", "ideal: mean", "physical: mean", "physical / ideal",
               "blocked share", "blocked moves per run", "physical ticks/s", "physical unfinished"], lines)  # fmt: skip
     md += (f"\n\nPhysical: pymunk discs (the scenario's bodies: diameter 0.4 cells by default). A run still "
            f"foraging after {CONGESTION_CAP:,} ticks is cut there, counted as unfinished, and enters the mean at "
