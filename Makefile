@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: install browser docker demo test lint experiments bench clean
+.PHONY: install browser docker demo test lint experiments reproduce bench clean
 
 install: $(STAMP)
 
@@ -51,6 +51,9 @@ experiments: install
 	$(BIN)/swarm experiment table3 --reps 50
 	$(BIN)/swarm experiment ants --reps 20
 	$(BIN)/swarm experiment congestion --reps 10 --seed 1
+
+reproduce: install
+	$(BIN)/swarm reproduce all --out docs/reports
 
 bench: install
 	$(BIN)/swarm bench engine

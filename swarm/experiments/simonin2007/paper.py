@@ -16,3 +16,19 @@ TABLE3 = {12: 155.5, 25: 345, 50: 805, 100: 2290, 200: 7844}
 # The text does not say at which sizes; we read them as the three largest sizes
 # plotted in Figure 9 and compare our gap, 1 - cmarking / ant, at every size.
 ANT_GAP_PERCENT = (73, 52, 37)
+
+# What our setup does differently from the paper's, and why (the report's last section).
+KNOWN_DIFFERENCES = (
+    "Maps: the paper does not say how TurtleKit drew its 30% obstacles (a probability per cell or an exact count) "
+    "nor whether a resource may sit where the base cannot reach; ours draw an exact count and place resources only "
+    "where the base can reach (world_server/grid/scenario.py).",
+    "Scheduling: TurtleKit steps agents one after another, each seeing the writes of those before it; ours all "
+    "decide from the start-of-tick world, so lock-step distributed runs equal in-process runs (docs/engine.md).",
+    "Loading takes the tick (choice 2 of docs/cmarking.md): about one iteration per trip.",
+    "Rules 5 and 6 are open in the paper: ours mend the trail home and remember the previous cell at the base; "
+    "the ablation above shows what each reading does.",
+    "climb_patience (choice 9): a climber circling a loop of trail cells gives up after 20 steps; the literal "
+    "rules livelock there.",
+    "The ant model: the paper gives only its rates and compass homing; ours is NetLogo's Ants model (wiggle 40, "
+    "sniffing ahead-left, ahead and ahead-right), tuned with the budget c-marking had (`swarm experiment tuning`).",
+)

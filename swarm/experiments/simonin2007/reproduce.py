@@ -80,7 +80,10 @@ def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = N
     claims = [c for _, _, cs in sections for c in cs]
     for name in TABLES:
         EXPERIMENTS[name].plot([r for r in rows if r["experiment"] == name], out_ / f"{name}.png")
-    parts = [(title, table) for title, table, _ in sections] + [rules.section(ablation)]
+    parts = [
+        (title, f"{table}\n![{name}]({name}.png)\n") for name, (title, table, _) in zip(TABLES, sections, strict=True)
+    ]
+    parts += [rules.section(ablation), ("Known differences", "\n".join(f"- {d}" for d in paper.KNOWN_DIFFERENCES))]
     text = R.report_text("Simonin, Charpillet & Thierry (2007)", DESIGN, claims, parts, reps, quick)
     result = out_.finish([R.claim_row(c) for c in claims], text, file="report.md")
     return result | {"claims": len(claims), "verdicts": R.tally(claims)}
