@@ -55,3 +55,19 @@ def test_reproduce_all_quick_from_the_command_line(tmp_path):
     assert done.returncode == 0, done.stderr[-2000:]
     for name in PAPERS.names():
         assert (tmp_path / name / "report.md").is_file()
+
+
+def test_a_reports_parameter_page_lists_every_declared_parameter_with_its_source(tmp_path):
+    from swarm.core.params import provenance
+    from swarm.experiments.report import parameter_classes, parameters_page, parameters_section
+
+    classes = parameter_classes(("cmarking", "ant", "cmarking"))
+    assert len(classes) == len(set(classes)) and classes  # each class once
+    page = parameters_page("T", ("cmarking", "ant"))
+    for cls in classes:
+        assert f"## {cls.__name__} ({cls.__module__})" in page
+        for p in provenance(cls):
+            assert f"| {p.name} | " in page
+    title, text = parameters_section(("cmarking", "ant"))
+    total = sum(len(provenance(c)) for c in classes)
+    assert title == "Parameters" and text.startswith(f"{total} parameters (") and "parameters.md" in text

@@ -6,6 +6,9 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Mapping, Sequence
 
+from agents.controllers import CONTROLLERS
+from swarm.core.params import SOURCES, provenance, provenance_table
+from swarm.core.registry import resolve
 from swarm.experiments import protocol as P
 
 QUICK_BANNER = "**Quick run: too few runs to be evidence; it checks that everything runs.**"
@@ -50,3 +53,32 @@ def claim_row(c: P.Claim) -> dict:
 def tally(claims: Sequence[P.Claim]) -> dict[str, int]:
     """How many claims got each verdict."""
     return dict(Counter(c.verdict for c in claims))
+
+
+def parameter_classes(controllers: Sequence[str]) -> list[type]:
+    """The parameter classes the controllers declare (ControllerSpec.parameters), each once, in order."""
+    seen: dict[str, type] = {}
+    for name in controllers:
+        for ref in CONTROLLERS[name].parameters:
+            seen.setdefault(ref, resolve(ref))
+    return list(seen.values())
+
+
+def parameters_page(title: str, controllers: Sequence[str]) -> str:
+    """parameters.md: every parameter the report's runs use, with its value and provenance."""
+    parts = [f"# {title}: the declared parameters", "",
+             "Every value the report's runs use unless an experiment says otherwise, with its provenance: "
+             "the paper's (where it gives it), the original code's, or ours with the reason "
+             "(swarm/core/params.py).", ""]  # fmt: skip
+    for cls in parameter_classes(controllers):
+        doc = " ".join((cls.__doc__ or "").strip().split("\n\n")[0].split())  # its first paragraph
+        parts += [f"## {cls.__name__} ({cls.__module__})", "", doc, "", provenance_table(cls), ""]
+    return "\n".join(parts)
+
+
+def parameters_section(controllers: Sequence[str]) -> tuple[str, str]:
+    """The report's section on its parameters: how many come from where, and a link to parameters.md."""
+    counts = Counter(p.source or "undeclared" for cls in parameter_classes(controllers) for p in provenance(cls))
+    said = ", ".join(f"{counts[s]} {s}" for s in (*SOURCES, "undeclared") if counts[s])
+    return "Parameters", (f"{sum(counts.values())} parameters ({said}; controllers: {', '.join(controllers)}), "
+                          "one declared set for every experiment: [parameters.md](parameters.md).")  # fmt: skip

@@ -33,6 +33,8 @@ from swarm.experiments.simonin2007.tables import (
 REPS = {"table1": 1000, "table2": 5000, "table3": 100, "ants": 100, "rules": 200}  # table 2: the paper's 5000
 QUICK_REPS = {"table1": 8, "table2": 40, "table3": 3, "ants": 3, "rules": 3}
 TABLES = ("table1", "table2", "table3", "ants")
+TITLE = "Simonin, Charpillet & Thierry (2007)"
+CONTROLLERS = ("cmarking", "ant")
 DESIGN = (
     "A seed is a map, shared by every condition of a table, so comparisons are paired. Intervals are 95% "
     "(bootstrap BCa for means, percentile for ratios; Kaplan-Meier for capped runs)."
@@ -83,8 +85,13 @@ def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = N
     parts = [
         (title, f"{table}\n![{name}]({name}.png)\n") for name, (title, table, _) in zip(TABLES, sections, strict=True)
     ]
-    parts += [rules.section(ablation), ("Known differences", "\n".join(f"- {d}" for d in paper.KNOWN_DIFFERENCES))]
-    text = R.report_text("Simonin, Charpillet & Thierry (2007)", DESIGN, claims, parts, reps, quick)
+    parts += [
+        rules.section(ablation),
+        ("Known differences", "\n".join(f"- {d}" for d in paper.KNOWN_DIFFERENCES)),
+        R.parameters_section(CONTROLLERS),
+    ]
+    (out_ / "parameters.md").write_text(R.parameters_page(TITLE, CONTROLLERS))
+    text = R.report_text(TITLE, DESIGN, claims, parts, reps, quick)
     result = out_.finish([R.claim_row(c) for c in claims], text, file="report.md")
     return result | {"claims": len(claims), "verdicts": R.tally(claims)}
 
