@@ -7,7 +7,9 @@ Two kinds of run, each at the sensors' specified noise ("low") and with it doubl
   drives the 253 m `localize` tour (drawn from seed + 1000) localizing on that map.  The mapping run gives
   the map's claims (nodes), the second tour the localization's (matching alone, the Markov filters);
 - loops: the robot maps the 253 m `localize` tour itself, which enters rooms two and three times, for
-  the paper's loop-closing claim.
+  the paper's loop-closing claim;
+- together (our extension, descriptive only): 1, 2, 4 and 8 robots survey the floor sharing one map
+  (team.team_job), at noise low.
 
 A run is the independent unit: a fingerprint's outcome depends on its neighbours' (the belief carries
 over, nodes span many fingerprints), so shares are the mean of per-run shares with a bootstrap interval
@@ -30,11 +32,13 @@ from swarm.experiments import stats as S
 from swarm.experiments.runner import Outputs, batch_run
 from swarm.experiments.tapus2006 import paper
 from swarm.experiments.tapus2006.fingerprint import NOISES, drive_tour, judge_map, localize_run, places, tour_scenario
+from swarm.experiments.tapus2006.team import TEAMS, team_job
 
 FLOOR = "office"
 # runs per noise level: the full report (the paper: one run of each), and --quick (not evidence)
-REPS = {"localize": 60, "loops": 40}
-QUICK_REPS = {"localize": 2, "loops": 2}
+REPS = {"localize": 60, "loops": 40, "together": 10}
+QUICK_REPS = {"localize": 2, "loops": 2, "together": 1}
+QUICK_TEAMS = (1, 2)  # --quick surveys with one and two robots only
 MAP_FIELDS = ("nodes", "places_visited", "places_with_node", "purity", "false_closures")
 DESIGN = (
     f"Floor `{FLOOR}`; every run at noise low and high. The localize runs of one seed map the 76 m tour and "
@@ -45,16 +49,19 @@ DESIGN = (
 )
 
 
-def plan(reps: dict[str, int]) -> list[tuple[str, str, int]]:
-    """Every run: (kind, noise, seed), the slower localize runs first."""
-    return [(kind, noise, seed) for kind in ("localize", "loops") for noise in NOISES
-            for seed in P.seeds(reps[kind], confirm=True)]  # fmt: skip
+def plan(reps: dict[str, int], teams: Sequence[int] = TEAMS) -> list[tuple]:
+    """Every run, the slower first: (kind, noise, seed) for localize and loops, ("together", robots, seed)."""
+    work: list[tuple] = [(kind, noise, seed) for kind in ("localize", "loops") for noise in NOISES
+                         for seed in P.seeds(reps[kind], confirm=True)]  # fmt: skip
+    return work + [("together", n, seed) for n in teams for seed in P.seeds(reps["together"], confirm=True)]
 
 
 def run_job(job: tuple[str, str, int]) -> dict:
     """One run's row: the mapping run judged against the floor's places and, for a localize run, the
     second tour's counts (fingerprint.localization_counts)."""
     kind, noise, seed = job
+    if kind == "together":
+        return {"experiment": kind} | team_job((noise, "low", seed))
     head = {"experiment": kind, "noise": noise, "seed": seed}
     if kind == "localize":
         mapped, counts = localize_run(FLOOR, noise, seed, "localize")
@@ -68,14 +75,15 @@ def run_job(job: tuple[str, str, int]) -> dict:
 def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = None, progress: bool = True) -> dict:
     reps = QUICK_REPS if quick else REPS
     out_ = Outputs(out if out is not None else Path("results") / "reproduce" / "tapus2006", "tapus2006")
-    rows = batch_run(run_job, plan(reps), jobs=jobs, desc="tapus2006", progress=progress)
+    rows = batch_run(run_job, plan(reps, QUICK_TEAMS if quick else TEAMS), jobs=jobs, desc="tapus2006",
+                     progress=progress)  # fmt: skip
     out_.runs(rows)
     sections, claims = [], []
     for part in (_mapping, _localization, _loops):
         title, table, cs = part(rows)
         sections.append((title, table))
         claims += cs
-    sections.append(("Known differences", KNOWN_DIFFERENCES))
+    sections += [_together(rows, quick), ("Known differences", KNOWN_DIFFERENCES)]
     plot(rows, out_ / "localization.png")
     text = R.report_text("Tapus, Battaglia & Siegwart (2006)", DESIGN, claims, sections, reps, quick)
     text += f"\n![per-run shares at the right node](localization.png)\n\nThe paper's n: {PAPER_N}\n"
@@ -215,6 +223,32 @@ def _loops(rows: Sequence[dict]):
             "taken within 0.3 m of one taken 3 m of travel or more earlier, the share that joined a node made "
             "before then (descriptive: the paper counts loops in its offices).\n")  # fmt: skip
     return "Loop closing: the 253 m tour mapped", table + note, claims
+
+
+def _together(rows: Sequence[dict], quick: bool) -> tuple[str, str]:
+    """Robots mapping together (descriptive): when robot 0's merged map covers the floor's places, and the
+    speed-up over one robot, paired by seed."""
+    team = [r for r in rows if r["experiment"] == "together"]
+    alone = {r["seed"]: r["covered_tick"] for r in team if r["robots"] == 1}
+    lines = []
+    for n in sorted({r["robots"] for r in team}):
+        sel = sorted((r for r in team if r["robots"] == n), key=lambda r: r["seed"])
+        done = [r for r in sel if r["covered_tick"] != ""]
+        both = [r for r in done if alone.get(r["seed"], "") != ""]  # seeds where one robot covered it too
+        ticks = np.array([r["covered_tick"] for r in both], float)
+        speedup = S.ratio_of_means([alone[r["seed"]] for r in both], ticks, paired=True)[0] if n > 1 else None
+        lines.append([str(n), f"{len(done)}/{len(sel)}", S.mean_ci([r["covered_tick"] for r in done]).text(4),
+                      speedup.text(3) if speedup else "1", f"{np.mean(_col(sel, 'known_not_visited')):.1f}",
+                      S.mean_ci(_col(sel, "nodes")).text(3)])  # fmt: skip
+    table = R.markdown_table(["robots", "runs covering the floor", "covered after (ticks, covering runs, 95% CI)",
+                              "speed-up over one robot (seeds both covered, 95% CI)", "places known, never visited",
+                              "robot 0's nodes (95% CI)"], lines)  # fmt: skip
+    note = ("\nOur extension (the paper maps with one robot; no claim): N robots survey N stretches of the "
+            "corridor and its rooms, sharing their maps (docs/fingerprint.md). Covered: each of the floor's 20 "
+            "places has a node in robot 0's merged map (a run that never covers it is counted, not timed). "
+            "Speed-up: one robot's ticks over N robots' on the same seed."
+            + (" Quick run: teams of 1 and 2 only." if quick else "") + "\n")  # fmt: skip
+    return "Mapping together (our extension, descriptive)", table + note
 
 
 KNOWN_DIFFERENCES = "\n".join(f"- {line}" for line in (
