@@ -1,7 +1,7 @@
 """Tapus, Battaglia & Siegwart (2006): topological mapping and localization with fingerprints of
 places on the office floor."""
 
-from swarm.core.registry import ExperimentSpec, Option
+from swarm.core.registry import ExperimentSpec, Option, PaperSpec
 
 _FLOOR = Option("--scenario", "a floor with 'mapping', 'localize' and 'localize-off-map' routes and place zones "
                 "(default office)")  # fmt: skip
@@ -17,3 +17,9 @@ EXPERIMENTS = (
                    "swarm.experiments.tapus2006.team:run_team_experiment", writes="runs.csv, table.md, plot.png",
                    smoke=(("reps", 1), ("teams", (1, 2)))),
 )  # fmt: skip
+PAPER = PaperSpec(
+    "tapus2006",
+    "Tapus, Battaglia & Siegwart (2006): fingerprints of places, topological mapping and localization",
+    "swarm.experiments.tapus2006.reproduce:reproduce",
+    "docs/fingerprint.md",
+)

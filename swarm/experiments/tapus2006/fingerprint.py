@@ -40,10 +40,11 @@ import numpy as np
 
 from swarm.core.errors import ScenarioError
 from swarm.experiments.runner import Outputs, batch_run
+from swarm.experiments.tapus2006 import paper
 
 NOISES = ("low", "high")
 THETAS = (0.2, 0.35, 0.5, 0.65, 0.8)
-PAPER_NODES, PAPER_MATCH, PAPER_MARKOV = 20, 0.81, 1.00
+PAPER_NODES, PAPER_MATCH, PAPER_MARKOV = paper.NODES, paper.MATCH, paper.MARKOV
 LOCALIZE_TOURS = ("localize", "localize-off-map")  # on the mapped floor (the paper's case), and leaving it
 OFF_MAP = 1.0  # a fingerprint taken farther than this from every mapping fingerprint is off the mapped floor
 TOLERANCE = 0.5  # nodes whose mapping fingerprints lie this much farther than the nearest count as right too
@@ -138,9 +139,22 @@ def judge_map(run: dict, zones: list) -> dict[str, Any]:
             "places_with_node": int(sum(per_place[p] > 0 for p in visited)),
             "nodes_per_place": round(run["size"] / max(len(visited), 1), 2), "purity": round(float(pure), 4),
             "links": len(run["map"]["links"]), "closures": run["closures"], "room_revisits": revisits,
-            "room_revisits_closed": closed,
+            "room_revisits_closed": closed, "false_closures": false_closures(run, zones),
             "corridor_seen_again_on_old_node": round(ground_seen_again(run["truth"][:, :2], first, truth, ~rooms),
                                                      4)}  # fmt: skip
+
+
+def false_closures(run: dict, zones: list) -> int:
+    """Nodes holding fingerprints taken farther apart than any two points of one place (the diagonal of
+    the floor's largest place zone): loops closed onto the wrong place, e.g. the corridor's two look-alike
+    ends joined in one node.  Ground truth judges the map here; the controller never sees it."""
+    far = max(math.hypot(x1 - x0, y1 - y0) for _, (x0, y0, x1, y1) in zones)
+    xy, nodes = run["truth"][:, :2], run["believed"]
+    wrong = 0
+    for node in np.unique(nodes):
+        p = xy[nodes == node]
+        wrong += int(np.hypot(*(p[:, None, :] - p[None, :, :]).transpose(2, 0, 1)).max() > far)
+    return wrong
 
 
 def first_use(believed: np.ndarray) -> np.ndarray:
@@ -203,12 +217,20 @@ def right_nodes(mapped: dict, xy: np.ndarray) -> set[int] | None:
     return set(mapped["believed"][d <= d.min() + TOLERANCE].tolist())
 
 
-def localize_job(job: tuple) -> dict:
-    name, noise, seed, route = job
-    s = tour_scenario(name, "mapping", noise, seed)
-    mapped = drive_tour(s)
-    k = mapped["size"]
+def localize_run(name: str, noise: str, seed: int, route: str) -> tuple[dict, dict]:
+    """The map of the mapping tour (odometry and sensor noise drawn from `seed`), then the `route` tour
+    localizing on it (drawn from seed + 1000): (the mapping run, localization_counts)."""
+    mapped = drive_tour(tour_scenario(name, "mapping", noise, seed))
     loc = drive_tour(tour_scenario(name, route, noise, seed + 1000), topomap=mapped["map"])
+    return mapped, {**localization_counts(mapped, loc), "ticks": loc["ticks"], "finished": loc["finished"],
+                    "wall_seconds": round(mapped["wall_seconds"] + loc["wall_seconds"], 2)}  # fmt: skip
+
+
+def localization_counts(mapped: dict, loc: dict) -> dict:
+    """Per second tour: how many fingerprints were on the mapped floor, how many of them each of matching
+    alone, the grid filter and the links-only filter put at a right node, the mean chance of a node drawn
+    at random being right, and where the right node ranked among the matches when matching missed."""
+    k = mapped["size"]
     by_match, by_markov, by_links, ranks, chance, off = [], [], [], [], [], 0
     for xy, matched, believed, linked, like in zip(loc["truth"][:, :2], loc["matched"], loc["believed"],
                                                    loc["believed_links"], loc["likelihoods"], strict=True):  # fmt: skip
@@ -224,14 +246,22 @@ def localize_job(job: tuple) -> dict:
             order = np.argsort(-like, kind="stable")
             ranks.append(int(np.flatnonzero(np.isin(order, list(right)))[0]) + 1)
     ranks = np.array(ranks, np.int64)
-    return {"scenario": name, "route": route, "noise": noise, "seed": seed, "map_nodes": k,
-            "fingerprints": len(loc["matched"]),
-            "on_map": len(by_match), "off_map": off, "match_correct": round(float(np.mean(by_match)), 4),
-            "markov_correct": round(float(np.mean(by_markov)), 4),
-            "links_markov_correct": round(float(np.mean(by_links)), 4), "chance": round(float(np.mean(chance)), 4),
+    return {"map_nodes": k, "fingerprints": len(loc["matched"]), "on_map": len(by_match), "off_map": off,
+            "match_right": int(sum(by_match)), "markov_right": int(sum(by_markov)),
+            "links_right": int(sum(by_links)), "chance": round(float(np.mean(chance)), 4),
             "missed_rank2": int((ranks == 2).sum()), "missed_rank3": int((ranks == 3).sum()),
-            "missed_rank_over3": int((ranks > 3).sum()), "ticks": loc["ticks"], "finished": loc["finished"],
-            "wall_seconds": round(mapped["wall_seconds"] + loc["wall_seconds"], 2)}  # fmt: skip
+            "missed_rank_over3": int((ranks > 3).sum())}  # fmt: skip
+
+
+def localize_job(job: tuple) -> dict:
+    name, noise, seed, route = job
+    _, c = localize_run(name, noise, seed, route)
+    share = {f"{key}_correct": round(c[f"{right}_right"] / c["on_map"], 4) if c["on_map"] else math.nan
+             for key, right in (("match", "match"), ("markov", "markov"), ("links_markov", "links"))}  # fmt: skip
+    head = ("map_nodes", "fingerprints", "on_map", "off_map")
+    tail = ("chance", "missed_rank2", "missed_rank3", "missed_rank_over3", "ticks", "finished", "wall_seconds")
+    return {"scenario": name, "route": route, "noise": noise, "seed": seed, **{k: c[k] for k in head}, **share,
+            **{k: c[k] for k in tail}}  # fmt: skip
 
 
 def calibration_pairs(name: str, noise: str, seed: int) -> tuple[np.ndarray, np.ndarray]:
