@@ -33,7 +33,7 @@ def test_a_quick_report_runs_on_confirmation_seeds_and_judges_every_claim(name, 
     monkeypatch.setattr(mod, "QUICK_REPS", {k: 3 for k in mod.QUICK_REPS})
     result = resolve(PAPERS[name].reproduce)(quick=True, jobs=2, out=tmp_path, progress=False)
     report = (tmp_path / "report.md").read_text()
-    assert "Quick run" in report and result["claims"] > 0
+    assert "Quick run" in report and result["claims"] > 0 and (tmp_path / "parameters.md").is_file()
     with open(tmp_path / "runs.csv") as f:
         seeds = {int(r["seed"]) for r in csv.DictReader(f)}
     assert seeds and seeds <= set(CONFIRMATION_SEEDS)

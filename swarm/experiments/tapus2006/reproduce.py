@@ -40,6 +40,8 @@ REPS = {"localize": 60, "loops": 40, "together": 10}
 QUICK_REPS = {"localize": 2, "loops": 2, "together": 1}
 QUICK_TEAMS = (1, 2)  # --quick surveys with one and two robots only
 MAP_FIELDS = ("nodes", "places_visited", "places_with_node", "purity", "false_closures")
+TITLE = "Tapus, Battaglia & Siegwart (2006)"
+CONTROLLERS = ("fingerprint",)
 DESIGN = (
     f"Floor `{FLOOR}`; every run at noise low and high. The localize runs of one seed map the 76 m tour and "
     "localize on the 253 m tour (its seed + 1000); the loops runs map the 253 m tour on the same seeds. "
@@ -86,9 +88,10 @@ def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = N
         title, table, cs = part(rows)
         sections.append((title, table))
         claims += cs
-    sections += [_together(rows, quick), ("Known differences", KNOWN_DIFFERENCES)]
+    sections += [_together(rows, quick), ("Known differences", KNOWN_DIFFERENCES), R.parameters_section(CONTROLLERS)]
+    (out_ / "parameters.md").write_text(R.parameters_page(TITLE, CONTROLLERS))
     plot(rows, out_ / "localization.png")
-    text = R.report_text("Tapus, Battaglia & Siegwart (2006)", DESIGN, claims, sections, reps, quick)
+    text = R.report_text(TITLE, DESIGN, claims, sections, reps, quick)
     result = out_.finish([R.claim_row(c) for c in claims], text, file="report.md")
     return result | {"claims": len(claims), "verdicts": R.tally(claims)}
 
