@@ -31,6 +31,7 @@ def add_reproduce_parser(sub) -> None:
 
 def cmd_reproduce(args) -> int:
     from swarm.experiments import PAPERS
+    from swarm.experiments.report import write_index
 
     papers = list(PAPERS) if args.paper == "all" else [PAPERS[args.paper]]
     for spec in papers:
@@ -38,4 +39,5 @@ def cmd_reproduce(args) -> int:
         result = resolve(spec.reproduce)(quick=args.quick, jobs=args.jobs, out=out)
         verdicts = ", ".join(f"{n} {v}" for v, n in result["verdicts"].items())
         print(f"{spec.name}: {result['claims']} claims: {verdicts}; report: {result['out']}/report.md")
+        write_index(Path(result["out"]).parent)
     return 0

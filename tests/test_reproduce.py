@@ -71,3 +71,24 @@ def test_a_reports_parameter_page_lists_every_declared_parameter_with_its_source
     title, text = parameters_section(("cmarking", "ant"))
     total = sum(len(provenance(c)) for c in classes)
     assert title == "Parameters" and text.startswith(f"{total} parameters (") and "parameters.md" in text
+
+
+def test_the_index_counts_each_reports_verdicts_and_marks_quick_runs(tmp_path):
+    from swarm.experiments.report import QUICK_BANNER, write_index
+
+    first, second = PAPERS.names()[:2]
+    for name, verdicts, banner in (
+        (first, [REPRODUCED, REVERSED, REPRODUCED], ""),
+        (second, [SAME_DIRECTION], QUICK_BANNER),
+    ):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "report.md").write_text(f"# x\n\n{banner}\n")
+        with open(tmp_path / name / "summary.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, ["claim", "verdict"])
+            w.writeheader()
+            w.writerows({"claim": str(i), "verdict": v} for i, v in enumerate(verdicts))
+    lines = write_index(tmp_path).read_text().splitlines()
+    row = {line.split("](")[1].split("/")[0]: line for line in lines if line.startswith("| [")}
+    assert set(row) == {first, second}
+    assert row[first].endswith("| 3 | 2 | 0 | 0 | 1 |") and "quick run" not in row[first]
+    assert row[second].endswith("| 1 | 0 | 1 | 0 | 0 |") and "quick run" in row[second]

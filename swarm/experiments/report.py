@@ -3,14 +3,18 @@ seeds and the verdict rule, its claims as summary.csv rows and the tally of verd
 
 from __future__ import annotations
 
+import csv
 from collections import Counter
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 
 from agents.controllers import CONTROLLERS
 from swarm.core.params import SOURCES, provenance, provenance_table
 from swarm.core.registry import resolve
+from swarm.experiments import PAPERS
 from swarm.experiments import protocol as P
 
+VERDICTS = (P.REPRODUCED, P.SAME_DIRECTION, P.NOT_REPRODUCED, P.REVERSED)
 QUICK_BANNER = "**Quick run: too few runs to be evidence; it checks that everything runs.**"
 VERDICT_RULE = (
     "Verdicts follow one rule (swarm/experiments/protocol.py): the expected direction with p < 0.05 is "
@@ -82,3 +86,23 @@ def parameters_section(controllers: Sequence[str]) -> tuple[str, str]:
     said = ", ".join(f"{counts[s]} {s}" for s in (*SOURCES, "undeclared") if counts[s])
     return "Parameters", (f"{sum(counts.values())} parameters ({said}; controllers: {', '.join(controllers)}), "
                           "one declared set for every experiment: [parameters.md](parameters.md).")  # fmt: skip
+
+
+def write_index(root: Path) -> Path:
+    """root/index.md: every paper's report found under `root`, its verdicts counted from its summary.csv,
+    so a page of results (the README's) can link one table that `swarm reproduce` keeps up to date."""
+    lines = []
+    for spec in PAPERS:
+        summary = root / spec.name / "summary.csv"
+        if not summary.is_file():
+            continue
+        with open(summary, newline="") as f:
+            counts = Counter(row["verdict"] for row in csv.DictReader(f))
+        quick = QUICK_BANNER in (root / spec.name / "report.md").read_text()
+        lines.append([f"[{spec.title}]({spec.name}/report.md)" + (" (quick run: not evidence)" if quick else ""),
+                      str(sum(counts.values())), *(str(counts[v]) for v in VERDICTS)])  # fmt: skip
+    text = ("# Reproductions\n\nEach paper's claims judged by `swarm reproduce` on confirmation seeds "
+            "(swarm/experiments/protocol.py); the reports give n, the 95% intervals and the tests.\n\n"
+            + markdown_table(["paper", "claims", *VERDICTS], lines))  # fmt: skip
+    (root / "index.md").write_text(text)
+    return root / "index.md"
