@@ -103,6 +103,36 @@ def proportion_ci(successes: int, n: int) -> Estimate:
     return Estimate(successes / n, float(ci.low), float(ci.high), n, "proportion")
 
 
+def binomial(successes: int, n: int, p0: float) -> Comparison:
+    """k of n against a proportion p0 the claim names (most runs: 0.5): the exact binomial test.
+    Effect: the observed proportion minus p0."""
+    from scipy.stats import binomtest
+
+    if n == 0:
+        return Comparison("binomial (exact)", math.nan, math.nan, math.nan, "proportion minus p0", 0)
+    res = binomtest(successes, n, p0)
+    return Comparison("binomial (exact)", float(successes), float(res.pvalue), successes / n - p0,
+                      "proportion minus p0", n)  # fmt: skip
+
+
+def anova(groups: Sequence[Sequence[float]]) -> Comparison:
+    """Independent groups of one continuous outcome: the one-way ANOVA (scipy's f_oneway), the test
+    papers often report.  Effect: eta squared, the share of the variance between the groups."""
+    from scipy.stats import f_oneway
+
+    xs = [_finite(g) for g in groups]
+    xs = [x for x in xs if len(x) > 1]
+    n = sum(len(x) for x in xs)
+    if len(xs) < 2:
+        return Comparison("one-way ANOVA", math.nan, math.nan, math.nan, "eta squared", n)
+    res = f_oneway(*xs)
+    every = np.concatenate(xs)
+    between = sum(len(x) * (x.mean() - every.mean()) ** 2 for x in xs)
+    total = float(((every - every.mean()) ** 2).sum())
+    return Comparison("one-way ANOVA", float(res.statistic), float(res.pvalue), between / total if total else 0.0,
+                      "eta squared", n)  # fmt: skip
+
+
 def mcnemar(a: Sequence[bool], b: Sequence[bool]) -> Comparison:
     """Paired binary outcomes (the same seeds and maps under two conditions): the exact McNemar test on the
     discordant pairs.  Effect: the difference of the proportions, a minus b."""

@@ -1,7 +1,7 @@
 """Billing, Lowe & Sandamirskaya (2015): the dft controller beside follow the carrot (its Appendix
 B baseline) in the Z-maze and the large maze."""
 
-from swarm.core.registry import ExperimentSpec, Option
+from swarm.core.registry import ExperimentSpec, Option, PaperSpec
 
 _MAZE = Option("--scenario", "zmaze or large-maze (default both)")
 _NOISE = Option("--noise", "only the conditions at this noise level", choices=("none", "low", "high"))
@@ -22,3 +22,9 @@ EXPERIMENTS = (
     ExperimentSpec("dft-together", "billing2015", "a scout shares the obstacle it meets over the context key space",
                    _DFT, options=(_MAZE, _NOISE, _STEPS)),
 )  # fmt: skip
+PAPER = PaperSpec(
+    "billing2015",
+    "Billing, Lowe & Sandamirskaya (2015): planning with dynamic neural fields",
+    "swarm.experiments.billing2015.reproduce:reproduce",
+    "docs/dft.md",
+)
