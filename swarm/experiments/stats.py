@@ -248,7 +248,9 @@ def logrank(times_a: Sequence[float], finished_a: Sequence[bool], times_b: Seque
     times (a minus b) up to the shorter of the two groups' longest times, positive where a lasts longer."""
     from scipy.stats import logrank as scipy_logrank
 
-    res = scipy_logrank(_censored(times_a, finished_a), _censored(times_b, finished_b))
+    with warnings.catch_warnings():  # no event in either group: scipy divides 0 by 0, and the p-value is nan
+        warnings.simplefilter("ignore", RuntimeWarning)
+        res = scipy_logrank(_censored(times_a, finished_a), _censored(times_b, finished_b))
     horizon = float(min(np.max(times_a), np.max(times_b)))
     effect = restricted_mean(times_a, finished_a, horizon) - restricted_mean(times_b, finished_b, horizon)
     return Comparison("log-rank", float(res.statistic), float(res.pvalue), effect, "difference of restricted means",

@@ -122,11 +122,12 @@ def _merged(table: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
 
 
 def run_survival(job: tuple) -> dict:
-    """One animat in bg-exp1 until it dies or 4 h pass: (condition, run, seed, [bg] changes)."""
+    """One animat in bg-exp1 until it dies or 4 h pass: (condition, run, seed, [bg] changes[, max_ticks])."""
     from swarm.engines.arena import ArenaEngine
 
-    condition, run, seed, changes = job
-    s = _with(load_scenario("bg-exp1"), bg=_merged(changes, {"planning": condition == "A"}), seed=seed)
+    condition, run, seed, changes, *cap = job
+    s = _with(load_scenario("bg-exp1"), bg=_merged(changes, {"planning": condition == "A"}), seed=seed,
+              max_ticks=cap[0] if cap else None)  # fmt: skip
     summary = ArenaEngine(s).run()
     r = summary["robots"][0]
     return {"condition": condition, "run": run, "seed": seed, "survival_seconds": r["survival_seconds"],
@@ -137,14 +138,14 @@ def run_survival(job: tuple) -> dict:
 
 
 def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] | None = None,
-              mode: str = "hungry") -> dict:  # fmt: skip
+              mode: str = "hungry", seconds: float = MAPPING_SECONDS) -> dict:  # fmt: skip
     """The mapping phase: the animat lives in `name` (as MAPPING_MODES[mode] says) until it has been at every
-    resource there and its map holds every kind (a node that learned it), or MAPPING_SECONDS pass; its map as
+    resource there and its map holds every kind (a node that learned it), or `seconds` pass; its map as
     plain data."""
     from swarm.engines.arena import ArenaEngine
 
     s = load_scenario(name)
-    ticks = int(MAPPING_SECONDS / s.control_period)
+    ticks = int(seconds / s.control_period)
     levels = {
         "energy": MAPPING_LEVELS[0],
         "potential": MAPPING_LEVELS[1],
@@ -430,8 +431,9 @@ def _mapped(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
 
 
 def _build_map_job(job: tuple) -> dict:
-    name, k, seed, absent, changes, mode = job
-    return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes, mode)}
+    """(scenario, map index, seed, resources absent, [bg] changes, mapping mode[, seconds])."""
+    name, k, seed, absent, changes, mode, *seconds = job
+    return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes, mode, *seconds)}
 
 
 def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None, progress: bool,
