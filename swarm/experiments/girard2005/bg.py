@@ -328,7 +328,7 @@ def direct_seconds(name: str, stops: tuple[str, ...] = ("Ep2", "Ep1")) -> float:
 # ------------------------------------------------------------------ plots
 
 
-def _plot(experiment: str, rows: list[dict], summary: list[dict], path: Path) -> None:
+def plot_experiment(experiment: str, rows: list[dict], summary: list[dict], path: Path) -> None:
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     if experiment == "bg-survival":
@@ -409,7 +409,7 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
     else:
         made = _maps(experiment, maps, seed, ratios, jobs, progress, changes, mapping)
         (out / "maps.json").write_text(json.dumps(made))
-        work = _tests(experiment, reps, seed, made, changes, mapping)
+        work = test_jobs(experiment, reps, seed, made, changes, mapping)
         rows = batch_run(run_test, work, jobs=jobs, desc=experiment, progress=progress)
         rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
         out.runs(rows, list(rows[0]))
@@ -417,11 +417,11 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
     if changes:
         title += f"[bg] changed in every run: {json.dumps(changes)}.\n\n"
     result = out.finish(summary, title + md)
-    _plot(experiment, rows, summary, out / "plot.png")
+    plot_experiment(experiment, rows, summary, out / "plot.png")
     return result
 
 
-def _mapped(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
+def mapped_floors(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
     """The scenarios an experiment maps, each with the resources absent while mapping."""
     if experiment in ("bg-choice", "bg-forget"):
         return {"bg-exp2": ("Ep2",) if experiment == "bg-choice" else ()}
@@ -430,7 +430,7 @@ def _mapped(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
     return {f"tmaze-{ratio:g}": () for ratio in ratios or RATIOS}
 
 
-def _build_map_job(job: tuple) -> dict:
+def build_map_job(job: tuple) -> dict:
     """(scenario, map index, seed, resources absent, [bg] changes, mapping mode[, seconds])."""
     name, k, seed, absent, changes, mode, *seconds = job
     return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes, mode, *seconds)}
@@ -439,14 +439,14 @@ def _build_map_job(job: tuple) -> dict:
 def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None, progress: bool,
           changes: dict[str, Any] | None = None, mode: str = "hungry") -> dict[str, list[dict]]:  # fmt: skip
     """`count` maps per scenario, map k from a mapping run with seed + k (in parallel)."""
-    mapped = _mapped(experiment, ratios)
+    mapped = mapped_floors(experiment, ratios)
     work = [(name, k, seed + k, absent, changes or {}, mode) for name, absent in mapped.items() for k in range(count)]
-    rows = batch_run(_build_map_job, work, jobs=jobs, desc=f"{experiment} mapping", progress=progress)
+    rows = batch_run(build_map_job, work, jobs=jobs, desc=f"{experiment} mapping", progress=progress)
     made = {(m["scenario"], m["index"]): m["data"] for m in rows}
     return {name: [made[name, k] for k in range(count)] for name in mapped}
 
 
-def _tests(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
+def test_jobs(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
            changes: dict[str, Any] | None = None, mapping: str = "hungry") -> list[tuple]:  # fmt: skip
     """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions).  A test's
     [bg]: what its mapping mode gives a test (MAPPING_MODES: learn_map, known_explore), under the command line's

@@ -42,7 +42,7 @@ def plan_lives_and_maps(reps: dict[str, int], quick: bool) -> list[tuple]:
     seconds = (QUICK_SECONDS,) if quick else ()
     jobs = [("life", (c, k, seed + k, {}, *cap)) for c in ("A", "B") for k in range(reps["bg-survival"])]
     for name in TESTED:
-        for scenario, absent in bg._mapped(name, None).items():
+        for scenario, absent in bg.mapped_floors(name, None).items():
             jobs += [("map", name, (scenario, k, seed + k, absent, {}, bg.MAPPING[name], *seconds))
                      for k in range(reps[name])]  # fmt: skip
     return jobs
@@ -52,7 +52,7 @@ def run_job(job: tuple) -> dict:
     if job[0] == "life":
         return {"experiment": "bg-survival"} | bg.run_survival(job[1])
     if job[0] == "map":
-        return {"experiment": job[1]} | bg._build_map_job(job[2])
+        return {"experiment": job[1]} | bg.build_map_job(job[2])
     return bg.run_test(job[1])
 
 
@@ -66,14 +66,15 @@ def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = N
     maps: dict[str, dict[str, list]] = {}
     for m in sorted((r for r in first if "data" in r), key=lambda r: (r["experiment"], r["scenario"], r["index"])):
         maps.setdefault(m["experiment"], {}).setdefault(m["scenario"], []).append(m["data"])
-    work = [("test", j) for name in TESTED for j in bg._tests(name, reps[name], seed, maps[name], {}, bg.MAPPING[name])]
+    work = [("test", j) for name in TESTED
+            for j in bg.test_jobs(name, reps[name], seed, maps[name], {}, bg.MAPPING[name])]  # fmt: skip
     tests = batch_run(run_job, work, jobs=jobs, desc="girard2005 tests", progress=progress)
     tests.sort(key=lambda r: (TESTED.index(r["experiment"]), str(r["condition"]), r["run"]))
     out_.runs(lives, SURVIVAL_FIELDS)
     out_.runs(tests, TEST_FIELDS, file="tests.csv")
     sections = [_survival(lives, quick), _choice(tests), _forget(tests), _fear(tests), _tmaze(tests)]
     claims = [c for _, _, cs in sections for c in cs]
-    bg._plot("bg-survival", lives, [], out_ / "survival.png")
+    bg.plot_experiment("bg-survival", lives, [], out_ / "survival.png")
     parts = [(title, table) for title, table, _ in sections]
     parts[0] = (parts[0][0], parts[0][1] + "\n![survival](survival.png)\n")
     parts += [("Known differences", "\n".join(f"- {d}" for d in paper.KNOWN_DIFFERENCES)),
