@@ -620,10 +620,10 @@ def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):
 
 
 def test_bg_experiment_tests_share_maps_across_conditions():
-    from swarm.experiments.girard2005.bg import _tests
+    from swarm.experiments.girard2005.bg import test_jobs
 
     maps = {"bg-exp3": [{"id": 0}, {"id": 1}]}
-    jobs = _tests("bg-fear", 4, 10, maps)
+    jobs = test_jobs("bg-fear", 4, 10, maps)
     assert [(j[1], j[3], j[8]) for j in jobs[:8]] == [
         (0.1, 10, 0),
         (0.1, 11, 1),
@@ -647,28 +647,28 @@ def test_a_test_goes_on_mapping_a_hungry_map_and_takes_an_explored_one_as_it_is(
     """A hungry mapping run leaves the way between resources, which a test extends; an exploring one covers
     the floor, and a test only localizes on it (a node it made would be a leaf whose routes lead back).  The
     command line's --bg learn_map overrides either."""
-    from swarm.experiments.girard2005.bg import _tests
+    from swarm.experiments.girard2005.bg import test_jobs
 
     maps = {"bg-exp3": [{}]}
-    assert all(j[5]["learn_map"] for j in _tests("bg-fear", 2, 0, maps))
-    assert not any(j[5]["learn_map"] for j in _tests("bg-fear", 2, 0, maps, None, "explore"))
-    assert all(j[5]["learn_map"] for j in _tests("bg-fear", 2, 0, maps, {"learn_map": True}, "explore"))
-    assert all(j[5]["fear"] == 0.0 for j in _tests("bg-fear", 2, 0, maps, None, "explore") if "no DA" in str(j[1]))
+    assert all(j[5]["learn_map"] for j in test_jobs("bg-fear", 2, 0, maps))
+    assert not any(j[5]["learn_map"] for j in test_jobs("bg-fear", 2, 0, maps, None, "explore"))
+    assert all(j[5]["learn_map"] for j in test_jobs("bg-fear", 2, 0, maps, {"learn_map": True}, "explore"))
+    assert all(j[5]["fear"] == 0.0 for j in test_jobs("bg-fear", 2, 0, maps, None, "explore") if "no DA" in str(j[1]))
     # ... and explores only where the explored map has a hole; --bg navigation.known_explore overrides it
-    assert all(j[5]["navigation"] == {"known_explore": 0.0} for j in _tests("bg-fear", 2, 0, maps, None, "explore"))
-    assert all("navigation" not in j[5] for j in _tests("bg-fear", 2, 0, maps))
-    override = _tests("bg-fear", 2, 0, maps, {"navigation": {"known_explore": 1.0, "reach": 6.0}}, "explore")
+    assert all(j[5]["navigation"] == {"known_explore": 0.0} for j in test_jobs("bg-fear", 2, 0, maps, None, "explore"))
+    assert all("navigation" not in j[5] for j in test_jobs("bg-fear", 2, 0, maps))
+    override = test_jobs("bg-fear", 2, 0, maps, {"navigation": {"known_explore": 1.0, "reach": 6.0}}, "explore")
     assert all(j[5]["navigation"] == {"known_explore": 1.0, "reach": 6.0} for j in override)
 
 
 def test_bg_choice_runs_the_papers_control_of_ten_tests_without_ep2():
-    from swarm.experiments.girard2005.bg import _tests
+    from swarm.experiments.girard2005.bg import test_jobs
 
-    jobs = _tests("bg-choice", 15, 0, {"bg-exp2": [{}]})
+    jobs = test_jobs("bg-choice", 15, 0, {"bg-exp2": [{}]})
     control = [j for j in jobs if j[1] == "no Ep2"]
     assert len(jobs) == 3 * 15 + 10 and len(control) == 10  # the paper's ten
     assert all(j[7] == ("Ep2",) and j[5]["w_plan"] == 0.65 for j in control)
-    assert len([j for j in _tests("bg-choice", 3, 0, {"bg-exp2": [{}]}) if j[1] == "no Ep2"]) == 3
+    assert len([j for j in test_jobs("bg-choice", 3, 0, {"bg-exp2": [{}]}) if j[1] == "no Ep2"]) == 3
 
 
 def test_a_control_table_counts_each_choice_and_the_time_to_reload():
@@ -747,7 +747,7 @@ def test_bg_experiment_maps_option_is_checked():
 def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     import argparse
 
-    from swarm.experiments.girard2005.bg import _tests, _with, run_bg_experiment
+    from swarm.experiments.girard2005.bg import test_jobs, _with, run_bg_experiment
     from swarm.experiments.girard2005.options import bg_setting as _bg_setting
     from swarm.experiments.girard2005.options import bg_table as _bg_table
 
@@ -758,7 +758,7 @@ def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     engine = ArenaEngine(_with(load_scenario("bg-exp1"), bg={**table, "planning": False}))
     animat = engine.controllers[0]
     assert animat.p.usable_threshold == 0.5 and animat.nav.p.anchor == 0.2 and not animat.p.planning
-    jobs = _tests("bg-choice", 2, 0, {"bg-exp2": [{}]}, table)  # a test's own [bg] fields kept beside them
+    jobs = test_jobs("bg-choice", 2, 0, {"bg-exp2": [{}]}, table)  # a test's own [bg] fields kept beside them
     assert all(job[5] == {"learn_map": True, **table, "w_plan": 0.65 if job[1] == "no Ep2" else job[1],
                           "w_taxon": 0.55} for job in jobs)  # fmt: skip
     with pytest.raises(ScenarioError, match=r"--bg.*bogus"):
