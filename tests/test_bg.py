@@ -747,7 +747,7 @@ def test_bg_experiment_maps_option_is_checked():
 def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     import argparse
 
-    from swarm.experiments.girard2005.bg import test_jobs, _with, run_bg_experiment
+    from swarm.experiments.girard2005.bg import _with, run_bg_experiment, test_jobs
     from swarm.experiments.girard2005.options import bg_setting as _bg_setting
     from swarm.experiments.girard2005.options import bg_table as _bg_table
 
