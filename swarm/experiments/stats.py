@@ -262,3 +262,15 @@ def spearman(x: Sequence[float], y: Sequence[float]) -> Comparison:
     res = spearmanr(u[keep], v[keep])
     return Comparison("Spearman", float(res.statistic), float(res.pvalue), float(res.statistic), "rho",
                       int(keep.sum()))  # fmt: skip
+
+
+def binomial(successes: int, n: int, null: float = 0.5) -> Comparison:
+    """One group's k of n against a share `null` (e.g. one of two options preferred): the exact binomial
+    test.  Effect: the observed share minus `null`."""
+    from scipy.stats import binomtest
+
+    if n == 0:
+        return Comparison("binomial", math.nan, math.nan, math.nan, "share minus null", 0)
+    res = binomtest(successes, n, null)
+    return Comparison(f"binomial vs {null:g}", float(successes), float(res.pvalue), successes / n - null,
+                      "share minus null", n)  # fmt: skip

@@ -1,7 +1,7 @@
 """Girard, Filliat, Meyer, Berthoz & Guillot (2005): the basal-ganglia animat's survival and its
 choices between resources, alone and as a colony sharing one map."""
 
-from swarm.core.registry import ExperimentSpec, Option
+from swarm.core.registry import ExperimentSpec, Option, PaperSpec
 
 _FLOOR = Option("--scenario", "the floor (default: the experiment's)")
 _MAPS = Option("--maps", "mapping runs per scenario; test k loads map k mod N (default: one per test; 1: one map for "
@@ -34,3 +34,9 @@ EXPERIMENTS = (
                    "swarm.experiments.girard2005.colony:run_colony_experiment", options=(_SIZES,),
                    smoke=(("reps", 1), ("sizes", (1, 2)), ("max_ticks", 200))),
 )  # fmt: skip
+PAPER = PaperSpec(
+    "girard2005",
+    "Girard, Filliat, Meyer, Berthoz & Guillot (2005): basal-ganglia action selection for a surviving animat",
+    "swarm.experiments.girard2005.reproduce:reproduce",
+    "docs/bg.md",
+)

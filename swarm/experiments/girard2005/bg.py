@@ -38,6 +38,7 @@ import numpy as np
 
 from swarm.core.errors import ScenarioError
 from swarm.core.plots import pyplot, save_figure
+from swarm.experiments.girard2005.paper import PAPER_CHOICE, PAPER_FEAR, PAPER_FORGET, PAPER_SURVIVAL, PAPER_TMAZE
 from swarm.experiments.runner import Outputs, batch_run
 from swarm.scenario import load_scenario
 
@@ -80,12 +81,6 @@ TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep b
 W_PLANS = (0.65, 0.55, 0.45)
 FEAR_EP = (0.1, 0.5)
 RATIOS = (1.0, 1.5, 2.0)
-# The paper's numbers, to print beside ours.
-PAPER_SURVIVAL = {"A": (14431.5, 2531, 17274), "B": (4908.0, 2518, 8831), "U": 15}
-PAPER_CHOICE = {0.65: (13, 2), 0.55: (7, 8), 0.45: (2, 13)}
-PAPER_FORGET = (178.0, 78.0, 300.0)  # mean, sd, max seconds
-PAPER_FEAR = {0.1: (13, 7), 0.5: (2, 18)}
-PAPER_TMAZE = {1.0: (3, 12), 1.5: (4, 11), 2.0: (8, 7)}
 # The paper's controls (no numbers given, only what happened): their conditions, tests and words.
 CHOICE_CONTROL, CHOICE_CONTROL_TESTS = "no Ep2", 10
 CHOICE_CONTROL_TEXT = ("ten tests in which Ep2 is not added: \"it goes directly to Ep1 and activates the ReloadEp "
@@ -122,11 +117,13 @@ def _merged(table: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
 
 
 def run_survival(job: tuple) -> dict:
-    """One animat in bg-exp1 until it dies or 4 h pass: (condition, run, seed, [bg] changes)."""
+    """One animat in bg-exp1 until it dies or 4 h pass (or `max_ticks`, where a quick run shortens it):
+    (condition, run, seed, [bg] changes[, max_ticks])."""
     from swarm.engines.arena import ArenaEngine
 
-    condition, run, seed, changes = job
-    s = _with(load_scenario("bg-exp1"), bg=_merged(changes, {"planning": condition == "A"}), seed=seed)
+    condition, run, seed, changes, *cap = job
+    s = _with(load_scenario("bg-exp1"), bg=_merged(changes, {"planning": condition == "A"}), seed=seed,
+              max_ticks=cap[0] if cap else None)  # fmt: skip
     summary = ArenaEngine(s).run()
     r = summary["robots"][0]
     return {"condition": condition, "run": run, "seed": seed, "survival_seconds": r["survival_seconds"],
@@ -137,14 +134,14 @@ def run_survival(job: tuple) -> dict:
 
 
 def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] | None = None,
-              mode: str = "hungry") -> dict:  # fmt: skip
+              mode: str = "hungry", seconds: float = MAPPING_SECONDS) -> dict:  # fmt: skip
     """The mapping phase: the animat lives in `name` (as MAPPING_MODES[mode] says) until it has been at every
-    resource there and its map holds every kind (a node that learned it), or MAPPING_SECONDS pass; its map as
+    resource there and its map holds every kind (a node that learned it), or `seconds` pass; its map as
     plain data."""
     from swarm.engines.arena import ArenaEngine
 
     s = load_scenario(name)
-    ticks = int(MAPPING_SECONDS / s.control_period)
+    ticks = int(seconds / s.control_period)
     levels = {
         "energy": MAPPING_LEVELS[0],
         "potential": MAPPING_LEVELS[1],
@@ -430,8 +427,9 @@ def _mapped(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
 
 
 def _build_map_job(job: tuple) -> dict:
-    name, k, seed, absent, changes, mode = job
-    return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes, mode)}
+    """(scenario, index, seed, absent, [bg] changes, mode[, seconds]): one map as a row."""
+    name, k, seed, absent, changes, mode, *seconds = job
+    return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes, mode, *seconds)}
 
 
 def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None, progress: bool,
