@@ -103,18 +103,6 @@ def proportion_ci(successes: int, n: int) -> Estimate:
     return Estimate(successes / n, float(ci.low), float(ci.high), n, "proportion")
 
 
-def binomial(successes: int, n: int, p0: float) -> Comparison:
-    """k of n against a proportion p0 the claim names (most runs: 0.5): the exact binomial test.
-    Effect: the observed proportion minus p0."""
-    from scipy.stats import binomtest
-
-    if n == 0:
-        return Comparison("binomial (exact)", math.nan, math.nan, math.nan, "proportion minus p0", 0)
-    res = binomtest(successes, n, p0)
-    return Comparison("binomial (exact)", float(successes), float(res.pvalue), successes / n - p0,
-                      "proportion minus p0", n)  # fmt: skip
-
-
 def anova(groups: Sequence[Sequence[float]]) -> Comparison:
     """Independent groups of one continuous outcome: the one-way ANOVA (scipy's f_oneway), the test
     papers often report.  Effect: eta squared, the share of the variance between the groups."""
@@ -294,3 +282,15 @@ def spearman(x: Sequence[float], y: Sequence[float]) -> Comparison:
     res = spearmanr(u[keep], v[keep])
     return Comparison("Spearman", float(res.statistic), float(res.pvalue), float(res.statistic), "rho",
                       int(keep.sum()))  # fmt: skip
+
+
+def binomial(successes: int, n: int, null: float = 0.5) -> Comparison:
+    """One group's k of n against a share `null` (e.g. one of two options preferred): the exact binomial
+    test.  Effect: the observed share minus `null`."""
+    from scipy.stats import binomtest
+
+    if n == 0:
+        return Comparison("binomial", math.nan, math.nan, math.nan, "share minus null", 0)
+    res = binomtest(successes, n, null)
+    return Comparison(f"binomial vs {null:g}", float(successes), float(res.pvalue), successes / n - null,
+                      "share minus null", n)  # fmt: skip

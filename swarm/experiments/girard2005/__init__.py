@@ -36,7 +36,7 @@ EXPERIMENTS = (
 )  # fmt: skip
 PAPER = PaperSpec(
     "girard2005",
-    "Girard, Filliat, Meyer, Berthoz & Guillot (2005): the basal-ganglia animat",
+    "Girard, Filliat, Meyer, Berthoz & Guillot (2005): basal-ganglia action selection for a surviving animat",
     "swarm.experiments.girard2005.reproduce:reproduce",
     "docs/bg.md",
 )

@@ -38,6 +38,7 @@ import numpy as np
 
 from swarm.core.errors import ScenarioError
 from swarm.core.plots import pyplot, save_figure
+from swarm.experiments.girard2005.paper import PAPER_CHOICE, PAPER_FEAR, PAPER_FORGET, PAPER_SURVIVAL, PAPER_TMAZE
 from swarm.experiments.runner import Outputs, batch_run
 from swarm.scenario import load_scenario
 
@@ -80,12 +81,6 @@ TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep b
 W_PLANS = (0.65, 0.55, 0.45)
 FEAR_EP = (0.1, 0.5)
 RATIOS = (1.0, 1.5, 2.0)
-# The paper's numbers, to print beside ours.
-PAPER_SURVIVAL = {"A": (14431.5, 2531, 17274), "B": (4908.0, 2518, 8831), "U": 15}
-PAPER_CHOICE = {0.65: (13, 2), 0.55: (7, 8), 0.45: (2, 13)}
-PAPER_FORGET = (178.0, 78.0, 300.0)  # mean, sd, max seconds
-PAPER_FEAR = {0.1: (13, 7), 0.5: (2, 18)}
-PAPER_TMAZE = {1.0: (3, 12), 1.5: (4, 11), 2.0: (8, 7)}
 # The paper's controls (no numbers given, only what happened): their conditions, tests and words.
 CHOICE_CONTROL, CHOICE_CONTROL_TESTS = "no Ep2", 10
 CHOICE_CONTROL_TEXT = ("ten tests in which Ep2 is not added: \"it goes directly to Ep1 and activates the ReloadEp "

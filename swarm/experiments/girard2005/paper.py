@@ -1,24 +1,24 @@
-"""What our setup of Girard et al. (2005) does differently from the paper's, for the report (the paper's
-printed numbers are bg.py's PAPER_* constants, which the experiments print too)."""
+"""The numbers of Girard, Filliat, Meyer, Berthoz & Guillot (2005) that we reproduce, as printed there."""
 
-SURVIVAL_CAP = 4 * 3600.0  # s: "each run lasting at most 4 h"
-
-KNOWN_DIFFERENCES = (
-    "The paper's condition A median (14,431.5 s) and maximum (17,274 s) exceed its own 4 h cap (14,400 s); we "
-    "cap at 4 h, count a run alive at the cap as censored there, and compare medians as Kaplan-Meier medians.",
-    "bg-exp1 sets, for this floor only, usable_threshold = 0.5, closure_radius = 1.0 m and pursuit = 0.5, chosen "
-    "on development seeds against failures traced there; the paper varies none of them.",
-    "bg-exp3 sets navigation ways = 'places' and reach = 8.0 m, and bg-fear's tests known_explore = 0 (through "
-    "its 'explore' mapping mode); the paper changes only F, the dangerous area and the start level of Ep.",
-    "Oracle inputs: A(res) and the learning of which node holds a resource read the world's zone bits, not "
-    "mProx(res) from the camera; mapping runs end when the harness sees every resource visited, with E lasting "
-    "4 h and the dangerous area costing nothing while mapping.",
-    "Any dorsal selection sets the wheels to zero directly (the paper's trans-subthalamic coordination, eq. 10, "
-    "is not what stops the animat); the ventral read-out counts a channel released up to 1.6 times its resting "
-    "output, with an incumbent-persists rule.",
-    "Odometry and compass errors are drawn independently each tick, without bias, which flatters mapping.",
-    "Experiments 2 and 3 load a map from a mapping run of their own floor (test k on map k, so conditions share "
-    "maps and seeds); the paper's maps came from its animat's earlier life.  A test that has not reloaded Ep "
-    "within 900 s counts as 'none' (censored for the time to forget).",
-    "The 3.1 control removes the dangerous area and also sets F = 0.",
-)
+# Experiment 1, Table 1: condition -> (median, min, max) survival in seconds over ten tests each, "with a
+# four-hour duration limit"; and the U statistic (p < 0.01).  A's median and maximum exceed that limit
+# (14,400 s): the table cannot be read as capped at 4 h.
+PAPER_SURVIVAL = {"A": (14431.5, 2531, 17274), "B": (4908.0, 2518, 8831), "U": 15}
+SURVIVAL_TESTS = 10
+CAP_SECONDS = 4 * 3600.0
+# Experiment 2.1, Table 2: W_plan -> (Ep1, Ep2) choices in fifteen tests (W_taxon 0.55); the control: ten tests
+# without Ep2, all to Ep1 ("it goes directly to E_P1").
+PAPER_CHOICE = {0.65: (13, 2), 0.55: (7, 8), 0.45: (2, 13)}
+CHOICE_TESTS = 15
+# Experiment 2.2: the time to forget (the test's duration less the most direct path's, 46 s): mean, sd and max
+# seconds over fifteen tests.
+PAPER_FORGET = (178.0, 78.0, 300.0)
+FORGET_TESTS = 15
+FORGET_DIRECT_SECONDS = 46.0
+# Experiment 3.1, Table 3: Ep at the start -> (Ep1, Ep2) choices in twenty tests with F = 0.2; Fisher's exact
+# test p < 0.01.  Without the dangerous area "the animat systematically chooses the closest resource (Ep1)".
+PAPER_FEAR = {0.1: (13, 7), 0.5: (2, 18)}
+FEAR_TESTS = 20
+# Experiment 3.2, Table 4: right / left branch length ratio -> (left, right) first choices in fifteen tests.
+PAPER_TMAZE = {1.0: (3, 12), 1.5: (4, 11), 2.0: (8, 7)}
+TMAZE_TESTS = 15
