@@ -90,5 +90,5 @@ def test_the_index_counts_each_reports_verdicts_and_marks_quick_runs(tmp_path):
     lines = write_index(tmp_path).read_text().splitlines()
     row = {line.split("](")[1].split("/")[0]: line for line in lines if line.startswith("| [")}
     assert set(row) == {first, second}
-    assert row[first].endswith("| 3 | 2 | 0 | 0 | 1 |") and "quick run" not in row[first]
-    assert row[second].endswith("| 1 | 0 | 1 | 0 | 0 |") and "quick run" in row[second]
+    assert row[first].endswith("| 3 | 2 | 0 | 0 | 1 | 0 |") and "quick run" not in row[first]
+    assert row[second].endswith("| 1 | 0 | 1 | 0 | 0 | 0 |") and "quick run" in row[second]

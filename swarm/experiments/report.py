@@ -100,9 +100,9 @@ def write_index(root: Path) -> Path:
             counts = Counter(row["verdict"] for row in csv.DictReader(f))
         quick = QUICK_BANNER in (root / spec.name / "report.md").read_text()
         lines.append([f"[{spec.title}]({spec.name}/report.md)" + (" (quick run: not evidence)" if quick else ""),
-                      str(sum(counts.values())), *(str(counts[v]) for v in VERDICTS)])  # fmt: skip
+                      str(sum(counts.values())), *(str(counts[v]) for v in (*VERDICTS, "–"))])  # fmt: skip
     text = ("# Reproductions\n\nEach paper's claims judged by `swarm reproduce` on confirmation seeds "
             "(swarm/experiments/protocol.py); the reports give n, the 95% intervals and the tests.\n\n"
-            + markdown_table(["paper", "claims", *VERDICTS], lines))  # fmt: skip
+            + markdown_table(["paper", "claims", *VERDICTS, "descriptive (no test)"], lines))  # fmt: skip
     (root / "index.md").write_text(text)
     return root / "index.md"
