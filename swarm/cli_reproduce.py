@@ -34,10 +34,13 @@ def cmd_reproduce(args) -> int:
     from swarm.experiments.report import write_index
 
     papers = list(PAPERS) if args.paper == "all" else [PAPERS[args.paper]]
+    roots = set()
     for spec in papers:
         out = args.out if args.out is None or len(papers) == 1 else args.out / spec.name
         result = resolve(spec.reproduce)(quick=args.quick, jobs=args.jobs, out=out)
         verdicts = ", ".join(f"{n} {v}" for v, n in result["verdicts"].items())
         print(f"{spec.name}: {result['claims']} claims: {verdicts}; report: {result['out']}/report.md")
-        write_index(Path(result["out"]).parent)
+        roots.add(Path(result["out"]).parent)
+    for root in roots:  # the folder holding the reports: its index counts them all
+        write_index(root)
     return 0

@@ -219,15 +219,34 @@ def kaplan_meier_median(times: Sequence[float], finished: Sequence[bool]) -> Est
 
 def restricted_mean(times: Sequence[float], finished: Sequence[bool], horizon: float) -> float:
     """The mean time to the event restricted to `horizon` (the area under the Kaplan-Meier curve up to it):
-    defined whatever share of the runs hit the cap, unlike the mean or the median."""
+    defined whatever share of the runs hit the cap, unlike the mean or the median.  The curve is known only up
+    to the longest time observed, so the area stops there when the horizon lies beyond it."""
     from scipy.stats import ecdf
 
     if not len(times):
         return math.nan
+    horizon = min(horizon, float(np.max(times)))
     sf = ecdf(_censored(times, finished)).sf
     t = np.concatenate([[0.0], sf.quantiles[sf.quantiles < horizon], [horizon]])
     s = np.concatenate([[1.0], sf.probabilities[sf.quantiles < horizon]])
     return float(np.sum(np.diff(t) * s))
+
+
+def restricted_mean_ci(times: Sequence[float], finished: Sequence[bool], horizon: float,
+                       seed: int = 0) -> Estimate:  # fmt: skip
+    """The restricted mean time up to `horizon` (censored runs kept) with a percentile bootstrap interval
+    over the runs."""
+    from scipy.stats import bootstrap
+
+    t, done = np.asarray(times, float), np.asarray(finished, bool)
+    value = restricted_mean(t, done, horizon)
+    if len(t) < 3 or np.all(t == t[0]):
+        return Estimate(value, math.nan, math.nan, len(t), "restricted mean")
+    res = bootstrap((t, done.astype(float)), lambda a, b: restricted_mean(a, b.astype(bool), horizon), paired=True,
+                    vectorized=False, n_resamples=1999, method="percentile",
+                    random_state=np.random.default_rng(seed))  # fmt: skip
+    low, high = res.confidence_interval
+    return Estimate(value, float(low), float(high), len(t), "restricted mean")
 
 
 def logrank(times_a: Sequence[float], finished_a: Sequence[bool], times_b: Sequence[float],

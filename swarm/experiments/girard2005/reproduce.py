@@ -157,24 +157,6 @@ def _vs_paper(k: int, n: int, paper_k: int, paper_n: int) -> str:
     return f"{S.fisher(k, n, paper_k, paper_n).p:.2f}" if n else "n/a"
 
 
-def restricted_mean_ci(times: np.ndarray, finished: np.ndarray, horizon: float, seed: int = 0) -> S.Estimate:
-    """The restricted mean time up to `horizon` (censored runs kept) with a percentile bootstrap interval over
-    the runs."""
-    from scipy.stats import bootstrap
-
-    def rmst(t, f):
-        f = np.asarray(f, bool)
-        return S.restricted_mean(t, f, horizon) if f.any() else float(min(horizon, np.min(t)))
-
-    value = rmst(times, finished)
-    if len(times) < 3 or np.all(times == times[0]):
-        return S.Estimate(value, math.nan, math.nan, len(times), "restricted mean")
-    res = bootstrap((times, finished.astype(float)), rmst, paired=True, vectorized=False, n_resamples=1999,
-                    method="percentile", random_state=np.random.default_rng(seed))  # fmt: skip
-    low, high = res.confidence_interval
-    return S.Estimate(value, float(low), float(high), len(times), "restricted mean")
-
-
 def _km_text(times: np.ndarray, finished: np.ndarray, cap: float) -> str:
     """The Kaplan-Meier median, or "> cap" where more than half the runs outlasted it."""
     e = S.kaplan_meier_median(times, finished)
@@ -197,7 +179,7 @@ def _survival(rows: list[dict], quick: bool):
         capped = f"{S.number(four_h, 5)} (≥ 5 of 10 past it)" if median > four_h else S.number(median, 5)
         lines.append([c, f"{len(t[c])} ({paper.SURVIVAL_TESTS})", _km_text(t[c], done[c], cap),
                       _share(int((~done[c]).sum()), len(t[c])), f"{t[c].min():,.0f} : {t[c].max():,.0f}",
-                      restricted_mean_ci(t[c], done[c], cap).text(4), f"{median:,} ({low:,} : {high:,})",
+                      S.restricted_mean_ci(t[c], done[c], cap).text(4), f"{median:,} ({low:,} : {high:,})",
                       capped])  # fmt: skip
     mw = S.mann_whitney(t["A"], t["B"])
     lr = S.logrank(t["A"], done["A"], t["B"], done["B"])
@@ -209,7 +191,7 @@ def _survival(rows: list[dict], quick: bool):
                 mw),
         P.Claim("exp. 1: A survives longer than B, runs alive at the cap censored (log-rank)", paper_text,
                 f"restricted means to {S.number(cap, 4)} s: " + " / ".join(
-                    restricted_mean_ci(t[c], done[c], cap).text(4) for c in ("A", "B")), lr),
+                    S.restricted_mean_ci(t[c], done[c], cap).text(4) for c in ("A", "B")), lr),
         P.Claim(f"exp. 1: A's runs alive at the cap ({S.number(cap, 4)} s)", "≥ 5/10 (median 14,431.5 s > 4 h)",
                 _share(alive, len(t["A"])), None),
     ]  # fmt: skip
@@ -266,7 +248,7 @@ def _forget(rows: list[dict]):
     km = S.kaplan_meier_median(t, reached)
     km_text = (f"{S.number(km.value - direct, 3)} [{S.number(km.low - direct, 3)}, {S.number(km.high - direct, 3)}]"
                if not math.isnan(km.value) else f"> {bg.TEST_SECONDS - direct:.0f} (over half censored)")  # fmt: skip
-    rm = restricted_mean_ci(t, reached, bg.TEST_SECONDS)
+    rm = S.restricted_mean_ci(t, reached, bg.TEST_SECONDS)
     rm_text = f"{rm.value - direct:.0f} [{rm.low - direct:.0f}, {rm.high - direct:.0f}]"
     within = int((reached & (forget <= paper.PAPER_FORGET[2])).sum())
     pm, ps, px = paper.PAPER_FORGET
