@@ -18,7 +18,10 @@ import struct
 from collections.abc import Callable
 from typing import Any
 
+import msgpack
+
 ExtHook = Callable[[int, memoryview], Any]
+TIMESTAMP = -1  # the extension type msgpack reserves for its Timestamp
 MAX_DEPTH = 64  # nested arrays and maps; a deeper message is refused, not a RecursionError
 
 _FIXED = {  # type byte: (struct format, size) of a fixed-size scalar
@@ -97,6 +100,8 @@ class _Reader:
 
     def ext(self, size: int) -> Any:
         code = self.number(">b", 1)
+        if code == TIMESTAMP:  # msgpack's own type, decoded (and refused when malformed) as msgpack does
+            return msgpack.Timestamp.from_bytes(bytes(self.take(size)))
         return self.ext_hook(code, self.take(size))
 
     def array(self, size: int, depth: int) -> list:
