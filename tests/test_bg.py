@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from agents.controllers.bg.controller import BgController
-from agents.controllers.bg.places import ANGLES, DIRECTIONS, Navigator, NavParams, _explore_channel
+from agents.controllers.bg.params import NavParams
+from agents.controllers.bg.places import ANGLES, DIRECTIONS, Navigator, _explore_channel
 from agents.controllers.bg.saliences import Drives, plan_vector, saliences
 from agents.controllers.bg.senses import Reflex, proximity, resource_pixels, sense, to_allocentric
 from agents.controllers.navigation.dijkstra import shortest_routes

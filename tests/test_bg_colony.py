@@ -9,7 +9,8 @@ import pytest
 
 from agents.controllers.arena import deliver
 from agents.controllers.bg.colony import ColonyMap
-from agents.controllers.bg.places import Navigator, NavParams
+from agents.controllers.bg.params import NavParams
+from agents.controllers.bg.places import Navigator
 from agents.controllers.bg.senses import RESOURCES
 from swarm.core.wire import pack
 from swarm.engines.arena import ArenaEngine

@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 
-from agents.controllers.bg.controller import BgParams
 from agents.controllers.bg.gpr import (
     EP,
     BasalGanglia,
@@ -12,6 +11,7 @@ from agents.controllers.bg.gpr import (
     select_dorsal,
     select_ventral,
 )
+from agents.controllers.bg.params import BgParams
 
 THRESHOLD = 0.2
 VENTRAL = BgParams().ventral_threshold  # the animat's: below 1.3 times the resting output

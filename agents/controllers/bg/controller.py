@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -21,10 +21,10 @@ import numpy as np
 
 from agents.controllers.bg.colony import ColonyMap
 from agents.controllers.bg.gpr import BasalGanglia, select_dorsal, select_ventral
-from agents.controllers.bg.places import DIRECTIONS, WAYS, Navigator, NavParams
-from agents.controllers.bg.saliences import SALIENCES, Drives, saliences
+from agents.controllers.bg.params import SALIENCES, WAYS, BgParams, NavParams
+from agents.controllers.bg.places import DIRECTIONS, Navigator
+from agents.controllers.bg.saliences import Drives, saliences
 from agents.controllers.bg.senses import RESOURCES, Reflex, sense
-from swarm.core.params import OURS, PAPER, declared
 from swarm.core.tables import params_from_table
 from world_server.arena.face.sensors.zones import ZONE_KINDS
 
@@ -33,93 +33,21 @@ USABLE_BITS = {r: 1 << ZONE_KINDS.index(z) for r, z in USABLE_ZONE.items()}  # i
 DORSAL_ACTS = ("ReloadE", "ReloadEp")  # channel order; world_server.arena.metabolism.ACTS codes 1, 2
 
 
-@dataclass(frozen=True)
-class BgParams:
-    saliences: str = declared(
-        "survival",
-        source=PAPER,
-        where="appendix A.2.1, eqs. 15-17 (experiments 1 and 2); fear: eq. 18 (exp. 3.1); tmaze: eqs. 19-20 (exp. 3.2)",
-    )
-    planning: bool = declared(
-        True,
-        source=PAPER,
-        where="section 4.1: condition A, taxon and topological navigation (False: condition B, taxon only)",
-    )
-    w_plan: float = declared(0.65, source=PAPER, where="appendix A.2.1, after eq. 17: W_plan = 0.65")
-    w_taxon: float = declared(0.55, source=PAPER, where="appendix A.2.1, after eq. 17: W_taxon(Ep) = 0.55")
-    fear: float = declared(0.2, source=PAPER, where="section 4.3.1 (experiment 3.1): F = 0.2, m(DA)")
-    # disinhibition an act needs to start (it goes on while above 0: docs/bg.md) ...
-    dorsal_threshold: float = declared(
-        0.9,
-        source=OURS,
-        reason="the paper's selection has no threshold; lower (0.3, "
-        "0.5) the 0.6 mProx(E) m(E) term of eq. 15 starts ReloadE far from E and "
-        "most animats die so (docs/bg.md, Selection)",
-    )
-    # ... and where it works (A(res)); lower, an act nearly selected there starts
-    usable_threshold: float = declared(
-        0.9,
-        source=OURS,
-        reason="the dorsal threshold, kept where the act's zone "
-        "is usable; a scenario may lower it (docs/bg.md, Selection)",
-    )
-    # ... a direction channel needs to join the vector sum (EP/SNr below 1.6 x rest)
-    ventral_threshold: float = declared(
-        -0.6,
-        source=OURS,
-        reason="in a 36-channel loop the diffuse STN lifts every "
-        "output, so the winner hardly drops below rest; a dorsal selection lifts "
-        "them to 1.6-2.2 x rest (docs/bg.md, Selection)",
-    )
-    too_close: float = declared(
-        0.45,
-        source=OURS,
-        reason="m from the centre: the paper's sonar reflex (section 3.2) "
-        "has no distance; the bg corridors are 0.8 m for a 0.3 m body (docs/bg.md)",
-    )
-    reflex_hold: float = declared(
-        2.0,
-        source=OURS,
-        reason="s the reflex drives straight on once the front is clear, past the obstacle (docs/bg.md, Sonar reflex)",
-    )
-    align: float = declared(
-        math.radians(30),
-        source=OURS,
-        reason="heading error beyond which the animat turns on "
-        "the spot; the paper gives no steering (docs/bg.md, Steering)",
-    )
-    learn_map: bool = declared(
-        True,
-        source=OURS,
-        reason="a switch of ours: the paper's animat always maps; False "
-        "keeps a loaded map as it is and only localizes on it",
-    )
-    share: bool = declared(
-        False,
-        source=OURS,
-        reason="a colony (publish and merge maps on swarm/<run>/map/**) is ours; the paper has one animat",
-    )
-    map: str = declared(
-        "",
-        source=OURS,
-        reason="a saved map (BgController.map_data() as JSON) to start from; the paper's animat starts with none",
-    )
-
-    @classmethod
-    def from_table(cls, table: dict[str, Any] | None) -> BgParams:
-        table = dict(table or {})
-        nav = table.pop("navigation", None)
-        if isinstance(table.get("map"), dict):
-            table.pop("map")  # a map given as data (experiments): read by the controller
-        p = params_from_table(cls, table, "bg", texts=("saliences", "map", "planning", "learn_map", "share"))
-        for name in ("planning", "learn_map", "share"):
-            if not isinstance(getattr(p, name), bool):
-                raise ValueError(f"[bg]: {name} expected true or false, got {getattr(p, name)!r}")
-        if p.saliences not in SALIENCES:
-            raise ValueError(f"bg.saliences: expected one of {', '.join(SALIENCES)}, got {p.saliences!r}")
-        if nav is not None:
-            nav_params(nav)
-        return p
+def bg_params(table: dict[str, Any] | None) -> BgParams:
+    """The [bg] table read into BgParams, its [bg.navigation] table checked: ValueError in one line."""
+    table = dict(table or {})
+    nav = table.pop("navigation", None)
+    if isinstance(table.get("map"), dict):
+        table.pop("map")  # a map given as data (experiments): read by the controller
+    p = params_from_table(BgParams, table, "bg", texts=("saliences", "map", "planning", "learn_map", "share"))
+    for name in ("planning", "learn_map", "share"):
+        if not isinstance(getattr(p, name), bool):
+            raise ValueError(f"[bg]: {name} expected true or false, got {getattr(p, name)!r}")
+    if p.saliences not in SALIENCES:
+        raise ValueError(f"bg.saliences: expected one of {', '.join(SALIENCES)}, got {p.saliences!r}")
+    if nav is not None:
+        nav_params(nav)
+    return p
 
 
 def nav_params(table: dict[str, Any] | None) -> NavParams:
@@ -132,13 +60,13 @@ def nav_params(table: dict[str, Any] | None) -> NavParams:
 
 
 def check_table(table: dict[str, Any]) -> None:
-    BgParams.from_table(table)
+    bg_params(table)
 
 
 class BgController:
     def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
         table = params.get("bg") or {}
-        self.p = BgParams.from_table(table)
+        self.p = bg_params(table)
         self.nav_params = nav_params(table.get("navigation"))
         robot = params["robot"]
         self.axle, self.max_speed = float(robot["axle"]), float(robot["max_speed"])

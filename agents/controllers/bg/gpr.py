@@ -30,42 +30,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from agents.controllers.bg.params import GprParams
 from swarm.core.kernels import exported, njit
-from swarm.core.params import OURS, PAPER, declared
 
 # Nuclei, in the order of the state's rows.
 D1, D2, STN, GP, EP, VL, TRN, CTX = range(8)
 NUCLEI = ("D1", "D2", "STN", "GP", "EP/SNr", "VL", "TRN", "Ctx")
-
-
-@dataclass(frozen=True)
-class GprParams:
-    """The GPR's numbers (appendix A.1).  The module constants below are taken from these defaults;
-    the weights of eqs. 9-12 (`gp_to_ep`, `stn_diffuse`, `trn_lateral`) are literals of `_euler`,
-    recorded here."""
-
-    # Table 5: threshold epsilon and slope m of each nucleus's output, in NUCLEI order.
-    epsilon: tuple[float, ...] = declared(
-        (0.2, 0.2, -0.25, -0.2, -0.2, -0.8, 0.0, 0.0), source=PAPER, where="Table 5 (epsilon per nucleus)"
-    )
-    slope: tuple[float, ...] = declared(
-        (1.0, 1.0, 1.0, 1.0, 1.0, 0.62, 0.5, 1.0), source=PAPER, where="Table 5 (m per nucleus)"
-    )
-    tau: float = declared(0.025, source=PAPER, where="appendix A.1, eq. 3: tau = 25 ms (Gurney's own code: 40 ms)")
-    dopamine: float = declared(0.2, source=PAPER, where="appendix A.1, eqs. 5-6: lambda, the dopamine level (0.2)")
-    dt: float = declared(
-        0.001,
-        source=OURS,
-        reason="s, the Euler step: explicit Euler with the diffuse STN is "
-        "stable only below 1.5 ms at 36 channels (docs/bg.md, Integration)",
-    )
-    cross: float = declared(0.4, source=PAPER, where="eq. 10: dorsal STN onto ventral EP/SNr, 0.4")
-    feedback_dorsal: float = declared(0.4, source=PAPER, where="eqs. 15-16, 19-20: 0.4 P_E, 0.4 P_Ep")
-    feedback_ventral: float = declared(0.2, source=PAPER, where="eqs. 17-18: 0.2 P_i")
-    gp_to_ep: float = declared(0.4, source=PAPER, where="eqs. 9-10: -0.4 y_GP")
-    stn_diffuse: float = declared(0.8, source=PAPER, where="eqs. 9-11: 0.8 sum y_STN")
-    trn_lateral: float = declared(0.13, source=PAPER, where="eq. 12: -0.13 sum y_TRN")
-    ventral_channels: int = declared(36, source=PAPER, where="section 2.2.2: 36 channels, directions 10 degrees apart")
 
 
 GPR = GprParams()

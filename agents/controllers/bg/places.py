@@ -38,172 +38,20 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from agents.controllers.bg.params import NavParams
 from agents.controllers.bg.senses import to_allocentric
 from agents.controllers.navigation.dijkstra import shortest_routes
 from agents.controllers.navigation.topomap import MapParams, TopoMap, topomap_from_data, topomap_to_data
 from swarm.core.kernels import exported, njit
-from swarm.core.params import OURS, declared
 from swarm.core.rng import fill_uniform
 
 DIRECTIONS = 36
 ANGLES = np.arange(DIRECTIONS) * (2 * math.pi / DIRECTIONS)
 S_EXPLORE = 101  # noise stream of the exploration preference
-WAYS = ("best", "places")  # NavParams.ways
-
-
-@dataclass(frozen=True)
-class NavParams:
-    """Filliat-style navigation (section 2.1 describes it and gives no numbers: every value is ours,
-    calibrated on bg-exp1 where docs/bg.md, Navigation, says so)."""
-
-    spacing: float = declared(
-        0.3,
-        source=OURS,
-        reason="odometric metres between two observations (the map's "
-        "delta d): views 0.3 m apart match with median 0.65 on bg-exp1 (docs/bg.md)",
-    )
-    theta: float = declared(
-        0.6,
-        source=OURS,
-        reason="largest dissimilarity (1 - P(match)) that joins the current "
-        "node: P > 0.4, calibrated on bg-exp1 views (docs/bg.md, Navigation)",
-    )
-    closure_match: float = declared(
-        0.45,
-        source=OURS,
-        reason="P(match) with which a known node the belief points at "
-        "closes a loop, calibrated on bg-exp1 (docs/bg.md, Navigation)",
-    )
-    extent: float = declared(
-        1.0,
-        source=OURS,
-        reason="m: a node stretches no farther from where it was first seen "
-        "(Filliat's maps are dense; a uniform corridor stays a chain of nodes)",
-    )
-    closure_radius: float = declared(
-        2.0,
-        source=OURS,
-        reason="m: a loop closes only onto a node this near by "
-        "odometry, so alike places elsewhere do not fold the map; bg-exp1's two mirrored "
-        "rooms close loops through the wall at 2 m, so it sets 1 m (docs/bg.md)",
-    )
-    merge_match: float = declared(
-        0.6,
-        source=OURS,
-        reason="P(match) with which another animat's node is one of ours (within closure_radius); colonies are ours",
-    )
-    grey_scale: float = declared(
-        35.0,
-        source=OURS,
-        reason="grey levels of one unit of dissimilarity, calibrated on bg-exp1 views (docs/bg.md, Navigation)",
-    )
-    sonar_scale: float = declared(
-        1.0,
-        source=OURS,
-        reason="metres of one unit of dissimilarity, calibrated on bg-exp1 views (docs/bg.md, Navigation)",
-    )
-    d_rise: float = declared(
-        0.1,
-        source=OURS,
-        reason="D rises 10% of the way to 1 per new node: the paper says only "
-        "that D rises while nodes are made (section 2.1)",
-    )
-    d_fall: float = declared(
-        0.9,
-        source=OURS,
-        reason="D falls by this factor per observation in a known node: the "
-        "paper says only that it falls in well known areas (section 2.1)",
-    )
-    gain: float = declared(
-        1.0,
-        source=OURS,
-        reason="Hebbian gain while a resource is usable, 1/s: a few seconds "
-        "there and the node holds it; the paper gives no gain (section 4.2.2)",
-    )
-    forget: float = declared(
-        0.02,
-        source=OURS,
-        reason="1/s while a resource is not even in sight: half forgotten in "
-        "about 35 s there (the paper's forgetting took 178 s on average, section 4.2.2)",
-    )
-    reach: float = declared(15.0, source=OURS, reason="m: P falls by e over this route length (docs/bg.md, Navigation)")
-    anchor: float = declared(
-        0.0,
-        source=OURS,
-        reason="share of the way odometry is pulled to a recognized node; off "
-        "by default, bg-exp1 sets 0.2 against the compass-turned odometry's drift (docs/bg.md)",
-    )
-    lookahead: float = declared(
-        1.0,
-        source=OURS,
-        reason="m of route whose direction P points along: the route's first metre (docs/bg.md, Navigation)",
-    )
-    pursuit: float = declared(
-        0.0,
-        source=OURS,
-        reason="when > 0, m: P points at the first route node this far from "
-        "the last observation (no corner cut through a wall's end); off by default "
-        "(docs/bg.md)",
-    )
-    width: float = declared(
-        4.0,
-        source=OURS,
-        reason="von Mises concentration of a direction's bump over the 36 channels (kappa = 4, docs/bg.md)",
-    )
-    known_age: int = declared(
-        20,
-        source=OURS,
-        reason="observations after its creation from which coming back to a "
-        "node means a known area (docs/bg.md, Disorientation)",
-    )
-    near: float = declared(
-        0.0,
-        source=OURS,
-        reason="m: link a new node to nodes observed this close; 0, only to "
-        "nodes driven between: two places 0.5 m apart on either side of a wall are no route",
-    )
-    recent: float = declared(
-        10.0,
-        source=OURS,
-        reason="m of travel within which `near` links (odometry drifts: "
-        "farther back, near means little); unused while near is 0",
-    )
-    open_range: float = declared(
-        1.0, source=OURS, reason="m of sonar room from which a direction counts as open (docs/bg.md, Expl)"
-    )
-    novelty_radius: float = declared(
-        2.0, source=OURS, reason="m: nodes nearer than this, in a direction, make it known (docs/bg.md, Expl)"
-    )
-    wander_period: float = declared(
-        20.0, source=OURS, reason="s between two draws of the exploration preference (docs/bg.md, Expl)"
-    )
-    wander_weight: float = declared(
-        0.5, source=OURS, reason="weight of the random preference beside room and novelty when Expl picks its direction"
-    )
-    known_explore: float = declared(
-        1.0,
-        source=OURS,
-        reason="Expl's height where the map knows its direction: 1, "
-        "Expl is 1 wherever it points; 0, only at unmapped areas (bg-fear's tests; "
-        "docs/bg.md, Expl)",
-    )
-    ways: str = declared(
-        "best",
-        source=OURS,
-        reason="P(res) as one bump along the best route; 'places', one "
-        "towards each place holding res, which bg-exp3 sets (docs/bg.md, Navigation)",
-    )
-    place_radius: float = declared(
-        2.0,
-        source=OURS,
-        reason="m: with ways = 'places', the nodes holding res this near "
-        "the one holding it most are one place (docs/bg.md)",
-    )
 
 
 class PlaceSignatures:

@@ -12,35 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from agents.controllers.bg.params import SALIENCES
 from swarm.core.kernels import exported, njit
-from swarm.core.params import PAPER, declared
-
-SALIENCES = ("survival", "fear", "tmaze")  # eqs. 15-17 (exps. 1, 2); 15, 16, 18 (exp. 3.1); 19, 20 (exp. 3.2)
-
-
-@dataclass(frozen=True)
-class SalienceWeights:
-    """The weights of eqs. 15-20 (appendix A.2), recorded with their provenance: `_saliences` writes
-    them as literals, in the order of the equations, so that it gives numpy's numbers to the bit.
-    W_plan and W_taxon, which experiment 2.1 varies, are BgParams'; the feedback weights GprParams'."""
-
-    e_usable: float = declared(1.2, source=PAPER, where="eq. 15: 1.2 A(E) m(E)")
-    e_prox: float = declared(0.6, source=PAPER, where="eq. 15: 0.6 mProx(E) m(E)")
-    ep_usable: float = declared(1.0, source=PAPER, where="eq. 16: A(Ep) m(Ep)")
-    ep_prox: float = declared(0.2, source=PAPER, where="eq. 16: 0.2 mProx(Ep) m(Ep)")
-    taxon_e: float = declared(0.55, source=PAPER, where="eq. 17: 0.55 sqrt(Prox(E)) m(E)")
-    bka: float = declared(0.4, source=PAPER, where="eqs. 17-18: 0.4 BKA m(BKA)")
-    expl: float = declared(0.25, source=PAPER, where="eq. 17: Exp (0.25 + ...)")
-    expl_need: float = declared(0.05, source=PAPER, where="eqs. 17-18: 0.05 (1 - mProx(res)) m(res), Ep and E")
-    fear_plan: float = declared(0.45, source=PAPER, where="eq. 18: 0.45 sqrt(Plan)")
-    fear_taxon: float = declared(0.35, source=PAPER, where="eq. 18: 0.35 sqrt(Prox(E)) m(E), 0.35 sqrt(Prox(Ep)) m(Ep)")
-    fear_danger: float = declared(0.19, source=PAPER, where="eq. 18: 0.19 (1 - Prox(DA)) m(DA)")
-    fear_expl: float = declared(0.05, source=PAPER, where="eq. 18: Exp (0.05 + ...)")
-    tmaze_usable: float = declared(0.9, source=PAPER, where="eqs. 19-20: 0.9 A(res) m(res)")
-    tmaze_prox: float = declared(0.1, source=PAPER, where="eqs. 19-20: 0.1 mProx(res) m(res)")
-    tmaze_plan: float = declared(
-        0.55, source=PAPER, where="appendix A.2.3: 0.55 sqrt(Plan) (1 - mProx(E)) (1 - mProx(Ep))"
-    )
 
 
 @dataclass(slots=True)  # not frozen: a frozen dataclass sets each field through object.__setattr__, every tick

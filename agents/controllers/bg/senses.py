@@ -10,37 +10,13 @@ directions, so every egocentric reading is turned by the compass first.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
+from agents.controllers.bg.params import SenseParams
 from swarm.core.kernels import exported, njit
-from swarm.core.params import OURS, PAPER, declared
 
 RESOURCES = ("DA", "Ep", "E")  # dangerous, potential energy (ingesting), energy (digesting)
-
-
-@dataclass(frozen=True)
-class SenseParams:
-    """The numbers of the animat's senses; the module constants below are taken from these defaults."""
-
-    grey: tuple[int, ...] = declared(
-        (31, 127, 255),
-        source=OURS,
-        reason="grey levels of DA, Ep and E (RESOURCES "
-        "order): the paper's simulated camera sees colours directly (section 3.2) and "
-        "gives none; three levels far apart (docs/bg.md)",
-    )
-    window: int = declared(
-        7, source=PAPER, where="section 3.2: contiguous pixels in a 7 pixels window centred on the direction"
-    )
-    side: float = declared(
-        1 / 3,
-        source=OURS,
-        reason="the +-45 degree sonars set the reflex off at this share of "
-        "too_close: in the bg corridors (0.8 m for a 0.3 m body) anything more sets it off at "
-        "every sway (docs/bg.md, Sonar reflex)",
-    )
 
 
 SENSES = SenseParams()
