@@ -412,10 +412,10 @@ def test_expl_is_as_high_as_its_direction_is_unmapped_when_known_explore_is_0(kn
     assert (min(heights) < 0.9) == (known == 0.0)  # some draws point where the map has nodes
 
 
-@pytest.mark.parametrize("radius, reached", [(1.0, [False, False, True, True, True, True]), (None, [True] * 6)])
+@pytest.mark.parametrize("radius, reached", [(None, [False, False, True, True, True, True]), (2.0, [True] * 6)])
 def test_a_loop_closes_only_onto_a_place_within_the_closure_radius(radius, reached):
     """bg-exp1's two rooms mirror each other across the middle wall: with loops closing onto nodes up to 2 m
-    away by odometry (the default) they close through the wall.  At 1 m a node 1.25 m away is out of reach."""
+    away by odometry they close through the wall.  At 1 m (the default) a node 1.25 m away is out of reach."""
     params = NavParams() if radius is None else NavParams(closure_radius=radius)
     nav = Navigator(params, seed=0, agent=0, resources=("DA", "Ep", "E"))
     _corridor(nav, [(math.pi / 2, 6)])  # places at y = 0, 0.3, ..., 1.5 (x = 0)
@@ -466,20 +466,75 @@ def test_the_animat_reloads_at_food_it_sees_and_then_goes_on():
     assert r["distance"] > 0.1 and engine.summary()["rejected_actions"] == 0
 
 
-@pytest.mark.parametrize("usable_threshold, reloads", [(0.5, True), (None, False)])
-def test_beside_food_a_moderate_need_tops_up_where_it_works(usable_threshold, reloads):
-    """Ep 0.65 beside an ingesting zone: ReloadEp's channel is released to about 0.9, just under the 0.9 an act
-    needs.  With `usable_threshold` 0.5 the act starts where its zone is usable: the animat tops up.  With the
-    default (0.9 there too) it does not (in bg-exp1 such an animat stood by Ep for 1000 s, starving for E)."""
+@pytest.mark.parametrize("dorsal_threshold, reloads", [(0.5, True), (None, False)])
+def test_beside_food_a_moderate_need_tops_up_only_below_the_dorsal_threshold(dorsal_threshold, reloads):
+    """Ep 0.65 beside an ingesting zone its camera sees fill the window (A(Ep)): ReloadEp's channel is released
+    to about 0.9, just under the 0.9 an act needs by default, so the animat does not top up; with the dorsal
+    threshold at 0.5 it does.  One threshold, wherever the animat is."""
     s = arena(FOOD.format(extra="energy = 1.0\npotential = 0.65\n", x=1.2, y=0.5), w=3.0, h=2.0, robot="animat",
               noise="low", max_ticks=600)  # fmt: skip
     params = dict(s.controller_params)
-    if usable_threshold is not None:
-        params["bg"] = {**params.get("bg", {}), "usable_threshold": usable_threshold}
+    if dorsal_threshold is not None:
+        params["bg"] = {**params.get("bg", {}), "dorsal_threshold": dorsal_threshold}
     engine = ArenaEngine(dataclasses.replace(s.with_overrides(start=(1.2, 0.5, math.pi)), controller_params=params))
     engine.step(400)
     r = engine.summary()["robots"][0]
     assert (r["reloads"]["ReloadEp"] > 10 and r["potential"] > 0.8) == reloads, r["reloads"]
+
+
+class _ReadLog(dict):
+    """A perception that remembers which of its readings the controller asked for."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.read: set[str] = set()
+
+    def __getitem__(self, key):
+        self.read.add(key)
+        return super().__getitem__(key)
+
+    def get(self, key, default=None):
+        self.read.add(key)
+        return super().get(key, default)
+
+
+# What the paper's animat senses (section 3.2): its camera, sonars, odometry and compass, and its own E and Ep.
+PAPER_SENSORS = {"camera", "sonar", "odometry", "compass"}
+PAPER_SENSES = {"camera_grey", "sonar", "odometry", "compass", "metabolism"}  # their readings
+
+
+def test_the_animat_reads_only_the_senses_the_paper_gives_it_and_learns_resources_from_its_camera():
+    """No world truth: every reading the controller takes is one of the paper's senses (the world's zone bits
+    are offered and never read), and A(res), which starts an act and teaches the map where a resource is,
+    is mProx(res) = 1 from the camera, as the paper defines it."""
+    from agents.controllers.bg import CONTROLLERS
+
+    assert set(CONTROLLERS.requires) <= PAPER_SENSORS
+    s = load_scenario("bg-exp1").with_overrides(max_ticks=2400)
+    engine = ArenaEngine(s)
+    animat = engine.controllers[0]
+    read: set[str] = set()
+    offered: set[str] = set()
+    step = animat.step
+
+    def logged(perception):
+        log = _ReadLog(perception)
+        log["zones"] = np.int64(0b111)  # world truth on offer: were it read, every resource would be usable
+        offered.update(log)
+        out = step(log)
+        read.update(log.read)
+        return out
+
+    animat.step = logged
+    engine.step(2400)
+    assert "zones" in offered and read <= PAPER_SENSES, read - PAPER_SENSES
+    # a view that fills the 7-pixel window makes the resource usable; a narrower one does not
+    grey = np.full(36, 180.0)
+    grey[:7] = 255.0  # E across sectors 0-6: direction 3 sees it fill its window
+    prox, _ = sense(grey, 0.0)
+    assert prox[2].max() == 1.0 and prox[1].max() == 0.0
+    grey[6] = 180.0
+    assert sense(grey, 0.0)[0][2].max() < 1.0
 
 
 def test_snapshot_and_restore_continue_bit_for_bit():
@@ -588,7 +643,13 @@ def test_with_learn_map_off_an_animat_localizes_on_a_loaded_map_and_leaves_it_as
     maker = ArenaEngine(load_scenario("bg-exp1").with_overrides(max_ticks=1200))
     maker.step(1200)
     made = maker.controllers[0].map_data()
-    engine = ArenaEngine(_with(load_scenario("bg-exp1"), bg={"map": made, "learn_map": False}, max_ticks=800))
+    engine = ArenaEngine(
+        _with(
+            load_scenario("bg-exp1"),
+            max_ticks=800,  # Expl everywhere, so that it moves on
+            bg={"map": made, "learn_map": False, "navigation": {"known_explore": 1.0}},
+        )
+    )
     nav = engine.controllers[0].nav
     start = engine.world.pose[0, :2].copy()
     visited, misses, farthest = set(), [], 0.0
@@ -621,9 +682,11 @@ def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):
 
 
 def test_bg_experiment_tests_share_maps_across_conditions():
-    from swarm.experiments.girard2005.bg import test_jobs
+    from swarm.experiments.girard2005.bg import mapped_floors, test_jobs
 
-    maps = {"bg-exp3": [{"id": 0}, {"id": 1}]}
+    sets = mapped_floors("bg-fear", ("bg-exp3",))
+    assert sets == {"bg-exp3": ("bg-exp3", ()), "bg-exp3 without DA": ("bg-exp3", ("DA",))}
+    maps = {"bg-exp3": [{"id": 0}, {"id": 1}], "bg-exp3 without DA": [{"id": 2}, {"id": 3}]}
     jobs = test_jobs("bg-fear", 4, 10, maps)
     assert [(j[1], j[3], j[8]) for j in jobs[:8]] == [
         (0.1, 10, 0),
@@ -635,41 +698,26 @@ def test_bg_experiment_tests_share_maps_across_conditions():
         (0.5, 12, 0),
         (0.5, 13, 1),
     ]
-    assert all(j[9] is maps["bg-exp3"][j[8]] for j in jobs)
-    # the paper's control: the same tests (seeds, maps, Ep) without the dangerous area and without fear
+    assert all(j[9] is maps["bg-exp3"][j[8]] for j in jobs[:8])
+    # the paper's control: the same seeds and Ep, the dangerous area absent from the floor and from its maps,
+    # and nothing else changed (F stays the scenario's 0.2)
     control = jobs[8:]
     assert [(j[1], j[3], j[8], j[6]) for j in control] == [
         (f"{ep}, no DA", 10 + k, k % 2, {"potential": ep}) for ep in (0.1, 0.5) for k in range(4)
     ]
-    assert all(j[7] == ("DA",) and j[5]["fear"] == 0.0 for j in control)
-
-
-def test_a_test_goes_on_mapping_a_hungry_map_and_takes_an_explored_one_as_it_is():
-    """A hungry mapping run leaves the way between resources, which a test extends; an exploring one covers
-    the floor, and a test only localizes on it (a node it made would be a leaf whose routes lead back).  The
-    command line's --bg learn_map overrides either."""
-    from swarm.experiments.girard2005.bg import test_jobs
-
-    maps = {"bg-exp3": [{}]}
-    assert all(j[5]["learn_map"] for j in test_jobs("bg-fear", 2, 0, maps))
-    assert not any(j[5]["learn_map"] for j in test_jobs("bg-fear", 2, 0, maps, None, "explore"))
-    assert all(j[5]["learn_map"] for j in test_jobs("bg-fear", 2, 0, maps, {"learn_map": True}, "explore"))
-    assert all(j[5]["fear"] == 0.0 for j in test_jobs("bg-fear", 2, 0, maps, None, "explore") if "no DA" in str(j[1]))
-    # ... and explores only where the explored map has a hole; --bg navigation.known_explore overrides it
-    assert all(j[5]["navigation"] == {"known_explore": 0.0} for j in test_jobs("bg-fear", 2, 0, maps, None, "explore"))
-    assert all("navigation" not in j[5] for j in test_jobs("bg-fear", 2, 0, maps))
-    override = test_jobs("bg-fear", 2, 0, maps, {"navigation": {"known_explore": 1.0, "reach": 6.0}}, "explore")
-    assert all(j[5]["navigation"] == {"known_explore": 1.0, "reach": 6.0} for j in override)
+    assert all(j[7] == ("DA",) and j[4] == "bg-exp3" and j[9] is maps["bg-exp3 without DA"][j[8]] for j in control)
+    assert all(j[5] == {} for j in jobs)  # a test is the declared animat: no [bg] change of its own
 
 
 def test_bg_choice_runs_the_papers_control_of_ten_tests_without_ep2():
     from swarm.experiments.girard2005.bg import test_jobs
 
-    jobs = test_jobs("bg-choice", 15, 0, {"bg-exp2": [{}]})
+    jobs = test_jobs("bg-choice", 15, 0, {"bg-exp2 without Ep2": [{}]})
     control = [j for j in jobs if j[1] == "no Ep2"]
     assert len(jobs) == 3 * 15 + 10 and len(control) == 10  # the paper's ten
     assert all(j[7] == ("Ep2",) and j[5]["w_plan"] == 0.65 for j in control)
-    assert len([j for j in test_jobs("bg-choice", 3, 0, {"bg-exp2": [{}]}) if j[1] == "no Ep2"]) == 3
+    assert len([j for j in test_jobs("bg-choice", 3, 0, {"bg-exp2 without Ep2": [{}]}) if j[1] == "no Ep2"]) == 3
+    assert all(j[4] == "bg-exp2" for j in jobs)  # the floor the map set was made on
 
 
 def test_a_control_table_counts_each_choice_and_the_time_to_reload():
@@ -713,15 +761,15 @@ def test_a_choice_table_says_how_many_of_neither_died():
 
 
 def test_an_exploring_mapping_run_maps_half_an_hour_and_knows_both_ep_where_they_are():
-    """bg-fear's mapping (MAPPING_MODES["explore"]): W_plan 0, at least 30 min.  At this seed the hungry
-    mapping animat knows only Ep2 (docs/bg.md, Maps for experiments 2 and 3); the exploring one knows both, on
-    nodes within 1.5 m of each (positions by odometry from the start)."""
+    """Every experiment's mapping (MAPPING_MODES["explore"]): W_plan 0, at least 30 min, then until the
+    animat's own map holds every kind of resource on the floor.  The exploring animat knows both Ep, on nodes
+    within 1.5 m of each (positions by odometry from the start)."""
     from swarm.experiments.girard2005.bg import MAPPING, build_map
     from swarm.scenario import load_scenario
 
-    assert MAPPING["bg-fear"] == "explore" and MAPPING["bg-choice"] == "hungry"
-    data = build_map("bg-exp3", 1, (), None, "explore")
-    assert data["mapped_seconds"] >= 1800.0 and {"Ep1", "Ep2", "DA", "E"} <= set(data["visited"])
+    assert MAPPING == "explore"
+    data = build_map("bg-exp3", 1, ())
+    assert data["mapped_seconds"] >= 1800.0 and all(max(data["assoc"][r]) > 0.5 for r in ("Ep", "E", "DA"))
     s = load_scenario("bg-exp3")
     places = np.array([n["position"] for n in data["map"]["nodes"]]) + np.array(s.groups[0].starts[0][:2])
     held = np.array(data["assoc"]["Ep"])
@@ -729,6 +777,26 @@ def test_an_exploring_mapping_run_maps_half_an_hour_and_knows_both_ep_where_they
         centre = next(o.centre for o in s.obstacles if o.name == name)
         near = np.hypot(*(places - np.array(centre)).T) < 1.5
         assert near.any() and held[near].max() > 0.5, name
+
+
+def test_a_bg_experiment_runs_on_a_floor_given_as_a_file_and_says_what_a_floor_lacks(tmp_path):
+    """--scenario FILE: a T-maze of the user's (here tmaze-2's floor under another name) runs as the bundled
+    ones do, labelled by its name; a floor without the resources an experiment names is one clear line."""
+    from swarm.experiments.girard2005.bg import run_bg_experiment
+    from swarm.scenario import BUNDLED_DIR as BUNDLED
+
+    floor = tmp_path / "my-tmaze.toml"
+    floor.write_text((BUNDLED / "tmaze-2.toml").read_text().replace('name = "tmaze-2"', 'name = "my-tmaze"'))
+    result = run_bg_experiment("bg-tmaze", str(floor), 2, 2, 0, tmp_path / "out", maps=1, progress=False)
+    assert result["runs"] == 2
+    with open(tmp_path / "out" / "runs.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert {r["condition"] for r in rows} == {"my-tmaze"} and all(r["branch"] in ("left", "right", "") for r in rows)
+    lacking = tmp_path / "no-ep2.toml"
+    lacking.write_text(floor.read_text().replace('name = "Ep2"', 'name = "Ep3"'))
+    with pytest.raises(ScenarioError, match="bg-tmaze needs Ep2") as e:
+        run_bg_experiment("bg-tmaze", str(lacking), 2, 1, 0, None, maps=1, progress=False)
+    assert "\n" not in str(e.value)
 
 
 def test_bg_experiment_maps_option_is_checked():
@@ -752,15 +820,15 @@ def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     from swarm.experiments.girard2005.options import bg_setting as _bg_setting
     from swarm.experiments.girard2005.options import bg_table as _bg_table
 
-    table = _bg_table([_bg_setting("usable_threshold=0.5"), _bg_setting("navigation.anchor=0.2")])
-    assert table == {"usable_threshold": 0.5, "navigation": {"anchor": 0.2}}
+    table = _bg_table([_bg_setting("dorsal_threshold=0.8"), _bg_setting("navigation.anchor=0.2")])
+    assert table == {"dorsal_threshold": 0.8, "navigation": {"anchor": 0.2}}
     with pytest.raises(argparse.ArgumentTypeError, match="KEY=VALUE"):
         _bg_setting("anchor")
     engine = ArenaEngine(_with(load_scenario("bg-exp1"), bg={**table, "planning": False}))
     animat = engine.controllers[0]
-    assert animat.p.usable_threshold == 0.5 and animat.nav.p.anchor == 0.2 and not animat.p.planning
-    jobs = test_jobs("bg-choice", 2, 0, {"bg-exp2": [{}]}, table)  # a test's own [bg] fields kept beside them
-    assert all(job[5] == {"learn_map": True, **table, "w_plan": 0.65 if job[1] == "no Ep2" else job[1],
+    assert animat.p.dorsal_threshold == 0.8 and animat.nav.p.anchor == 0.2 and not animat.p.planning
+    jobs = test_jobs("bg-choice", 2, 0, {"bg-exp2 without Ep2": [{}]}, table)  # a test's own [bg] fields beside them
+    assert all(job[5] == {**table, "w_plan": 0.65 if job[1] == "no Ep2" else job[1],
                           "w_taxon": 0.55} for job in jobs)  # fmt: skip
     with pytest.raises(ScenarioError, match=r"--bg.*bogus"):
         run_bg_experiment("bg-survival", None, 2, 1, 0, None, progress=False, bg={"bogus": 1})

@@ -26,10 +26,7 @@ from agents.controllers.bg.places import DIRECTIONS, Navigator
 from agents.controllers.bg.saliences import Drives, saliences
 from agents.controllers.bg.senses import RESOURCES, Reflex, sense
 from swarm.core.tables import params_from_table
-from world_server.arena.face.sensors.zones import ZONE_KINDS
 
-USABLE_ZONE = {"DA": "dangerous", "Ep": "ingesting", "E": "digesting"}
-USABLE_BITS = {r: 1 << ZONE_KINDS.index(z) for r, z in USABLE_ZONE.items()}  # in the world's `zones` reading
 DORSAL_ACTS = ("ReloadE", "ReloadEp")  # channel order; world_server.arena.metabolism.ACTS codes 1, 2
 
 
@@ -102,10 +99,10 @@ class BgController:
         energy, potential = (float(levels[0]), float(levels[1])) if levels is not None else (1.0, 1.0)
         heading = float(perception["compass"])
         grey, sonar = perception["camera_grey"], np.asarray(perception["sonar"], np.float64)
-        zones = int(perception.get("zones", 0))
-        usable = {r: bool(zones & bit) for r, bit in USABLE_BITS.items()}
         self.nav.move(float(perception["odometry"][0]), heading)
         prox, seen = sense(grey, heading)
+        # A(res): mProx(res) = 1, the resource fills a whole 7-pixel window (section 3.2): the camera's, not the world's
+        usable = {r: bool(prox[k].max() == 1.0) for k, r in enumerate(RESOURCES)}
         if self.p.planning:
             if self.nav.due():
                 self.colony.adopt(self.nav.observe(grey, sonar, heading))
@@ -123,9 +120,7 @@ class BgController:
                                                  self.p.w_plan if self.p.planning else 0.0, self.p.w_taxon)  # fmt: skip
         self.bg.run(s_dorsal, s_ventral, self.dt)
         d, v = self.bg.disinhibition()
-        works = (self.p.usable_threshold if usable["E"] else self.p.dorsal_threshold,  # DORSAL_ACTS' zones
-                 self.p.usable_threshold if usable["Ep"] else self.p.dorsal_threshold)  # fmt: skip
-        chosen = select_dorsal(d, works, self.acting)
+        chosen = select_dorsal(d, self.p.dorsal_threshold, self.acting)
         self.acting = chosen
         direction, strength = select_ventral(v, self.p.ventral_threshold)
         reflex = self.reflex(sonar, self.dt) if chosen < 0 else None

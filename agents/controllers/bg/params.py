@@ -42,13 +42,6 @@ class BgParams:
         "0.5) the 0.6 mProx(E) m(E) term of eq. 15 starts ReloadE far from E and "
         "most animats die so (docs/bg.md, Selection)",
     )
-    # ... and where it works (A(res)); lower, an act nearly selected there starts
-    usable_threshold: float = declared(
-        0.9,
-        source=OURS,
-        reason="the dorsal threshold, kept where the act's zone "
-        "is usable; a scenario may lower it (docs/bg.md, Selection)",
-    )
     # ... a direction channel needs to join the vector sum (EP/SNr below 1.6 x rest)
     ventral_threshold: float = declared(
         -0.6,
@@ -200,11 +193,11 @@ class NavParams:
         "(Filliat's maps are dense; a uniform corridor stays a chain of nodes)",
     )
     closure_radius: float = declared(
-        2.0,
+        1.0,
         source=OURS,
-        reason="m: a loop closes only onto a node this near by "
-        "odometry, so alike places elsewhere do not fold the map; bg-exp1's two mirrored "
-        "rooms close loops through the wall at 2 m, so it sets 1 m (docs/bg.md)",
+        reason="m: a loop closes only onto a node this near by odometry, so alike places elsewhere "
+        "do not fold the map; one node's extent (`extent`): farther, it is another place, and a "
+        "closure 2 m off joins rooms that mirror each other through a 0.1 m wall (docs/bg.md, Navigation)",
     )
     merge_match: float = declared(
         0.6,
@@ -249,8 +242,8 @@ class NavParams:
     anchor: float = declared(
         0.0,
         source=OURS,
-        reason="share of the way odometry is pulled to a recognized node; off "
-        "by default, bg-exp1 sets 0.2 against the compass-turned odometry's drift (docs/bg.md)",
+        reason="share of the way odometry is pulled to a recognized node: off, since a view matched "
+        "to another place would pull the frame there (docs/bg.md, Alternatives considered)",
     )
     lookahead: float = declared(
         1.0,
@@ -258,11 +251,11 @@ class NavParams:
         reason="m of route whose direction P points along: the route's first metre (docs/bg.md, Navigation)",
     )
     pursuit: float = declared(
-        0.0,
+        0.5,
         source=OURS,
-        reason="when > 0, m: P points at the first route node this far from "
-        "the last observation (no corner cut through a wall's end); off by default "
-        "(docs/bg.md)",
+        reason="m: P points at the first node of the route this far from the last observation, "
+        "the next place on the way, not along the route's first metre, which cuts through a wall's "
+        "end round a corner (0: the first metre; docs/bg.md, Navigation)",
     )
     width: float = declared(
         4.0,
@@ -302,15 +295,19 @@ class NavParams:
     known_explore: float = declared(
         1.0,
         source=OURS,
-        reason="Expl's height where the map knows its direction: 1, "
-        "Expl is 1 wherever it points; 0, only at unmapped areas (bg-fear's tests; "
-        "docs/bg.md, Expl)",
+        reason="Expl's height where the map knows its direction: a full bump wherever it points.  "
+        "The paper's Expl points 'to explore unmapped areas' (section 2.1), but our novelty (no node "
+        "within 2 m that way) is local: scaled by it (0), exploration dies out in corridors before "
+        "the floor is mapped (on development seeds, 2 h mapping runs on bg-exp3 met 1-2 of its 4 "
+        "resources, against all 4 in 30 min at 1; docs/bg.md, Expl)",
     )
     ways: str = declared(
-        "best",
+        "places",
         source=OURS,
-        reason="P(res) as one bump along the best route; 'places', one "
-        "towards each place holding res, which bg-exp3 sets (docs/bg.md, Navigation)",
+        reason="P(res) as a bump towards each place holding res (the largest where they overlap): "
+        "the paper's P gives 'the proximity of that resource in 36 directions' (section 2.1), so "
+        "two places of a resource pull two ways; 'best', one bump along the best route only "
+        "(docs/bg.md, Navigation)",
     )
     place_radius: float = declared(
         2.0,

@@ -3,15 +3,17 @@ choices between resources, alone and as a colony sharing one map."""
 
 from swarm.core.registry import ExperimentSpec, Option, PaperSpec
 
-_FLOOR = Option("--scenario", "the floor (default: the experiment's)")
+_FLOOR = Option("--scenario", "the floor: a bundled name or a TOML file with the resources the experiment names "
+                "(Ep1, Ep2, DA; a T-maze's stem walls below_left, below_right) (default: the experiment's)",
+                metavar="FILE")  # fmt: skip
 _MAPS = Option("--maps", "mapping runs per scenario; test k loads map k mod N (default: one per test; 1: one map for "
                "every test)", type="swarm.core.tables:positive", metavar="N")  # fmt: skip
 _MAPPING = Option("--mapping", "how the mapping animat maps: hungry, planning back to what it found, or exploring "
-                  "without planning for at least 30 min (default: explore for bg-fear, hungry for the others; "
-                  "docs/bg.md)", choices=("hungry", "explore"))  # fmt: skip
+                  "without planning for at least 30 min (default: explore; docs/bg.md)",
+                  choices=("hungry", "explore"))  # fmt: skip
 _OPTIONS = "swarm.experiments.girard2005.options"
 _BG = Option("--bg", "change a [bg] setting in every run, mapping runs included (repeatable; e.g. "
-             "usable_threshold=0.5, navigation.pursuit=0.5: docs/bg.md)", type=f"{_OPTIONS}:bg_setting",
+             "dorsal_threshold=0.8, navigation.pursuit=0: docs/bg.md)", type=f"{_OPTIONS}:bg_setting",
              metavar="KEY=VALUE", repeat=True, collect=f"{_OPTIONS}:bg_table")  # fmt: skip
 _RATIOS = Option("--ratios", "right / left branch length ratios to run (default 1,1.5,2: tmaze-R scenarios)",
                  type=f"{_OPTIONS}:ratios", metavar="R,R,...")  # fmt: skip

@@ -12,18 +12,21 @@ the experiments of Girard et al. (2005) with the bg animat.
   forget it (the time to reload at Ep1 less the most direct path's).
 - bg-fear (exp. 3.1, Table 3): F = 0.2 and Ep 0.1 or 0.5; Ep1 behind the
   dangerous area or the far Ep2; Fisher's exact test; and the paper's
-  control, the same tests without the dangerous area (where "the animat
-  systematically chooses the closest resource").
+  control, the dangerous area absent (where "the animat systematically
+  chooses the closest resource").
 - bg-tmaze (exp. 3.2, Table 4): the T-maze with branch ratios 1, 1.5, 2;
   which branch the animat enters first.
 
 Experiments 2 and 3 give the animat "a previously built map": a mapping run
-(the animat lives up to `MAPPING_SECONDS` there, hungry, so it meets the
-resources; for bg-fear exploring, not planning: `MAPPING`), saved, and
-loaded by a test.  By default test k of every
+(the animat explores without planning for at least half an hour, then until
+its own map holds every kind of resource on the floor, at most
+`MAPPING_SECONDS`), saved, and loaded by a test.  By default test k of every
 condition loads map k, made with seed + k: the conditions are compared on
 the same maps, and a table is not hostage to one mapping run (`maps=1` is
-one map for every test).  docs/bg.md says every choice.
+one map for every test).  Every run is the animat of
+agents/controllers/bg/params.py; an experiment changes only what the paper
+changes.  `--scenario FILE` runs an experiment on another floor that has the
+resources it names (`FLOOR_NEEDS`).  docs/bg.md says every choice.
 """
 
 from __future__ import annotations
@@ -51,32 +54,28 @@ MAPPING_LEVELS = (0.5, 0.5)  # E, Ep during mapping: needs enough to seek both r
 MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping animat must live to map
 
 
-# How a mapping animat maps, and how a test uses its map (docs/bg.md, Experiments): "hungry" lives as in
-# experiment 1, planning back to the resources it found, and a test goes on mapping from it (the map is the way
-# between resources, not the floor); "explore" does not plan (W_plan 0: the "first phase of random exploration and
-# map building" of experiment 1) and maps at least half an hour, so that its map covers the floor, and a test
-# takes that map as it is (it localizes on it and learns where resources are, but makes no node: a node made in
-# a test is a leaf whose routes lead back the way it came) and explores only where the map has a hole (Expl "to
-# explore unmapped areas": known_explore 0; on a map that covers the floor a full-height Expl is noise).
-# Experiment 3.1 needs maps that know both Ep ("the animat systematically chooses the closest resource"): on
-# bg-exp3 the hungry animat planned back to the first Ep it found and knew both on 1 map of 20, the exploring one
-# on 18.
+# How a mapping animat maps (docs/bg.md, Experiments).  The paper gives its animat "a previously built map" and
+# does not say how it was built; ours is built the way experiment 1 starts, by "random exploration and map
+# building": "explore" does not plan (W_plan 0) and maps at least half an hour, so that its map covers the floor.
+# "hungry" (a choice on the command line) lives as in experiment 1, planning back to the resources it found.
+# Either way the mapping run ends on the animat's own state (its map holds every kind of resource on the floor)
+# or after MAPPING_SECONDS, and a test is the same animat as every other run: it goes on mapping from its map.
 @dataclasses.dataclass(frozen=True)
 class MappingMode:
     changes: dict[str, Any]  # [bg] fields of the mapping run
     least_seconds: float  # the mapping run goes on at least this long
-    tests: dict[str, Any]  # [bg] fields of a test: whether it goes on mapping (learn_map), ... (--bg overrides them)
     text: str  # what the table's head says of it
 
 
 MAPPING_MODES = {
-    "hungry": MappingMode({}, 0.0, {"learn_map": True}, ").  A test goes on mapping from the map it loads"),
-    "explore": MappingMode({"w_plan": 0.0}, 1800.0, {"learn_map": False, "navigation": {"known_explore": 0.0}},
-                           ", W_plan 0: exploring, not planning, for at least 30 min).  A test takes the map as it "
-                           "is: it localizes on it and learns where resources are, but makes no node, and explores "
-                           "only where the map has a hole"),
-}  # fmt: skip
-MAPPING = {"bg-choice": "hungry", "bg-forget": "hungry", "bg-fear": "explore", "bg-tmaze": "hungry"}
+    "hungry": MappingMode({}, 0.0, ", planning back to what it found)"),
+    "explore": MappingMode({"w_plan": 0.0}, 1800.0, ", W_plan 0: exploring, not planning, for at least 30 min)"),
+}
+MAPPING = "explore"  # every experiment's mapping: one procedure for all
+# The resources an experiment names, by name, and the walls that mark the T-maze's junction (the stem's sides):
+# a floor given with --scenario must have them.
+FLOOR_NEEDS = {"bg-survival": (), "bg-choice": ("Ep1", "Ep2"), "bg-forget": ("Ep1", "Ep2"),
+               "bg-fear": ("Ep1", "Ep2", "DA"), "bg-tmaze": ("Ep1", "Ep2", "below_left", "below_right")}  # fmt: skip
 TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep by then counts as "none"
 W_PLANS = (0.65, 0.55, 0.45)
 FEAR_EP = (0.1, 0.5)
@@ -87,8 +86,9 @@ CHOICE_CONTROL_TEXT = ("ten tests in which Ep2 is not added: \"it goes directly 
                        "action\"; W_plan 0.65")  # fmt: skip
 FEAR_CONTROL = {ep: f"{ep}, no DA" for ep in FEAR_EP}
 FEAR_CONTROL_TEXT = ("\"When the Dangerous Area is absent, the animat systematically chooses the closest resource "
-                     "(Ep1)\"; here the same maps and tests with the dangerous area gone and F = 0")  # fmt: skip
-JUNCTION = (3.1, 4.3)  # T-maze: the stem's walls (x): beyond the first, the left branch; beyond the second, the right
+                     "(Ep1)\"; here the dangerous area is absent from the floor, while mapping and in the test, and "
+                     "nothing else changes (F = 0.2 still)")  # fmt: skip
+WITHOUT = " without "  # a map set's name: its floor, and " without " the resources absent while mapping
 
 
 def _with(s, bg: dict[str, Any] | None = None, metabolism: dict[str, Any] | None = None,
@@ -117,12 +117,15 @@ def _merged(table: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
 
 
 def run_survival(job: tuple) -> dict:
-    """One animat in bg-exp1 until it dies or 4 h pass: (condition, run, seed, [bg] changes[, max_ticks])."""
+    """One animat in bg-exp1 (or `floor`) until it dies or 4 h pass: (condition, run, seed, [bg] changes[,
+    max_ticks or None[, floor]])."""
     from swarm.engines.arena import ArenaEngine
 
-    condition, run, seed, changes, *cap = job
-    s = _with(load_scenario("bg-exp1"), bg=_merged(changes, {"planning": condition == "A"}), seed=seed,
-              max_ticks=cap[0] if cap else None)  # fmt: skip
+    condition, run, seed, changes, *rest = job
+    cap = rest[0] if rest else None
+    floor = rest[1] if len(rest) > 1 else SCENARIO["bg-survival"]
+    s = _with(load_scenario(floor), bg=_merged(changes, {"planning": condition == "A"}), seed=seed,
+              max_ticks=cap)  # fmt: skip
     summary = ArenaEngine(s).run()
     r = summary["robots"][0]
     return {"condition": condition, "run": run, "seed": seed, "survival_seconds": r["survival_seconds"],
@@ -133,10 +136,10 @@ def run_survival(job: tuple) -> dict:
 
 
 def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] | None = None,
-              mode: str = "hungry", seconds: float = MAPPING_SECONDS) -> dict:  # fmt: skip
-    """The mapping phase: the animat lives in `name` (as MAPPING_MODES[mode] says) until it has been at every
-    resource there and its map holds every kind (a node that learned it), or `seconds` pass; its map as
-    plain data."""
+              mode: str = MAPPING, seconds: float = MAPPING_SECONDS) -> dict:  # fmt: skip
+    """The mapping phase: the animat lives in `name` (as MAPPING_MODES[mode] says) until its own map holds every
+    kind of resource on the floor (a node that learned it), or `seconds` pass; its map as plain data, with
+    the resources it came within reach of (recorded, not used)."""
     from swarm.engines.arena import ArenaEngine
 
     s = load_scenario(name)
@@ -155,6 +158,7 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
     present = [o for o in s.obstacles if o.zone is not None and o.name not in absent]
     engine = ArenaEngine(s)
     nav, visited = engine.controllers[0].nav, set()
+    wanted = {kinds[o.zone] for o in present}
     while not engine.done():
         engine.step(1)
         xy = engine.world.pose[0, :2]
@@ -162,10 +166,9 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
         if (
             engine.world.tick % 40 == 0
             and engine.world.tick * s.control_period >= how.least_seconds
-            and len(visited) == len(present)
-            and all(len(nav.assoc[kinds[o.zone]]) and nav.assoc[kinds[o.zone]].max() > 0.5 for o in present)
+            and all(len(nav.assoc[r]) and nav.assoc[r].max() > 0.5 for r in wanted)
         ):
-            break  # been at every resource (the harness's ground truth) and the map holds every kind
+            break  # the animat's own map holds every kind of resource the floor has
     data = engine.controllers[0].map_data()
     data["mapped_seconds"] = engine.world.tick * s.control_period
     data["visited"] = sorted(visited)
@@ -183,11 +186,12 @@ def run_test(job: tuple) -> dict:
               max_ticks=int(TEST_SECONDS / s.control_period))  # fmt: skip
     engine = ArenaEngine(s)
     first_branch = None
+    left, right, bar = junction(s) if experiment == "bg-tmaze" else (0.0, 0.0, math.inf)
     while not engine.done():
         engine.step(1)
         x = float(engine.world.pose[0, 0])
-        if first_branch is None and experiment == "bg-tmaze" and float(engine.world.pose[0, 1]) > 3.1:
-            first_branch = "left" if x < JUNCTION[0] else "right" if x > JUNCTION[1] else None
+        if first_branch is None and float(engine.world.pose[0, 1]) > bar:
+            first_branch = "left" if x < left else "right" if x > right else None
     r = engine.summary()["robots"][0]
     seconds = r["ingest_tick"] * s.control_period if r["ingest_tick"] is not None else None
     return {"experiment": experiment, "condition": label, "run": run, "seed": seed, "map": map_index,
@@ -278,14 +282,14 @@ def _control_summary(rows: list[dict], conditions: list[str], header: str, paper
 
 
 def _fear_effect(rows: list[dict]) -> str:
-    """Ep1 with the dangerous area against without it, per level of Ep, on the same maps and seeds: what fear
+    """Ep1 with the dangerous area against without it, per level of Ep, with the same seeds: what fear
     takes away (the paper: much at Ep 0.5, where its animat chose Ep1 in 2 of 20; little at 0.1, 13 of 20)."""
 
     def ep1(condition) -> int:
         return _tally([r for r in rows if r["condition"] == condition], ("Ep1", "Ep2"))[0]
 
     parts = [f"Ep {ep}: {ep1(ep)} / {ep1(control)}" for ep, control in FEAR_CONTROL.items()]
-    return ("\nWhat fear takes away: tests at Ep1 with the dangerous area / without it (the same maps and seeds): "
+    return ("\nWhat fear takes away: tests at Ep1 with the dangerous area / without it (the same seeds): "
             + "; ".join(parts) + ".  The paper's animat chose Ep1 in 13 of 20 at Ep 0.1 and 2 of 20 at 0.5, and "
             "\"systematically\" without the dangerous area.\n")  # fmt: skip
 
@@ -302,6 +306,15 @@ def _forget_summary(rows: list[dict], direct: float) -> tuple[list[dict], str]:
           f"({direct:.0f} s here: start, Ep2's reach, Ep1's reach at 0.4 m/s; the paper's was 46 s).\n")  # fmt: skip
     return [{"tests": n, "reached_ep1": len(times), "mean_s": mean, "sd_s": sd, "max_s": top, "direct_s": direct,
              "paper_mean_s": pm, "paper_sd_s": ps, "paper_max_s": px}], md  # fmt: skip
+
+
+def junction(s) -> tuple[float, float, float]:
+    """A T-maze's junction from the walls beside its stem (`below_left`, `below_right`): the animat has entered
+    the left branch once north of them (y above their tops) and west of the left one's east side; the right,
+    east of the right one's west side."""
+    walls = {w.name: w.coords for w in s.walls}
+    (_, _, x0, y0), (x1, _, _, y1) = walls["below_left"], walls["below_right"]
+    return x0, x1, max(y0, y1)
 
 
 def direct_seconds(name: str, stops: tuple[str, ...] = ("Ep2", "Ep1")) -> float:
@@ -363,20 +376,11 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
                       out: Path | None, ratios: tuple[float, ...] | None = None, maps: int | None = None,
                       progress: bool = True, bg: dict[str, Any] | None = None,
                       mapping: str | None = None) -> dict:  # fmt: skip
-    """Run one experiment; `maps` mapping runs per scenario for experiments 2 and 3 (default: one per test),
-    made as `mapping` says (MAPPING_MODES; default MAPPING[experiment]); `bg` changes the [bg] table of every
-    run (mapping runs included)."""
-    from agents.controllers.bg.controller import check_table
-
+    """Run one experiment on its floor (or `scenario`, a file with the resources FLOOR_NEEDS names); `maps`
+    mapping runs per floor for experiments 2 and 3 (default: one per test), made as `mapping` says
+    (MAPPING_MODES; default MAPPING); `bg` changes the [bg] table of every run (mapping runs included)."""
     changes = dict(bg or {})
-    try:
-        base = load_scenario("tmaze-1" if experiment == "bg-tmaze" else SCENARIO[experiment])
-        check_table(_merged(base.controller_params.get("bg", {}), changes))
-    except ValueError as e:
-        raise ScenarioError("command line", "--bg", str(e)) from None
-    expected = SCENARIO[experiment]
-    if scenario not in (None, expected) and not (experiment == "bg-tmaze" and scenario.startswith("tmaze")):
-        raise ScenarioError("command line", "--scenario", f"{experiment} runs on {expected} (the paper's)")
+    floors = check_floors(experiment, scenario, ratios, changes)
     reps = REPS[experiment] if reps is None else reps
     if reps < 2:
         raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
@@ -387,24 +391,24 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
         raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
     if experiment == "bg-survival" and mapping is not None:
         raise ScenarioError("command line", "--mapping", "bg-survival has no mapping phase (A maps as it lives)")
-    mapping = MAPPING.get(experiment, "hungry") if mapping is None else mapping
+    mapping = MAPPING if mapping is None else mapping
     if mapping not in MAPPING_MODES:
         raise ScenarioError("command line", "--mapping", f"one of {', '.join(MAPPING_MODES)}, not {mapping!r}")
     out = Outputs(out, experiment)
     if experiment == "bg-survival":
-        work = [(c, k, seed + k, changes) for c in ("A", "B") for k in range(reps)]
+        work = [(c, k, seed + k, changes, None, floors[0]) for c in ("A", "B") for k in range(reps)]
         rows = batch_run(run_survival, work, jobs=jobs, desc=experiment, progress=progress)
         rows.sort(key=lambda r: (r["condition"], r["run"]))
         out.runs(rows, list(rows[0]))
         summary, md = _survival_summary(rows)
         title = (
             f"# Experiment 1 (Girard et al. 2005): survival with and without the map\n\n{reps} runs per "
-            f"condition, at most 4 h; seed {seed}.\n\n"
+            f"condition on {floors[0]}, at most 4 h; seed {seed}.\n\n"
         )
     else:
-        made = _maps(experiment, maps, seed, ratios, jobs, progress, changes, mapping)
+        made = _maps(experiment, maps, seed, floors, jobs, progress, changes, mapping)
         (out / "maps.json").write_text(json.dumps(made))
-        work = test_jobs(experiment, reps, seed, made, changes, mapping)
+        work = test_jobs(experiment, reps, seed, made, changes)
         rows = batch_run(run_test, work, jobs=jobs, desc=experiment, progress=progress)
         rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
         out.runs(rows, list(rows[0]))
@@ -416,56 +420,105 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
     return result
 
 
-def mapped_floors(experiment: str, ratios) -> dict[str, tuple[str, ...]]:
-    """The scenarios an experiment maps, each with the resources absent while mapping."""
-    if experiment in ("bg-choice", "bg-forget"):
-        return {"bg-exp2": ("Ep2",) if experiment == "bg-choice" else ()}
+def check_floors(experiment: str, scenario: str | None, ratios, changes: dict[str, Any]) -> tuple[str, ...]:
+    """The floors an experiment runs on (its own, or `scenario`), each checked for the resources and walls it
+    names and for the [bg] changes: a ScenarioError that says what is missing."""
+    from agents.controllers.bg.controller import check_table
+
+    if scenario is not None:
+        floors: tuple[str, ...] = (scenario,)
+    elif experiment == "bg-tmaze":
+        floors = tuple(f"tmaze-{ratio:g}" for ratio in ratios or RATIOS)
+    else:
+        floors = (SCENARIO[experiment],)
+    for floor in floors:
+        s = load_scenario(floor)
+        if getattr(s, "kind", "arena") != "arena":
+            raise ScenarioError(floor, "kind", f"{experiment} runs on an arena floor")
+        names = {o.name for o in s.obstacles if o.zone is not None} | {w.name for w in s.walls}
+        missing = [n for n in FLOOR_NEEDS[experiment] if n not in names]
+        if missing:
+            example = "tmaze-1" if experiment == "bg-tmaze" else SCENARIO[experiment]
+            raise ScenarioError(floor, "resources", f"{experiment} needs {', '.join(missing)} (named [[resource]] "
+                                f"or [[wall]] tables, as swarm/scenarios/{example}.toml has them)")  # fmt: skip
+        kinds = {o.zone for o in s.obstacles if o.zone is not None}
+        if not {"ingesting", "digesting"} <= kinds:
+            raise ScenarioError(floor, "resources", "the animat needs an ingesting (Ep) and a digesting (E) resource")
+        try:
+            check_table(_merged(s.controller_params.get("bg", {}), changes))
+        except ValueError as e:
+            raise ScenarioError("command line", "--bg", str(e)) from None
+    return floors
+
+
+def mapped_floors(experiment: str, floors: tuple[str, ...]) -> dict[str, tuple[str, tuple[str, ...]]]:
+    """The map sets an experiment needs: name -> (floor, resources absent while mapping).  Experiment 2.1 maps
+    without Ep2 (it appears in the test); the control of 3.1 has its own maps, without the dangerous area."""
+    if experiment == "bg-choice":
+        return {f"{floors[0]}{WITHOUT}Ep2": (floors[0], ("Ep2",))}
     if experiment == "bg-fear":
-        return {"bg-exp3": ()}
-    return {f"tmaze-{ratio:g}": () for ratio in ratios or RATIOS}
+        return {floors[0]: (floors[0], ()), f"{floors[0]}{WITHOUT}DA": (floors[0], ("DA",))}
+    return {floor: (floor, ()) for floor in floors}
 
 
 def build_map_job(job: tuple) -> dict:
-    """(scenario, map index, seed, resources absent, [bg] changes, mapping mode[, seconds])."""
-    name, k, seed, absent, changes, mode, *seconds = job
-    return {"scenario": name, "index": k, "data": build_map(name, seed, absent, changes, mode, *seconds)}
+    """(map set, map index, seed, floor, resources absent, [bg] changes, mapping mode[, seconds])."""
+    name, k, seed, floor, absent, changes, mode, *seconds = job
+    return {"scenario": name, "index": k, "data": build_map(floor, seed, absent, changes, mode, *seconds)}
 
 
-def _maps(experiment: str, count: int, seed: int, ratios, jobs: int | None, progress: bool,
-          changes: dict[str, Any] | None = None, mode: str = "hungry") -> dict[str, list[dict]]:  # fmt: skip
-    """`count` maps per scenario, map k from a mapping run with seed + k (in parallel)."""
-    mapped = mapped_floors(experiment, ratios)
-    work = [(name, k, seed + k, absent, changes or {}, mode) for name, absent in mapped.items() for k in range(count)]
+def _maps(experiment: str, count: int, seed: int, floors: tuple[str, ...], jobs: int | None, progress: bool,
+          changes: dict[str, Any] | None = None, mode: str = MAPPING) -> dict[str, list[dict]]:  # fmt: skip
+    """`count` maps per map set, map k from a mapping run with seed + k (in parallel)."""
+    mapped = mapped_floors(experiment, floors)
+    work = [(name, k, seed + k, floor, absent, changes or {}, mode)
+            for name, (floor, absent) in mapped.items() for k in range(count)]  # fmt: skip
     rows = batch_run(build_map_job, work, jobs=jobs, desc=f"{experiment} mapping", progress=progress)
     made = {(m["scenario"], m["index"]): m["data"] for m in rows}
     return {name: [made[name, k] for k in range(count)] for name in mapped}
 
 
-def test_jobs(experiment: str, reps: int, seed: int, maps: dict[str, list[dict]],
-           changes: dict[str, Any] | None = None, mapping: str = "hungry") -> list[tuple]:  # fmt: skip
-    """The tests' jobs: test k of every condition loads map k mod len(maps) (paired across conditions).  A test's
-    [bg]: what its mapping mode gives a test (MAPPING_MODES: learn_map, known_explore), under the command line's
-    changes, under its condition's."""
-    base = _merged(MAPPING_MODES[mapping].tests, changes or {})
+def floor_of(map_set: str) -> str:
+    """The floor a map set was made on (mapped_floors' names)."""
+    return map_set.split(WITHOUT)[0]
+
+
+def test_jobs(
+    experiment: str, reps: int, seed: int, maps: dict[str, list[dict]], changes: dict[str, Any] | None = None
+) -> list[tuple]:
+    """The tests' jobs: test k of every condition loads map k mod len(maps) of its map set (paired across
+    conditions).  A test's [bg]: the command line's changes, under its condition's (what the paper varies)."""
+    base = dict(changes or {})
+    sets = list(maps)
 
     def job(label, k: int, name: str, bg: dict, metabolism: dict, absent: tuple[str, ...]) -> tuple:
         m = k % len(maps[name])
-        return (experiment, label, k, seed + k, name, _merged(base, bg), metabolism, absent, m, maps[name][m])
+        return (experiment, label, k, seed + k, floor_of(name), _merged(base, bg), metabolism, absent, m,
+                maps[name][m])  # fmt: skip
 
     if experiment == "bg-choice":
-        return [job(w, k, "bg-exp2", {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)] + [
-            job(CHOICE_CONTROL, k, "bg-exp2", {"w_plan": W_PLANS[0], "w_taxon": 0.55}, {}, ("Ep2",))
+        return [job(w, k, sets[0], {"w_plan": w, "w_taxon": 0.55}, {}, ()) for w in W_PLANS for k in range(reps)] + [
+            job(CHOICE_CONTROL, k, sets[0], {"w_plan": W_PLANS[0], "w_taxon": 0.55}, {}, ("Ep2",))
             for k in range(min(reps, CHOICE_CONTROL_TESTS))
         ]
     if experiment == "bg-forget":
-        return [job("Ep2 gone", k, "bg-exp2", {}, {}, ("Ep2",)) for k in range(reps)]
+        return [job("Ep2 gone", k, sets[0], {}, {}, ("Ep2",)) for k in range(reps)]
     if experiment == "bg-fear":
-        return [job(ep, k, "bg-exp3", {}, {"potential": ep}, ()) for ep in FEAR_EP for k in range(reps)] + [
-            job(FEAR_CONTROL[ep], k, "bg-exp3", {"fear": 0.0}, {"potential": ep}, ("DA",))
-            for ep in FEAR_EP
-            for k in range(reps)
+        return [job(ep, k, sets[0], {}, {"potential": ep}, ()) for ep in FEAR_EP for k in range(reps)] + [
+            job(FEAR_CONTROL[ep], k, sets[1], {}, {"potential": ep}, ("DA",)) for ep in FEAR_EP for k in range(reps)
         ]
-    return [job(float(name.split("-")[1]), k, name, {}, {}, ()) for name in maps for k in range(reps)]
+    return [job(tmaze_label(name), k, name, {}, {}, ()) for name in maps for k in range(reps)]
+
+
+def tmaze_label(floor: str) -> float | str:
+    """A T-maze's condition: its branch ratio for a tmaze-R floor (bundled, or a file so named), else the floor's
+    name (a file's stem)."""
+    name = Path(floor).stem if floor.endswith(".toml") else floor
+    tail = name.removeprefix("tmaze-")
+    try:
+        return float(tail) if tail != name else name
+    except ValueError:
+        return name
 
 
 def _maps_line(made: list[dict]) -> str:
@@ -485,7 +538,8 @@ def _maps_line(made: list[dict]) -> str:
 
 
 def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int, maps: dict[str, list[dict]],
-                  mapping: str = "hungry") -> tuple[list[dict], str, str]:  # fmt: skip
+                  mapping: str = MAPPING) -> tuple[list[dict], str, str]:  # fmt: skip
+    floor = floor_of(next(iter(maps)))
     held = "; ".join(f"{name}: {_maps_line(made)}" for name, made in maps.items())
     n = len(next(iter(maps.values())))
     head = (
@@ -498,28 +552,29 @@ def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int, maps:
             else f"test k of every condition on the map of mapping run k mod {n} (seed + k mod {n})"
         )
         + f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full "
-        f"E lasting 4 h, the saliences of exp. 1) until it has been at every resource and its map holds every kind, "
-        f'or {MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}"{MAPPING_MODES[mapping].text}.\n\n'
+        f"E lasting 4 h, the saliences of exp. 1) until its own map holds every kind of resource on the floor, or "
+        f'{MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}"{MAPPING_MODES[mapping].text}.  A test is the same '
+        f"animat: it goes on mapping from the map it loads.\n\n"
     )
     if experiment == "bg-choice":
         summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
         control, md_control = _control_summary(
-            rows, [CHOICE_CONTROL], "test", CHOICE_CONTROL_TEXT, direct_seconds("bg-exp2", ("Ep1",))
+            rows, [CHOICE_CONTROL], "test", CHOICE_CONTROL_TEXT, direct_seconds(floor, ("Ep1",))
         )
         summary, md = summary + control, md + md_control
         title = "# Experiment 2.1 (Girard et al. 2005): a new resource, planning against taxon\n\n" + head
     elif experiment == "bg-forget":
-        summary, md = _forget_summary(rows, direct_seconds("bg-exp2"))
+        summary, md = _forget_summary(rows, direct_seconds(floor))
         title = "# Experiment 2.2 (Girard et al. 2005): forgetting an exhausted resource\n\n" + head
     elif experiment == "bg-fear":
         summary, md = _choice_summary(rows, PAPER_FEAR, "Ep at start", ("Ep1", "Ep2"), fisher=True)
         control, md_control = _control_summary(
-            rows, list(FEAR_CONTROL.values()), "Ep at start", FEAR_CONTROL_TEXT, direct_seconds("bg-exp3", ("Ep1",))
+            rows, list(FEAR_CONTROL.values()), "Ep at start", FEAR_CONTROL_TEXT, direct_seconds(floor, ("Ep1",))
         )
         summary, md = summary + control, md + md_control + _fear_effect(rows)
         title = "# Experiment 3.1 (Girard et al. 2005): fear against the need for Ep (F = 0.2)\n\n" + head
     else:
-        paper = {r: PAPER_TMAZE[r] for r in sorted({row["condition"] for row in rows})}
+        paper = {r: PAPER_TMAZE.get(r, ("-", "-")) for r in sorted({row["condition"] for row in rows}, key=str)}
         summary, md = _choice_summary(rows, paper, "ratio", ("left", "right"), field="branch")
         title = "# Experiment 3.2 (Girard et al. 2005): the T-maze, first branch entered\n\n" + head
     return summary, md, title

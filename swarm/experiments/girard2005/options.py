@@ -27,7 +27,7 @@ def bg_setting(text: str) -> tuple[str, object]:
     except tomllib.TOMLDecodeError:
         parsed = None
     if parsed is None or isinstance(parsed, (dict, list)):
-        raise argparse.ArgumentTypeError(f"expected KEY=VALUE (e.g. usable_threshold=0.5, navigation.anchor=0.2), "
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE (e.g. dorsal_threshold=0.8, navigation.anchor=0.2), "
                                          f"got {text}")  # fmt: skip
     return key.strip(), parsed
 

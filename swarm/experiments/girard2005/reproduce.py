@@ -49,19 +49,15 @@ DESIGN = (
 KNOWN_DIFFERENCES = (
     "Every dimension of the floors is ours (the paper's figures are not available); so is every parameter the "
     "paper leaves open (docs/bg.md, Parameters).",
-    "bg-exp1.toml (experiment 1) puts Ep in a niche with a 1.6 m door, because our B lived 1.4-1.7 times the "
-    "paper's B with Ep in the open; not in the paper.",
-    "bg-exp1.toml sets [bg] usable_threshold = 0.5 (default 0.9) for this floor only.",
-    "bg-exp1.toml sets [bg.navigation] closure_radius = 1.0 and pursuit = 0.5 (defaults: off) for this floor only.",
-    'bg-exp3.toml (experiment 3.1) sets [bg.navigation] ways = "places" and reach = 8.0 (defaults "best", 15 m), '
-    "chosen so that eq. 1's plan ratio falls where the need decides.",
-    "bg-fear's maps are made exploring (W_plan 0, at least 30 min), and its tests alone set known_explore = 0 and "
-    "learn_map = false; the other experiments map hungry and go on mapping in their tests.",
-    "The 3.1 control (the paper's words only) removes the dangerous area and also sets F = 0.",
-    "Mapping runs start at E = Ep = 0.5 with E lasting 4 h, danger costing nothing and the saliences of "
-    "experiment 1, and stop on the world's record that every resource was visited (an oracle) or after 2 h.",
-    "Oracle input: A(res) and the Hebbian learning of which node holds a resource read the world's zone bits, "
-    "not mProx(res) = 1 from the camera as the paper defines A.",
+    "Every experiment runs one declared parameter set (agents/controllers/bg/params.py); an experiment changes "
+    "only what the paper varies (the saliences' variant, W_plan, F's condition, the start levels of E and Ep).",
+    'How the paper\'s "previously built map" was made is not said: ours comes from a mapping run that explores '
+    "without planning (W_plan 0) for at least 30 min, then until the animat's own map holds every kind of "
+    "resource on the floor, at most 2 h; it starts at E = Ep = 0.5, with E lasting 4 h and danger costing "
+    "nothing, so that the mapping animat lives to map.",
+    "The 3.1 control (the paper's words only): the dangerous area is absent from the floor, in the mapping run "
+    "and in the test; F stays 0.2.  Its maps are made from the same seeds as the maps with the danger, so a "
+    "control test is paired with a test by seed, not by map.",
     "A dorsal selection sets the wheels to zero directly; eq. 10's trans-subthalamic pathway is not what stops "
     "the animat.",
     "The ventral read-out counts a channel released up to 1.6 times its resting output (a threshold of ours), "
@@ -83,9 +79,9 @@ def plan(reps: dict[str, int], quick: bool) -> list[tuple]:
             for c in ("A", "B") for k, seed in enumerate(P.seeds(reps["bg-survival"], confirm=True))]  # fmt: skip
     seconds = QUICK_SECONDS if quick else bg.MAPPING_SECONDS
     for experiment in ("bg-choice", "bg-forget", "bg-fear", "bg-tmaze"):
-        for name, absent in bg.mapped_floors(experiment, None).items():
+        for name, (floor, absent) in bg.mapped_floors(experiment, bg.check_floors(experiment, None, None, {})).items():
             map_seeds = P.seeds(reps[experiment], confirm=True, offset=MAP_SEED_OFFSET)
-            jobs += [("map", experiment, (name, k, seed, absent, {}, bg.MAPPING[experiment], seconds))
+            jobs += [("map", experiment, (name, k, seed, floor, absent, {}, bg.MAPPING, seconds))
                      for k, seed in enumerate(map_seeds)]  # fmt: skip
     work = {"A": 10.0, "B": 3.0, "bg-forget": 3.0, "bg-fear": 2.0}
     return sorted(jobs, key=lambda j: work.get(j[2][0] if j[0] == "survival" else j[1], 1.0), reverse=True)
@@ -110,8 +106,7 @@ def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = N
         made: dict[str, list[dict]] = {}
         for m in (m for m in maps if m["experiment"] == experiment):
             made.setdefault(m["scenario"], []).append(m["data"])
-        tests += bg.test_jobs(experiment, reps[experiment], P.CONFIRMATION_SEEDS.start, made, {},
-                              bg.MAPPING[experiment])  # fmt: skip
+        tests += bg.test_jobs(experiment, reps[experiment], P.CONFIRMATION_SEEDS.start, made)
     rows = batch_run(bg.run_test, tests, jobs=jobs, desc="girard2005 tests", progress=progress)
     for r in rows:
         r["map_seed"] = P.CONFIRMATION_SEEDS.start + MAP_SEED_OFFSET + r["map"]
@@ -298,16 +293,17 @@ def _fear(rows: list[dict]):
         P.Claim("exp. 3.1: the same, paired on the maps and seeds (McNemar on Ep1, 'neither' not Ep1)",
                 "13/20 vs 2/20", f"{s1}/{len(ep1[strong])} vs {m1}/{len(ep1[moderate])}",
                 S.mcnemar(ep1[strong], ep1[moderate])),
-        P.Claim("exp. 3.1: at Ep 0.5 the dangerous area turns the animat from the closest Ep1 (without it and "
-                "F = 0 against with it, the same maps)", "\"systematically\" Ep1 vs 2/20",
+        P.Claim("exp. 3.1: at Ep 0.5 the dangerous area turns the animat from the closest Ep1 (without it "
+                "against with it, paired by seed)", "\"systematically\" Ep1 vs 2/20",
                 f"{int(ep1[control].sum())}/{len(ep1[control])} vs {m1}/{len(ep1[moderate])}",
                 S.mcnemar(ep1[control], ep1[moderate])),
     ]  # fmt: skip
     table = R.markdown_table(["Ep at start (F = 0.2)", "tests (paper)", "Ep1", "Ep2", "neither", "ours: Ep1 share",
                               "paper: Ep1 : Ep2", "ours vs paper: Fisher p on (Ep1, Ep2)"], lines)  # fmt: skip
     note = (
-        '\nThe "no DA" rows are the paper\'s control, given in words only: the same maps and tests without the '
-        "dangerous area (and F = 0).  Died: E ran out before any reload (the dangerous area drains E).\n"
+        '\nThe "no DA" rows are the paper\'s control, given in words only: the dangerous area absent from the '
+        "floor while mapping and in the test, F = 0.2 still, the same seeds.  Died: E ran out before any reload "
+        "(the dangerous area drains E).\n"
     )
     return "Experiment 3.1: fear against the need for Ep (Table 3)", table + note, claims
 
