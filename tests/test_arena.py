@@ -381,3 +381,39 @@ def test_route_is_the_path_record_shows_and_costs_no_record(controller, ref, has
         np.testing.assert_array_equal(path, brain.record()["path"])
     else:
         assert path is None and "path" not in brain.record()
+
+
+def test_odometry_and_compass_biases_are_drawn_once_per_robot_and_run_and_add_up():
+    """A bias (`[robot.odometry] bias`, `[robot.compass] bias`) stays the same every tick of a run and
+    differs between robots and seeds, so the odometric path drifts; the fresh per-tick error averages out.
+    Without a bias the readings are as they were."""
+    from types import SimpleNamespace
+
+    from world_server.arena.face.robots import ANIMAT
+    from world_server.arena.face.sensors.compass import Compass
+    from world_server.arena.face.sensors.odometry import Odometry
+    from world_server.arena.sensors import Noise, Suite
+
+    def mean_readings(model, seed: int, ticks: int = 400) -> tuple[np.ndarray, np.ndarray]:
+        suite = Suite(model, np.arange(3), Noise(), seed)
+        state = SimpleNamespace(motion=np.tile([0.1, 0.02], (3, 1)), pose=np.zeros((3, 3)))
+        odo = np.mean([Odometry.read(model.sensors.odometry, suite.reading(t, state))["odometry"]
+                       for t in range(ticks)], axis=0)  # fmt: skip
+        heading = np.mean(
+            [
+                (Compass.read(model.sensors.compass, suite.reading(t, state))["compass"] + np.pi) % (2 * np.pi) - np.pi
+                for t in range(ticks)
+            ],
+            axis=0,
+        )  # fmt: skip (true heading 0)
+        return odo / [0.1, 0.02] - 1.0, heading
+
+    plain_odo, plain_heading = mean_readings(ANIMAT, 1)
+    assert np.abs(plain_odo).max() < 0.01 and np.abs(plain_heading).max() < 0.02  # errors within 5% and 10 deg
+    biased = ANIMAT.with_sensors(odometry=Odometry(bias=0.05), compass=Compass(bias=0.1))
+    odo, heading = mean_readings(biased, 1)
+    assert np.abs(odo).max() > 0.01 and np.abs(odo).max() <= 0.05 + 0.01  # a constant scale error per robot
+    assert np.abs(heading).max() > 0.02 and np.abs(heading).max() <= 0.1 + 0.02
+    assert len({round(float(x), 6) for x in odo[:, 0]}) == 3  # each robot its own bias
+    other, _ = mean_readings(biased, 2)
+    assert not np.allclose(other, odo)  # ... and each seed

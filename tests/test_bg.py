@@ -6,6 +6,7 @@ import csv
 import dataclasses
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -848,3 +849,33 @@ def test_swarm_run_prints_the_animats_metabolism_and_map():
                          text=True, timeout=300)  # fmt: skip
     assert out.returncode == 0, out.stderr
     assert "alive: E 0.99" in out.stdout and "map:" in out.stdout and "Traceback" not in out.stderr
+
+
+def test_the_ablation_switches_change_the_animat_and_bad_ones_are_one_clear_line():
+    """[bg] feedback = "literal" (eqs. 15-20 as printed), hold_wheels = false (the loops alone stop the
+    animat), [bg.gpr] cross and dopamine (eq. 10's weight, lambda): each reaches the GPR or the wheels, and
+    the declared animat is the default of each."""
+    from agents.controllers.bg.controller import bg_params, check_table
+
+    base = controller_params(load_scenario("bg-exp1"), 0)
+    animat = BgController()
+    animat.reset(0, 0, base)
+    assert animat.bg.cross == 0.4 and animat.bg.dopamine == 0.2 and animat.p.hold_wheels
+    assert np.isfinite(animat.bg.ctx_rest_d).all() and (animat.bg.ctx_rest_d > 0.5).all()  # from rest
+    ablated = BgController()
+    ablated.reset(0, 0, {**base, "bg": {**base["bg"], "feedback": "literal", "hold_wheels": False,
+                                        "gpr": {"cross": 0.0, "dopamine": 0.4}}})  # fmt: skip
+    assert ablated.bg.cross == 0.0 and ablated.bg.dopamine == 0.4 and not ablated.p.hold_wheels
+    assert (ablated.bg.ctx_rest_d == 0.0).all()  # the cortex's whole output fed back
+    # literally, a salience of 0.1 selects an act outright (why the feedback counts from rest)
+    ablated.bg.run(np.array([0.1, 0.0]), np.zeros(36), 2.0)
+    assert ablated.bg.disinhibition()[0][0] > 0.9
+    animat.bg.run(np.array([0.1, 0.0]), np.zeros(36), 2.0)
+    assert animat.bg.disinhibition()[0].max() < 0.0
+    for bad, words in [({"feedback": "echo"}, "bg.feedback"), ({"hold_wheels": 1}, "hold_wheels"),
+                       ({"gpr": {"tau": 0.04}}, "[bg.gpr]: 'tau' cannot change per run"),
+                       ({"gpr": {"cross": "x"}}, "cross")]:  # fmt: skip
+        with pytest.raises(ValueError, match=re.escape(words)) as e:
+            check_table(bad)
+        assert "\n" not in str(e.value)
+    assert bg_params({}).feedback == "rest"

@@ -4,6 +4,7 @@ one line that names the file and the field, and a parameter dataclass filled fro
 from __future__ import annotations
 
 import argparse
+import numbers
 from dataclasses import fields
 from typing import Any
 
@@ -24,6 +25,8 @@ def params_from_table(cls, table: dict[str, Any] | None, section: str, ints=(), 
     for k, v in table.items():
         if k not in texts and isinstance(v, bool):  # float(True) is 1.0: a switch given for a number is a slip
             raise ValueError(f"[{section}] {k}: expected a number, got {str(v).lower()}")
+        if k not in texts and not isinstance(v, numbers.Real):  # "x", a list, a table: no number at all
+            raise ValueError(f"[{section}] {k}: expected a number, got {v!r}")
     return cls(**{k: (v if k in texts else int(v) if k in ints else float(v)) for k, v in table.items()})
 
 

@@ -24,6 +24,7 @@ from world_server.arena.raycast import MARK, SOLID
 
 NOISE_LEVELS = ("none", "low", "high")
 LEVEL_SCALE = {"none": 0.0, "low": 1.0, "high": 2.0}  # on every sensor's specified error
+PER_RUN = -1  # the tick that keys a run's per-robot draws (a sensor's bias): ticks count from 0
 
 
 @dataclass(frozen=True)
@@ -81,7 +82,8 @@ class Suite:
     def reading(self, tick: int, state=None) -> Reading:
         """What the sensors read at this tick, before the rays' results: the robots, the noise, the draws."""
         return Reading(self.robots, tick, self.noise, partial(self._uniform, tick=tick),
-                       partial(self._normal, tick=tick), state)  # fmt: skip
+                       partial(self._normal, tick=tick), state,
+                       per_run=partial(self._uniform, tick=PER_RUN))  # fmt: skip
 
     # ------------------------------------------------------------------ rays
 

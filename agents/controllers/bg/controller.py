@@ -21,12 +21,14 @@ import numpy as np
 
 from agents.controllers.bg.colony import ColonyMap
 from agents.controllers.bg.gpr import BasalGanglia, select_dorsal, select_ventral
-from agents.controllers.bg.params import SALIENCES, WAYS, BgParams, NavParams
+from agents.controllers.bg.params import SALIENCES, WAYS, BgParams, GprParams, NavParams
 from agents.controllers.bg.places import DIRECTIONS, Navigator
 from agents.controllers.bg.saliences import Drives, saliences
 from agents.controllers.bg.senses import RESOURCES, Reflex, sense
 from swarm.core.tables import params_from_table
 
+FEEDBACK = ("rest", "literal")  # BgParams.feedback
+GPR_RUNTIME = ("cross", "dopamine")  # the [bg.gpr] fields a run may change
 DORSAL_ACTS = ("ReloadE", "ReloadEp")  # channel order; world_server.arena.metabolism.ACTS codes 1, 2
 
 
@@ -36,15 +38,30 @@ def bg_params(table: dict[str, Any] | None) -> BgParams:
     nav = table.pop("navigation", None)
     if isinstance(table.get("map"), dict):
         table.pop("map")  # a map given as data (experiments): read by the controller
-    p = params_from_table(BgParams, table, "bg", texts=("saliences", "map", "planning", "learn_map", "share"))
-    for name in ("planning", "learn_map", "share"):
+    gpr = table.pop("gpr", None)
+    p = params_from_table(BgParams, table, "bg", texts=("saliences", "map", "planning", "learn_map", "share",
+                                                        "feedback", "hold_wheels"))  # fmt: skip
+    for name in ("planning", "learn_map", "share", "hold_wheels"):
         if not isinstance(getattr(p, name), bool):
             raise ValueError(f"[bg]: {name} expected true or false, got {getattr(p, name)!r}")
     if p.saliences not in SALIENCES:
         raise ValueError(f"bg.saliences: expected one of {', '.join(SALIENCES)}, got {p.saliences!r}")
+    if p.feedback not in FEEDBACK:
+        raise ValueError(f"bg.feedback: expected one of {', '.join(FEEDBACK)}, got {p.feedback!r}")
     if nav is not None:
         nav_params(nav)
+    if gpr is not None:
+        gpr_params(gpr)
     return p
+
+
+def gpr_params(table: dict[str, Any] | None) -> GprParams:
+    """[bg.gpr]: the GPR's numbers a run may change (an ablation): eq. 10's cross weight and the dopamine
+    level lambda; the rest are written into the GPR's compiled kernel."""
+    table = dict(table or {})
+    if fixed := sorted(set(table) - set(GPR_RUNTIME)):
+        raise ValueError(f"[bg.gpr]: {fixed[0]!r} cannot change per run; only {', '.join(GPR_RUNTIME)} can")
+    return params_from_table(GprParams, table, "bg.gpr")
 
 
 def nav_params(table: dict[str, Any] | None) -> NavParams:
@@ -71,7 +88,9 @@ class BgController:
         self.max_turn = float(robot["max_turn_rate"])
         self.dt = float(params["control_period"])
         self.agent, self.tick = agent, 0
-        self.bg = BasalGanglia()
+        gpr = gpr_params(table.get("gpr"))
+        self.bg = BasalGanglia(cross=gpr.cross, dopamine=gpr.dopamine,
+                               literal_feedback=self.p.feedback == "literal")  # fmt: skip
         self.nav = Navigator(self.nav_params, seed, agent, RESOURCES, mapping=self.p.learn_map)
         # P(DA) counts only in experiment 3.1's eq. 1: elsewhere its row of the plans stays 0
         self.plan_for = tuple((k, r) for k, r in enumerate(RESOURCES) if r != "DA" or self.p.saliences == "fear")
@@ -124,14 +143,15 @@ class BgController:
         self.acting = chosen
         direction, strength = select_ventral(v, self.p.ventral_threshold)
         reflex = self.reflex(sonar, self.dt) if chosen < 0 else None
-        if chosen >= 0:
-            forward, turn, act = 0.0, 0.0, chosen + 1
+        act = chosen + 1  # 0: none
+        if chosen >= 0 and self.p.hold_wheels:
+            forward, turn = 0.0, 0.0
         elif reflex is not None:
-            forward, turn, act = reflex[0] * self.max_speed, reflex[1] * self.max_turn, 0
+            forward, turn = reflex[0] * self.max_speed, reflex[1] * self.max_turn
         elif strength > 0:
-            forward, turn, act = *self._steer(direction, heading, float(sonar[0])), 0
+            forward, turn = self._steer(direction, heading, float(sonar[0]))
         else:
-            forward, turn, act = 0.0, 0.0, 0
+            forward, turn = 0.0, 0.0
         # both wheels within their limit: the turn is kept, the forward speed gives way
         room = max(self.max_wheel - abs(turn) * self.axle / 2, 0.0)
         forward = min(max(forward, -room), room)

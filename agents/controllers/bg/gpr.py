@@ -164,10 +164,13 @@ VENTRAL = LoopSpec(channels=GPR.ventral_channels, feedback=GPR.feedback_ventral,
 
 class BasalGanglia:
     """Two GPR loops stepped together; `cross` is the trans-subthalamic weight
-    (0.4, eq. 10).  A lone loop for tests: a ventral spec of 0 channels."""
+    (0.4, eq. 10).  The cortical feedback counts from the cortex's resting level
+    (docs/bg.md); `literal_feedback` feeds back the cortex's whole output, as eqs.
+    15-20 print it (an ablation).  A lone loop for tests: a ventral spec of 0 channels."""
 
     def __init__(self, dorsal: LoopSpec = DORSAL, ventral: LoopSpec = VENTRAL, cross: float = GPR.cross,
-                 dt: float = DT, tau: float = TAU, dopamine: float = DOPAMINE):  # fmt: skip
+                 dt: float = DT, tau: float = TAU, dopamine: float = DOPAMINE,
+                 literal_feedback: bool = False):  # fmt: skip
         self.dorsal, self.ventral, self.cross = dorsal, ventral, cross
         self.h, self.dopamine, self.dt = dt / tau, dopamine, dt
         self.lat_d, self.lat_v = dorsal.lateral(), ventral.lateral()
@@ -181,6 +184,8 @@ class BasalGanglia:
         self.run(np.zeros(dorsal.channels), np.zeros(ventral.channels), 2.0)
         y_d, y_v = outputs(self.a_d), outputs(self.a_v)
         self.ctx_rest_d, self.ctx_rest_v = y_d[CTX].copy(), y_v[CTX].copy()
+        if literal_feedback:  # the cortex's whole output fed back, at rest too; disinhibition from the same rest
+            self.ctx_rest_d, self.ctx_rest_v = np.zeros(dorsal.channels), np.zeros(ventral.channels)
         self.rest_d, self.rest_v = y_d[EP].copy(), y_v[EP].copy()
         self.a_d[...], self.a_v[...] = 0.0, 0.0
 

@@ -50,6 +50,22 @@ class BgParams:
         "output, so the winner hardly drops below rest; a dorsal selection lifts "
         "them to 1.6-2.2 x rest (docs/bg.md, Selection)",
     )
+    feedback: str = declared(
+        "rest",
+        source=OURS,
+        reason="the cortical feedback of eqs. 15-20 counts from the cortex's resting level: taken "
+        "literally ('literal', an ablation), each dorsal channel gets 0.33 of salience from it at "
+        "rest, above D1's threshold, and a salience of 0.1 selects an act outright, where 0.35 is "
+        "needed from rest: the animat would reload at the faintest need (docs/bg.md, The GPR model)",
+    )
+    hold_wheels: bool = declared(
+        True,
+        source=OURS,
+        reason="a dorsal act holds the wheels: with eq. 10's cross term alone, our ventral read-out "
+        "(ventral_threshold) still releases a direction in about a third of the ticks of acts "
+        "longer than a second (bg-exp1, development seeds 1-2), which would walk the animat off "
+        "the resource mid-meal; False, an ablation (docs/bg.md, Selection)",
+    )
     too_close: float = declared(
         0.45,
         source=OURS,

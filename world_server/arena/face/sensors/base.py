@@ -39,7 +39,8 @@ class Reading:
     """What a sensor makes its readings of, for the n robots of one group at one tick.
 
     `uniform(stream, k)` and `normal(stream, k)` are the robots' (n, k) draws of a noise stream at
-    this tick (uniform in [-1, 1), standard normal).  `noise` is the run's noise
+    this tick (uniform in [-1, 1), standard normal); `per_run(stream, k)` the robots' uniform draws
+    that stay the same every tick of the run (a sensor's bias).  `noise` is the run's noise
     (world_server.arena.sensors.Noise: `factor(name)` scales a sensor's specified error).
     `state` is the world, indexed by global robot id: pose, motion, contact, zones,
     hit_colours(what).  `ranges`, `what` and `rgb` are this sensor's rays, (n, rays[, 3]): the
@@ -55,6 +56,7 @@ class Reading:
     ranges: np.ndarray | None = None
     what: np.ndarray | None = None
     rgb: np.ndarray | None = None
+    per_run: Callable[[int, int], np.ndarray] | None = None
 
 
 class Sensor:
