@@ -32,6 +32,10 @@ EXPERIMENTS = (
                    smoke=(("reps", 2), ("maps", 1))),
     ExperimentSpec("bg-tmaze", "girard2005", "the T-maze", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG, _RATIOS),
                    smoke=(("reps", 2), ("maps", 1), ("ratios", (1.0,)))),
+    ExperimentSpec("bg-ablations", "girard2005", "eq. 10's cross term, the literal feedback, the wheels, dopamine, "
+                   "biased odometry: what each does to experiments 1 and 3.2",
+                   "swarm.experiments.girard2005.ablations:run_ablations", options=(_MAPS, _RATIOS),
+                   smoke=(("reps", 2), ("maps", 1), ("ratios", (1.0,)), ("max_ticks", 200))),
     ExperimentSpec("bg-colony", "girard2005", "survival against colony size, with and without a shared map",
                    "swarm.experiments.girard2005.colony:run_colony_experiment", options=(_SIZES,),
                    smoke=(("reps", 1), ("sizes", (1, 2)), ("max_ticks", 200))),

@@ -92,9 +92,15 @@ WITHOUT = " without "  # a map set's name: its floor, and " without " the resour
 
 
 def _with(s, bg: dict[str, Any] | None = None, metabolism: dict[str, Any] | None = None,
-          seed: int | None = None, absent: tuple[str, ...] = (), max_ticks: int | None = None):  # fmt: skip
+          seed: int | None = None, absent: tuple[str, ...] = (), max_ticks: int | None = None,
+          sensors: dict[str, dict[str, float]] | None = None):  # fmt: skip
     """A scenario changed for one run: [bg] fields (and [bg.navigation] ones), metabolism fields, resources
-    taken away."""
+    taken away, and the fields of the animats' sensors (`{"odometry": {"bias": 0.05}}`)."""
+    if sensors:
+        groups = tuple(dataclasses.replace(g, robot=g.robot.with_sensors(**{
+            name: dataclasses.replace(getattr(g.robot.sensors, name), **fields) for name, fields in sensors.items()
+        })) for g in s.groups)  # fmt: skip
+        s = dataclasses.replace(s, groups=groups)
     params = dict(s.controller_params)
     params["bg"] = _merged(params.get("bg", {}), bg or {})
     obstacles = tuple(dataclasses.replace(o, appear=10**9) if o.name in absent else o for o in s.obstacles)
@@ -118,14 +124,15 @@ def _merged(table: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
 
 def run_survival(job: tuple) -> dict:
     """One animat in bg-exp1 (or `floor`) until it dies or 4 h pass: (condition, run, seed, [bg] changes[,
-    max_ticks or None[, floor]])."""
+    max_ticks or None[, floor[, sensor changes]]])."""
     from swarm.engines.arena import ArenaEngine
 
     condition, run, seed, changes, *rest = job
     cap = rest[0] if rest else None
     floor = rest[1] if len(rest) > 1 else SCENARIO["bg-survival"]
+    sensors = rest[2] if len(rest) > 2 else None
     s = _with(load_scenario(floor), bg=_merged(changes, {"planning": condition == "A"}), seed=seed,
-              max_ticks=cap)  # fmt: skip
+              max_ticks=cap, sensors=sensors)  # fmt: skip
     summary = ArenaEngine(s).run()
     r = summary["robots"][0]
     return {"condition": condition, "run": run, "seed": seed, "survival_seconds": r["survival_seconds"],
@@ -177,13 +184,13 @@ def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] 
 
 def run_test(job: tuple) -> dict:
     """One test of experiments 2 and 3 on a loaded map: (experiment, label, run, seed, scenario, bg, metabolism,
-    absent, map index, map)."""
+    absent, map index, map[, sensor changes])."""
     from swarm.engines.arena import ArenaEngine
 
-    experiment, label, run, seed, name, bg, metabolism, absent, map_index, map_data = job
+    experiment, label, run, seed, name, bg, metabolism, absent, map_index, map_data, *sensors = job
     s = load_scenario(name)
     s = _with(s, bg={**bg, "map": map_data}, metabolism=metabolism, seed=seed, absent=absent,
-              max_ticks=int(TEST_SECONDS / s.control_period))  # fmt: skip
+              max_ticks=int(TEST_SECONDS / s.control_period), sensors=sensors[0] if sensors else None)  # fmt: skip
     engine = ArenaEngine(s)
     first_branch = None
     left, right, bar = junction(s) if experiment == "bg-tmaze" else (0.0, 0.0, math.inf)

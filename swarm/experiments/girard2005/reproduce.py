@@ -58,11 +58,14 @@ KNOWN_DIFFERENCES = (
     "The 3.1 control (the paper's words only): the dangerous area is absent from the floor, in the mapping run "
     "and in the test; F stays 0.2.  Its maps are made from the same seeds as the maps with the danger, so a "
     "control test is paired with a test by seed, not by map.",
-    "A dorsal selection sets the wheels to zero directly; eq. 10's trans-subthalamic pathway is not what stops "
-    "the animat.",
+    "A dorsal selection holds the wheels (ours): with eq. 10's trans-subthalamic pathway alone, our ventral "
+    "read-out still releases a direction in about a third of the ticks of acts longer than a second.  "
+    "`swarm experiment bg-ablations` measures what the animat does without it.",
     "The ventral read-out counts a channel released up to 1.6 times its resting output (a threshold of ours), "
-    "keeps the incumbent, and counts the cortical feedback above its resting level only.",
-    "Odometry and compass errors are drawn independently each tick, unbiased (no drift bias).",
+    "keeps the incumbent, and counts the cortical feedback above its resting level only (bg-ablations: the "
+    "feedback as printed).",
+    "Odometry and compass errors are drawn independently each tick, unbiased; bg-ablations runs them biased "
+    "(drawn once per animat and run), so that the odometric position drifts.",
     'A test of experiments 2 and 3 ends at 900 s ("none" if it has not reloaded Ep); the paper\'s ran until '
     "ReloadEp.  Forgetting's direct path is ours (A* on our floor), the paper's 46 s.",
     "Experiment 3.2's first branch is where the animat first crosses the T's bar north of the stem's walls.",
