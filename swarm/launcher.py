@@ -30,7 +30,7 @@ from swarm.core.errors import RunError, raise_interrupt
 from swarm.core.registry import resolve
 from swarm.scenario import load_scenario
 from world_server import WORLD_KINDS, kind_of, progress_keys, world_kind
-from world_server.grid.scenario import PhysicsParams
+from world_server.grid.params import PhysicsParams
 
 
 def _terminate(procs: list[subprocess.Popen], grace: float = 5.0) -> None:

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from agents.controllers.dft.architecture import EBS, TRAVEL, spa_architecture
-from agents.controllers.dft.controller import DftController, DftParams
+from agents.controllers.dft.controller import DftController
 from agents.controllers.dft.fields import (
     Architecture,
     Coupling,
@@ -25,7 +25,8 @@ from agents.controllers.dft.fields import (
     gauss_1d,
     kernel_image,
 )
-from agents.controllers.dft.robot import Interface, gaussian_2d
+from agents.controllers.dft.params import DftParams, Interface
+from agents.controllers.dft.robot import gaussian_2d, heading_images, ir_image, wheel_profiles, wheel_speeds
 from swarm.core.errors import ScenarioError
 from swarm.engines.arena import ArenaEngine
 from swarm.scenario import load_scenario, parse_scenario_text
@@ -341,16 +342,16 @@ def test_release_raises_an_intention_ahead_the_robot_moves_and_satisfaction_form
 
 def test_the_e_puck_interface_follows_the_original_code():
     iface = Interface()
-    lw, rw = iface.wheel_profiles()
+    lw, rw = wheel_profiles(iface)
     assert (round(lw[49], 1), round(rw[49], 1)) == (416.5, 433.0)  # cell 50 (1-based), as parameters.md says
-    head = iface.heading_images(np.pi / 2)  # facing north: the north action field's input peaks at cell 50
+    head = heading_images(iface, np.pi / 2)  # facing north: the north action field's input peaks at cell 50
     assert int(np.argmax(head["N"])) == 49 and head["N"].max() == pytest.approx(4.0)
     assert int(np.argmax(head["E"])) > 49  # east lies to the robot's right: cells above 50
-    ir = iface.ir_image(np.array([1000.0, 0, 0, 0, 0, 0, 0, 0]))  # ps0, front right
+    ir = ir_image(iface, np.array([1000.0, 0, 0, 0, 0, 0, 0, 0]))  # ps0, front right
     assert int(np.argmax(ir)) == 54 and ir.max() == pytest.approx(5 * np.log1p(1000 / 50))
     one = {d: np.zeros(100) for d in EBS}
     one["N"][60] = 1.0  # a peak right of straight ahead turns the robot right
-    left, right = iface.wheels(one)
+    left, right = wheel_speeds(iface, one)
     assert left > right and abs(left - right) <= 400
 
 

@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 from agents.controllers.fingerprint.align import (
-    AlignParams,
     C,
     Matcher,
     N,
@@ -25,8 +24,10 @@ from agents.controllers.fingerprint.align import (
     paper_length,
     to_string,
 )
-from agents.controllers.fingerprint.features import FeatureParams, camera_features, fingerprint, laser_corners
-from agents.controllers.navigation.topomap import Link, MapParams, TopoMap
+from agents.controllers.fingerprint.features import camera_features, fingerprint, laser_corners
+from agents.controllers.fingerprint.params import AlignParams, FeatureParams
+from agents.controllers.navigation.params import MapParams
+from agents.controllers.navigation.topomap import Link, TopoMap
 from swarm.core.errors import ScenarioError
 from swarm.scenario import load_scenario
 
@@ -272,7 +273,8 @@ def test_the_grid_belief_follows_the_odometry_where_the_views_say_nothing():
     """Places a, x, b, y along a corridor; in the dark only odometry can say where the robot is.
     On the map's odometric grid the belief moves with it, node by node; over the links alone a
     node is left at a constant rate per view, wherever in the node the robot is."""
-    from agents.controllers.navigation.gridbelief import GridBelief, GridParams
+    from agents.controllers.navigation.gridbelief import GridBelief
+    from agents.controllers.navigation.params import GridParams
 
     m = corridor_map()  # a at x 0-1, x at 2-3, b at 4-5, y at 6-7 (observations every 0.5 m)
     grid = GridBelief(m, GridParams(cell=0.1))

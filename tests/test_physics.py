@@ -11,7 +11,7 @@ from swarm.scenario import load_scenario, parse_scenario_text
 from world_server import persist
 from world_server.grid.bodies import Bodies
 from world_server.grid.face.layout import A_MOVE, ACT_LEN, STAY
-from world_server.grid.scenario import PhysicsParams
+from world_server.grid.params import PhysicsParams
 from world_server.grid.world import GridWorld
 
 N, E, S, W = 0, 1, 2, 3

@@ -1,6 +1,7 @@
 """Declared parameters: every value of a model with where it comes from.
 
-A model's parameters live on its frozen dataclasses, in the model's own file, and each field is
+A model's parameters live on its frozen dataclasses, in one file per model: its `params.py`, which
+imports nothing else of the model (a controller of one module keeps them beside its code).  Each field is
 declared with `declared(default, source=..., where=..., reason=...)`, which is
 `dataclasses.field(default=default, metadata={"provenance": Provenance(...)})`: defaults,
 `asdict`, `replace`, equality and the tables' parsers (swarm.core.tables) see an ordinary field.
@@ -8,8 +9,8 @@ The source is one of three: PAPER (the paper gives that number; `where` cites th
 or section), CODE (the original authors' code gives it; `where` names the file, or the section of
 the notes we took from it) or OURS (neither does; `reason` says why this value, and declaring an
 OURS value without a reason raises at import).  Constants that compiled (numba) kernels read stay
-plain numbers: their provenance is declared on a dataclass beside them, from whose defaults the
-module constants are taken, or which only records the numbers a kernel writes as literals.
+plain numbers in their modules: their provenance is declared on a dataclass of the model's, from
+whose defaults the module constants are taken, or which only records the numbers a kernel writes as literals.
 `provenance(cls)` lists a class's fields with their values and sources, `provenance_table(cls)`
 renders them as a markdown table, and each controller's entry names its parameter classes
 (swarm.core.registry.ControllerSpec.parameters), so tests/test_params.py can hold every model to

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from world_server.grid.face.layout import A_MOVE, DIR_DC, DIR_DR, N_DIRS, STAY
-from world_server.grid.scenario import PhysicsParams
+from world_server.grid.params import PhysicsParams
 from world_server.grid.steering import waypoints
 
 _GOLDEN_ANGLE = np.pi * (3.0 - np.sqrt(5.0))

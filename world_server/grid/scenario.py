@@ -21,9 +21,9 @@ from typing import Any
 import numpy as np
 
 from swarm.core.errors import ScenarioError
-from swarm.core.params import CODE, OURS, PAPER, declared
 from swarm.core.tables import no_unknown, section_of, typed
 from world_server.grid.face.layout import CONTROLLERS
+from world_server.grid.params import AntParams, CMarkingParams, PhysicsParams
 
 CONTROLLER_NAMES = tuple(CONTROLLERS)  # the grid face's compiled controllers
 DEFAULT_CONTROLLER = "cmarking"
@@ -43,99 +43,11 @@ class Generator:
     resources: int
 
 
-@dataclass(frozen=True)
-class AntParams:
-    """The pheromone ant baseline: NetLogo's Ants model (section 5.5; docs/cmarking.md, "The ant baseline")."""
-
-    diffusion: float = declared(0.95, source=PAPER, where="section 5.5: the diffusion rate is set to 95%")
-    evaporation: float = declared(0.005, source=PAPER, where="section 5.5: the evaporation rate to 0.5%")
-    deposit: float = declared(
-        1.0,
-        source=OURS,
-        reason="the paper gives no amount; only its ratio to `threshold` "
-        "matters, so one unit per cell crossed (docs/cmarking.md, the ant baseline)",
-    )
-    threshold: float = declared(
-        0.001,
-        source=OURS,
-        reason="the paper does not give its ant model's rule; the best of 25 settings of "
-        "`swarm experiment tuning` on development seeds, the budget c-marking's climb_patience had",
-    )
-    ceiling: float = declared(
-        0.04,
-        source=OURS,
-        reason="NetLogo's window [0.05, 2) is 40 x its floor; kept at 40 x threshold",
-    )
-    wiggle: float = declared(
-        40,
-        source=CODE,
-        where="NetLogo Ants model: `rt random 40 lt random 40` each step; also the tuning's best",
-    )
-    detour: float = declared(
-        8,
-        source=OURS,
-        reason="random steps when both compass directions are walled: without "
-        "them ants freeze forever in concave pockets (Figure 11.a; docs/cmarking.md)",
-    )
-
-
-@dataclass(frozen=True)
-class CMarkingParams:
-    """The c-marking agents' open numbers and the two rules the paper leaves open (docs/cmarking.md)."""
-
-    climb_patience: int = declared(
-        20,
-        source=OURS,
-        reason="a climber circling a loop of trail cells (two parallel "
-        "trails make 2x2 loops) livelocks under the literal rules; after this many climb "
-        "steps without a higher mark it wipes and erases (docs/cmarking.md, choice 9)",
-    )
-    return_on_trail: str = declared(
-        "mend",
-        source=OURS,
-        reason="rule 5: a returner that loaded on a coloured cell mends the trail home; "
-        "the literal reading `descend` leaves gaps (the report's ablation shows both)",
-    )
-    at_base: str = declared(
-        "remember",
-        source=OURS,
-        reason="rule 6: the literal reading of 'coloured neighbours different from the previous "
-        "position' right after unloading; `forget` is the alternative (the report's ablation shows both)",
-    )
-
-
 RETURN_ON_TRAIL = ("mend", "descend")
 AT_BASE = ("remember", "forget")
 
 
 PHYSICS_MODES = ("ideal", "physical")
-
-
-@dataclass(frozen=True)
-class PhysicsParams:
-    """Robot bodies (world_server/grid/bodies.py).  Lengths in cells, times in seconds."""
-
-    mode: str = declared(
-        "ideal",
-        source=PAPER,
-        where="section 5.1: one iteration, each agent moves to a "
-        "neighbouring cell (ideal: instant cell-to-cell moves; physical: pymunk discs, ours)",
-    )
-    diameter: float = declared(
-        0.4, source=OURS, reason="body diameter in cells: two fit side by side in a corridor (docs/physics.md)"
-    )
-    speed: float = declared(2.0, source=OURS, reason="top speed, cells per second (docs/physics.md)")
-    timeout: float = declared(
-        2.0,
-        source=OURS,
-        reason="longest simulated time one tick may take: a cell is crossed in 0.5 s at top speed (docs/physics.md)",
-    )
-    dt: float = declared(0.05, source=OURS, reason="physics step, s (docs/physics.md)")
-    arrive: float = declared(
-        0.2,
-        source=OURS,
-        reason="a body has reached a cell when its centre is this close to the cell's centre (docs/physics.md)",
-    )
 
 
 @dataclass(frozen=True)

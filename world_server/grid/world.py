@@ -50,7 +50,8 @@ from world_server.grid.face.layout import (
     TRAIL_PAINT,
     new_perception,
 )
-from world_server.grid.scenario import Layout, PhysicsParams, Scenario
+from world_server.grid.params import PhysicsParams
+from world_server.grid.scenario import Layout, Scenario
 from world_server.grid.steering import waypoints
 from world_server.persist import ARRAYS as PERSISTED
 

@@ -1,7 +1,7 @@
 """`dft`: simultaneous planning and action with dynamic neural fields (Billing,
 Lowe & Sandamirskaya 2015): an architecture declared as fields and couplings
 (architecture.py), one engine that steps any such table (fields.py), and the
-e-puck's faces to it (robot.py)."""
+e-puck's faces to it (robot.py); every number with its provenance in params.py."""
 
 from swarm.core.registry import ControllerSpec
 
@@ -13,11 +13,11 @@ CONTROLLERS = ControllerSpec(
     example="zmaze",
     factory="agents.controllers.dft.controller:DftController",
     parameters=(
-        "agents.controllers.dft.controller:DftParams",
-        "agents.controllers.dft.controller:MapNoise",
-        "agents.controllers.dft.architecture:SpaParams",
-        "agents.controllers.dft.robot:Interface",
-        "agents.controllers.dft.robot:SensorLayout",
+        "agents.controllers.dft.params:DftParams",
+        "agents.controllers.dft.params:MapNoise",
+        "agents.controllers.dft.params:SpaParams",
+        "agents.controllers.dft.params:Interface",
+        "agents.controllers.dft.params:SensorLayout",
     ),
     table="agents.controllers.dft.controller:check_table",
     requires=("position", "compass", "ir"),

@@ -20,122 +20,22 @@ inhibition.
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
 
-from agents.controllers.dft.architecture import EBS, SpaParams, spa_architecture
+from agents.controllers.dft.architecture import EBS, spa_architecture
 from agents.controllers.dft.context import SensedContext
 from agents.controllers.dft.fields import Engine, fill_noise, noise_key
-from agents.controllers.dft.robot import Interface, gaussian_2d
+from agents.controllers.dft.params import DftParams, Interface, MapNoise, SpaParams
+from agents.controllers.dft.robot import gaussian_2d, heading_images, ir_image, wheel_speeds
 from agents.controllers.navigation.astar import occupancy
-from swarm.core.params import CODE, OURS, PAPER, declared
-from swarm.core.tables import params_from_table
 
 FIELD_STREAM, MAP_STREAM = 1, 2
 
 
-@dataclass(frozen=True)
-class MapNoise:
-    """Map noise, std per map cell, a wall being 1, at each noise level (MAP_NOISE is taken from it)."""
-
-    none: float = declared(
-        0.005,
-        source=CODE,
-        where="EBMap.m, initNoiseLevel.m: 0.005 in run sets tagged neither "
-        "low nor high noise (parameters.md section 7)",
-    )
-    low: float = declared(
-        0.05,
-        source=PAPER,
-        where="section 4: std = 5% of the contextual stimuli strength "
-        "(lambda); the code agrees, 0.05 (parameters.md section 7)",
-    )
-    high: float = declared(
-        1.0, source=PAPER, where="section 4: std of 100% of lambda; the code agrees, 1.0 (parameters.md section 7)"
-    )
-
-
 MAP_NOISE = asdict(MapNoise())  # {"none": 0.005, "low": 0.05, "high": 1.0}
-
-
-@dataclass(frozen=True)
-class DftParams:
-    cell: float = declared(
-        0.01,
-        source=CODE,
-        where="turnField.m: 100 x 100 fields over the 1 m Z-maze, 1 cm cells (parameters.md section 2)",
-    )
-    border: int = declared(
-        5,
-        source=CODE,
-        where=(
-            "webots/setupMap.m: wall rows and columns 1..5 and N-5..N round the field (parameters.md "
-            "section 6: 5 north and west, 6 south and east)"
-        ),
-    )
-    goal_peak: float = declared(
-        10.0,
-        source=CODE,
-        where=(
-            "turnField.m: gamma, a plain Gaussian of peak 10 on the goal cell (parameters.md section "
-            "6; the paper gives no number)"
-        ),
-    )
-    goal_sigma: float = declared(
-        3.0, source=CODE, where="turnField.m: the goal Gaussian's s = 3 cells (parameters.md section 6)"
-    )
-    position_sigma: float = declared(
-        3.0,
-        source=CODE,
-        where=(
-            "EPuckController.m: the robot position image, s = 3 (peak 1, 1.2 at high noise), into C "
-            "with gain c8 (parameters.md section 5, row 8; the paper: sigma 2)"
-        ),
-    )
-    position_every: int = declared(
-        2,
-        source=CODE,
-        where="turnFieldSupervisor.py: a pose message every 128 ms, two 64 ms steps (parameters.md sections 6, 11)",
-    )
-    wheel_unit: float = declared(
-        0.1288e-3,
-        source=OURS,
-        reason=(
-            "m/s per e-puck wheel unit: the e-puck's 1000 steps/s are 12.88 cm/s (Mondada et al. "
-            "2009); the code leaves it to Webots (docs/dft.md)"
-        ),
-    )
-    obstacles: str = declared(
-        "told",
-        source=PAPER,
-        where=(
-            "section 4 (case 3): when an obstacle was added the map was updated with it (the "
-            "supervisor wrote it into the map: parameters.md section 6)"
-        ),
-    )
-    sense_margin: float = declared(
-        0.03, source=OURS, reason="sensed (ours): a point this close to a wall of the map is the wall"
-    )
-    mark_radius: float = declared(
-        0.04,
-        source=OURS,
-        reason="sensed (ours): the disc a point marks, the robot's radius: the room it takes from one passing",
-    )
-    memory: int = declared(300, source=OURS, reason="sensed (ours): ticks a mark lasts unless seen again, about 19 s")
-    min_reading: float = declared(
-        120.0, source=OURS, reason="sensed (ours): IR readings from this up count, 5 cm from the sensor on a white wall"
-    )
-
-    @classmethod
-    def from_table(cls, table: dict[str, Any] | None) -> DftParams:
-        p = params_from_table(cls, table, "dft", ints=("border", "position_every", "memory"), texts=("obstacles",))
-        if p.obstacles not in ("told", "sensed", "unknown"):
-            raise ValueError(f"[dft]: obstacles is 'told', 'sensed' or 'unknown', not {p.obstacles!r}")
-        if p.cell <= 0 or p.position_every < 1 or p.border < 0 or p.memory < 1:
-            raise ValueError("[dft]: cell must be > 0, position_every and memory >= 1, border >= 0")
-        return p
 
 
 def check_table(table: dict[str, Any]) -> None:
@@ -221,9 +121,9 @@ class DftController:
             x, y = (float(v) for v in perception["position"])
             cj, ci = self._cell(x, y)
             e.set_input("position", gaussian_2d(self.shape, cj, ci, self.p.position_sigma, self.position_peak))
-        for d, img in self.iface.heading_images(float(perception["compass"])).items():
+        for d, img in heading_images(self.iface, float(perception["compass"])).items():
             e.set_input(f"heading_{d}", img)
-        e.set_input("ir", self.iface.ir_image(perception["ir"]))
+        e.set_input("ir", ir_image(self.iface, perception["ir"]))
         if self.sensed is not None:
             self.sensed.sense(perception["position"], float(perception["compass"]), perception["ir"], self.tick)
         e.set_input("context", self._context())
@@ -233,7 +133,7 @@ class DftController:
         e.step(noise_key(self.seed, self.agent, self.tick, FIELD_STREAM), times)
         self.tick += 1
         t0 = clock() if clock else 0.0
-        left, right = self.iface.wheels({d: e.output(f"A_{d}") for d in EBS})
+        left, right = wheel_speeds(self.iface, {d: e.output(f"A_{d}") for d in EBS})
         wheels = np.clip(np.array([left, right]) * self.p.wheel_unit, -self.max_wheel, self.max_wheel)
         self.last_wheels = wheels
         if clock:

@@ -33,23 +33,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from agents.controllers.dft import pocketfft
+from agents.controllers.dft.params import Lateral
 from swarm.core import rng_scalar
 from swarm.core.kernels import exported, njit
 from swarm.core.rng import mix64
 
 DTYPE = np.float32
 CDTYPE = np.complex64
-
-
-@dataclass(frozen=True)
-class Lateral:
-    """Interaction kernel of a field with itself (equation 2)."""
-
-    c_exc: float = 0.0
-    s_exc: float = 1.0
-    c_inh: float = 0.0
-    s_inh: float = 1.0
-    c_global: float = 0.0  # every cell gets c_global * sum of the field's output
 
 
 @dataclass(frozen=True)

@@ -26,13 +26,11 @@ in one compiled call.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
+from agents.controllers.fingerprint.params import AlignParams
 from swarm.core.kernels import exported, njit
-from swarm.core.params import OURS, declared
-from swarm.core.tables import params_from_table
 
 HUES = 16  # symbols 0..15: hue bins 'A'..'P'
 V, C, N = 16, 17, 18  # vertical edge, laser corner; N + k - 1: a run of k empty-space quanta
@@ -67,79 +65,25 @@ def from_string(text: str) -> np.ndarray:
     return np.array(out, np.int8)
 
 
-@dataclass(frozen=True)
-class AlignParams:
-    """Global alignment with uncertainty: the paper names the method ([26], after Needleman-Wunsch) without its
-    constants; ours are negative log-probabilities of what makes two views of one place differ, chosen by
-    the area under the ROC curve of same- against different-place pairs (docs/fingerprint.md, Matching).
-    """
+def cost_tables(p: AlignParams) -> tuple[np.ndarray, np.ndarray]:
+    """(substitution costs SYMBOLS x SYMBOLS, gap cost per symbol), integers of SCALE.
 
-    miss_hue: float = declared(
-        0.02, source=OURS, reason="chance that a colour patch is missed or spurious (docs/fingerprint.md, Matching)"
-    )
-    miss_edge: float = declared(
-        0.5, source=OURS, reason="chance that a vertical edge is missed or spurious (docs/fingerprint.md, Matching)"
-    )
-    miss_corner: float = declared(
-        0.5, source=OURS, reason="chance that a laser corner is missed or spurious (docs/fingerprint.md, Matching)"
-    )
-    miss_space: float = declared(
-        0.5, source=OURS, reason="chance of one empty-space quantum more or less (docs/fingerprint.md, Matching)"
-    )
-    hue_near: float = declared(
-        1.2, source=OURS, reason="cost of a hue patch read one bin off (docs/fingerprint.md, Matching)"
-    )
-    wrong: float = declared(
-        4.0,
-        source=OURS,
-        reason=(
-            "any other substitution: more than a gap of either feature, so one missing feature costs "
-            "less than one wrong one"
-        ),
-    )
-    centre: float = declared(
-        0.544,
-        source=OURS,
-        reason=(
-            "P(match) = 1 / (1 + exp((d - centre) / width)), d the cost per character of the longer "
-            "string: fitted by logistic regression on office (swarm experiment fingerprint-calibrate,"
-            " docs/fingerprint.md)"
-        ),
-    )
-    width: float = declared(
-        0.122,
-        source=OURS,
-        reason="the logistic's width, fitted with centre on office (docs/fingerprint.md, Probability)",
-    )
-
-    @classmethod
-    def from_table(cls, table: dict | None) -> AlignParams:
-        return params_from_table(cls, table, "fingerprint.align")
-
-    def tables(self) -> tuple[np.ndarray, np.ndarray]:
-        """(substitution costs SYMBOLS x SYMBOLS, gap cost per symbol), integers of SCALE.
-
-        A run of k empty quanta is one symbol: it aligns with a run of l at the
-        cost of |k - l| quanta gapped, and is gapped whole at k of them."""
-        gap = np.empty(SYMBOLS)
-        gap[:HUES] = -math.log(self.miss_hue)
-        gap[V], gap[C] = -math.log(self.miss_edge), -math.log(self.miss_corner)
-        runs = np.arange(1, MAX_RUN + 1)
-        gap[N:] = runs * -math.log(self.miss_space)
-        sub = np.full((SYMBOLS, SYMBOLS), self.wrong)
-        for a in range(HUES):
-            for b in range(HUES):
-                ring = min(abs(a - b), HUES - abs(a - b))
-                sub[a, b] = 0.0 if ring == 0 else (self.hue_near if ring == 1 else self.wrong)
-        sub[V, V] = sub[C, C] = 0.0
-        sub[N:, N:] = np.abs(runs[:, None] - runs[None, :]) * -math.log(self.miss_space)
-        sub[N:, :N] = sub[:N, N:] = 1e6  # empty space is never a feature: always two gaps
-        return np.round(sub * SCALE).astype(np.int64), np.round(gap * SCALE).astype(np.int64)
-
-    def probability(self, cost: np.ndarray | float, longer: np.ndarray | int) -> np.ndarray:
-        """P(match) from a cost (in nats) and the longer string's length in the paper's characters."""
-        d = np.asarray(cost, np.float64) / np.maximum(np.asarray(longer, np.float64), 1.0)
-        return 1.0 / (1.0 + np.exp(np.clip((d - self.centre) / self.width, -50.0, 50.0)))
+    A run of k empty quanta is one symbol: it aligns with a run of l at the
+    cost of |k - l| quanta gapped, and is gapped whole at k of them."""
+    gap = np.empty(SYMBOLS)
+    gap[:HUES] = -math.log(p.miss_hue)
+    gap[V], gap[C] = -math.log(p.miss_edge), -math.log(p.miss_corner)
+    runs = np.arange(1, MAX_RUN + 1)
+    gap[N:] = runs * -math.log(p.miss_space)
+    sub = np.full((SYMBOLS, SYMBOLS), p.wrong)
+    for a in range(HUES):
+        for b in range(HUES):
+            ring = min(abs(a - b), HUES - abs(a - b))
+            sub[a, b] = 0.0 if ring == 0 else (p.hue_near if ring == 1 else p.wrong)
+    sub[V, V] = sub[C, C] = 0.0
+    sub[N:, N:] = np.abs(runs[:, None] - runs[None, :]) * -math.log(p.miss_space)
+    sub[N:, :N] = sub[:N, N:] = 1e6  # empty space is never a feature: always two gaps
+    return np.round(sub * SCALE).astype(np.int64), np.round(gap * SCALE).astype(np.int64)
 
 
 @njit(cache=True)
@@ -361,7 +305,7 @@ class Matcher:
 
     def __init__(self, params: AlignParams | None = None):
         self.params = params or AlignParams()
-        self.sub, self.gap = self.params.tables()
+        self.sub, self.gap = cost_tables(self.params)
 
     def cost(self, a: np.ndarray, b: np.ndarray, exact: bool = False) -> float:
         a, b = np.asarray(a, np.int8), np.asarray(b, np.int8)

@@ -11,13 +11,14 @@ compass heading into the odometric frame in which nodes and links live.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
 
-from agents.controllers.fingerprint.align import AlignParams, Matcher
-from agents.controllers.fingerprint.features import FeatureParams, Fingerprint, fingerprint
+from agents.controllers.fingerprint.align import Matcher
+from agents.controllers.fingerprint.features import Fingerprint, fingerprint
+from agents.controllers.fingerprint.params import AlignParams, FeatureParams, FingerprintParams
 from agents.controllers.fingerprint.signatures import (
     FingerprintSignatures,
     fingerprint_data,
@@ -27,94 +28,8 @@ from agents.controllers.fingerprint.signatures import (
 )
 from agents.controllers.navigation.gridbelief import GridBelief
 from agents.controllers.navigation.mapshare import SharedMap
-from agents.controllers.navigation.topomap import MapParams, TopoMap
-from swarm.core.params import OURS, PAPER, declared
-from swarm.core.tables import params_from_table
-
-DRIVES = ("route", "explore")
-MODES = ("map", "localize")
-FILTERS = ("grid", "links")
-
-
-@dataclass(frozen=True)
-class FingerprintParams:
-    spacing: float = declared(
-        0.15,
-        source=PAPER,
-        where="metres between fingerprints: section 3, Figure 4, 500 data sets over a 75 m tour (75 m / 500)",
-    )
-    drive: str = declared(
-        "route",
-        source=OURS,
-        reason=(
-            "route: the carrot along the group's route, as the paper's robot was driven along a tour "
-            "(section 3); explore: wander"
-        ),
-    )
-    mode: str = declared(
-        "map",
-        source=OURS,
-        reason=(
-            "map: build the map, the paper's first experiment; localize: on the map given in "
-            "params['topomap'] (its second)"
-        ),
-    )
-    theta: float = declared(
-        0.5,
-        source=OURS,
-        reason=(
-            "largest dissimilarity at which a fingerprint joins the current node: the paper "
-            "determines theta experimentally and does not give it (section 3); P(match) > 0.5 "
-            "(docs/fingerprint.md)"
-        ),
-    )
-    keep: int = declared(
-        30,
-        source=OURS,
-        reason=(
-            "fingerprints a node keeps for its mean: the paper builds its mean without saying how "
-            "(docs/fingerprint.md, the map)"
-        ),
-    )
-    closure: float = declared(
-        0.5,
-        source=OURS,
-        reason=(
-            "belief in a known node that closes a loop: at least half on it (docs/fingerprint.md, "
-            "loop closing through localization)"
-        ),
-    )
-    sharpness: float = declared(
-        2.0,
-        source=OURS,
-        reason=(
-            "the Markov filter weighs nodes by P(match) ** sharpness: a look-alike room still gets "
-            "0.5-0.8 against the right one's 0.9 (docs/fingerprint.md)"
-        ),
-    )
-    filter: str = declared(
-        "grid",
-        source=OURS,
-        reason=(
-            "localizing, the belief that decides: on the map's odometric grid (99.4-99.7% against "
-            "96-97% over the links alone, docs/fingerprint.md)"
-        ),
-    )
-
-    @classmethod
-    def from_table(cls, table: dict[str, Any] | None) -> FingerprintParams:
-        p = params_from_table(cls, table, "fingerprint", ints=("keep",), texts=("drive", "mode", "filter"),
-                              nested=("features", "align"))  # fmt: skip
-        if p.drive not in DRIVES:
-            raise ValueError(f"[fingerprint].drive: {p.drive!r}; expected one of {', '.join(DRIVES)}")
-        if p.mode not in MODES:
-            raise ValueError(f"[fingerprint].mode: {p.mode!r}; expected one of {', '.join(MODES)}")
-        if p.filter not in FILTERS:
-            raise ValueError(f"[fingerprint].filter: {p.filter!r}; expected one of {', '.join(FILTERS)}")
-        if not (p.spacing > 0 and 0 < p.theta < 1 and p.keep >= 1 and 0 < p.sharpness <= 10):
-            raise ValueError("[fingerprint]: spacing > 0, 0 < theta < 1, keep >= 1 and 0 < sharpness <= 10 "
-                             "are required")  # fmt: skip
-        return p
+from agents.controllers.navigation.params import MapParams
+from agents.controllers.navigation.topomap import TopoMap
 
 
 def check_table(table: dict[str, Any] | None) -> None:

@@ -13,7 +13,7 @@
 
 The features are ordered by bearing, counter-clockwise from the robot's
 heading, into a circular string.  Every threshold is a field of
-FeatureParams, and docs/fingerprint.md gives the reasons for each value.
+FeatureParams (params.py), and docs/fingerprint.md gives the reasons for each value.
 """
 
 from __future__ import annotations
@@ -25,74 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from agents.controllers.fingerprint.align import HUES, MAX_RUN, C, N, V, paper_length, to_string
-from swarm.core.params import OURS, declared
-from swarm.core.tables import params_from_table
+from agents.controllers.fingerprint.params import FeatureParams
 
 TWO_PI = 2 * math.pi
-
-
-@dataclass(frozen=True)
-class FeatureParams:
-    """The feature extraction's numbers: the paper names the features (section 3) without any threshold; all
-    ours (docs/fingerprint.md, Features).
-    """
-
-    saturation: float = declared(
-        0.35,
-        source=OURS,
-        reason="a sector has a hue when its HSV saturation is at least this (docs/fingerprint.md, Features)",
-    )
-    min_patch: int = declared(
-        2,
-        source=OURS,
-        reason="sectors (degrees, on the scout) a colour patch must span (docs/fingerprint.md, Features)",
-    )
-    colour_step: float = declared(
-        30.0,
-        source=OURS,
-        reason="an edge where adjacent sectors differ this much in some RGB channel (docs/fingerprint.md, Features)",
-    )
-    depth_step: float = declared(
-        0.25,
-        source=OURS,
-        reason=(
-            "or where the camera's range jumps this much (metres): door frames, furniture sides, what"
-            " light and shade draw in a real image"
-        ),
-    )
-    depth_ratio: float = declared(
-        0.15, source=OURS, reason="... and this share of the nearer range (docs/fingerprint.md, Features)"
-    )
-    merge: float = declared(
-        math.radians(3.0),
-        source=OURS,
-        reason="edges (or corners) closer than this are one (docs/fingerprint.md, Features)",
-    )
-    break_range: float = declared(
-        0.3,
-        source=OURS,
-        reason="the laser scan breaks into stretches at range jumps above this (metres) before Douglas-Peucker",
-    )
-    epsilon: float = declared(
-        0.06,
-        source=OURS,
-        reason="Douglas-Peucker tolerance (metres): the paper names the algorithm (section 3) without its tolerance",
-    )
-    min_segment: float = declared(
-        0.4, source=OURS, reason="segments shorter than this give no corners (metres; docs/fingerprint.md, Features)"
-    )
-    quantum: float = declared(
-        math.radians(20.0),
-        source=OURS,
-        reason=(
-            "one `n` per this much empty angle: the paper's 'n' gives the angular distance between "
-            "features without a unit (section 3)"
-        ),
-    )
-
-    @classmethod
-    def from_table(cls, table: dict | None) -> FeatureParams:
-        return params_from_table(cls, table, "fingerprint.features", ints=("min_patch",))
 
 
 @dataclass(frozen=True)

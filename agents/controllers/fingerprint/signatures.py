@@ -18,7 +18,8 @@ import numpy as np
 
 from agents.controllers.fingerprint.align import MAX_LENGTH, SYMBOLS, Matcher, paper_length
 from agents.controllers.fingerprint.features import Fingerprint
-from agents.controllers.navigation.topomap import MapParams, TopoMap, topomap_from_data, topomap_to_data
+from agents.controllers.navigation.params import MapParams
+from agents.controllers.navigation.topomap import TopoMap, topomap_from_data, topomap_to_data
 
 
 def pack(strings: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

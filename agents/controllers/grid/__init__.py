@@ -6,9 +6,9 @@ module of pure functions over the grid face's flat rows (world_server/grid/face/
 from swarm.core.registry import ControllerSpec
 
 _KERNELS = ("swarm.core.rng",)
-_RULE = "world_server.grid.face.marks:MarkingRule"
-_SCENARIO = "world_server.grid.scenario"
-_BODIES = f"{_SCENARIO}:PhysicsParams"  # the robots' bodies, ideal (the paper) or physical
+_PARAMS = "world_server.grid.params"  # the one declared parameter set of the three and of the bodies
+_RULE = f"{_PARAMS}:MarkingRule"
+_BODIES = f"{_PARAMS}:PhysicsParams"  # the robots' bodies, ideal (the paper) or physical
 
 CONTROLLERS = (
     ControllerSpec(
@@ -16,7 +16,7 @@ CONTROLLERS = (
         world="grid",
         description="c-marking agents: marks that converge to the distance from the base, and trails (Simonin 2007)",
         factory="world_server.grid.face.layout:CMARKING",
-        parameters=(_RULE, f"{_SCENARIO}:CMarkingParams", _BODIES),
+        parameters=(_RULE, f"{_PARAMS}:CMarkingParams", _BODIES),
         kernels=_KERNELS,
     ),
     ControllerSpec(
@@ -32,7 +32,7 @@ CONTROLLERS = (
         world="grid",
         description="the pheromone ant baseline: pheromone laid and followed, evaporating and diffusing",
         factory="world_server.grid.face.layout:ANT",
-        parameters=(f"{_SCENARIO}:AntParams", _BODIES),
+        parameters=(f"{_PARAMS}:AntParams", _BODIES),
         kernels=_KERNELS,
     ),
 )

@@ -21,61 +21,12 @@ stays in charge.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from agents.controllers.navigation.params import GridParams
 from agents.controllers.navigation.topomap import TopoMap
-from swarm.core.params import OURS, declared
-
-
-@dataclass(frozen=True)
-class GridParams:
-    """Markov localization on the map's odometric grid: ours, the fingerprint paper localizes with a POMDP over
-    nodes ([27]) without numbers (docs/fingerprint.md).
-    """
-
-    cell: float = declared(0.2, source=OURS, reason="metres per cell: small against a node's stretch of corridor")
-    reach: float = declared(
-        1.0,
-        source=OURS,
-        reason=(
-            "a cell within this of an observation stands for that observation's node; 0.7-1.5 m made "
-            "no difference (docs/fingerprint.md)"
-        ),
-    )
-    slip: float = declared(
-        0.2,
-        source=OURS,
-        reason=(
-            "odometry and map-frame error, m per sqrt(m) travelled (the belief's blur); 0.1 or 0.2 "
-            "made no difference (docs/fingerprint.md)"
-        ),
-    )
-    spread: float = declared(
-        1e-3,
-        source=OURS,
-        reason="belief spread to every mapped cell at each step (errors, kidnapping) (docs/fingerprint.md)",
-    )
-    off_map: float = declared(
-        0.6,
-        source=OURS,
-        reason=(
-            "weight of a cell farther than reach from every observation: a place off the map matches "
-            "a view about as well as a look-alike room (P 0.5-0.8), so the belief follows the robot "
-            "into a room the map lacks; chosen on seeds 0-2 among 0.001, 0.3, 0.5, 0.6, 0.7 "
-            "(docs/fingerprint.md)"
-        ),
-    )
-    sharpness: float = declared(
-        1.0,
-        source=OURS,
-        reason=(
-            "each cell weighed by its node's P(match) ** sharpness (TopoMap.correct): 1, the exponent"
-            " tried against 1.5 and 2 (docs/fingerprint.md)"
-        ),
-    )
 
 
 class GridBelief:

@@ -48,7 +48,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from swarm.core.params import OURS, declared
+from agents.controllers.navigation.params import MapParams
 
 
 class Signatures(Protocol):
@@ -90,102 +90,6 @@ class Link:
     @property
     def direction(self) -> float:
         return float(math.atan2(self.displacement[1], self.displacement[0]))
-
-
-@dataclass(frozen=True)
-class MapParams:
-    """The topological map's numbers (the fingerprint paper's map, its [27] for loops; the BG animat's Filliat-
-    style map): none is given by either paper, all ours (docs/fingerprint.md, the map; docs/bg.md,
-    Navigation).
-    """
-
-    theta: float = declared(
-        0.5,
-        source=OURS,
-        reason=(
-            "the largest dissimilarity at which an observation joins a node: the fingerprint paper's "
-            "theta, determined experimentally and not given (section 3)"
-        ),
-    )
-    keep: int = declared(
-        30,
-        source=OURS,
-        reason="observations a node keeps to compute its mean from: the paper builds its mean without saying how",
-    )
-    closure: float = declared(
-        0.5,
-        source=OURS,
-        reason=(
-            "a loop closes when the belief, the current node left out, gives a known node this: at "
-            "least half (docs/fingerprint.md)"
-        ),
-    )
-    closure_match: float = declared(
-        0.9,
-        source=OURS,
-        reason=(
-            "... and the observation matches it this well: a wrong loop bends the map's topology, a "
-            "missed one only adds a node (docs/fingerprint.md)"
-        ),
-    )
-    young: int = declared(
-        5,
-        source=OURS,
-        reason=(
-            "a node this young (observations, first visit) folds into a known one it turns out to be:"
-            " late closing (docs/fingerprint.md)"
-        ),
-    )
-    merge_match: float = declared(
-        0.9,
-        source=OURS,
-        reason=(
-            "another robot's node is one of ours when it matches this well (no odometry to help); "
-            "with 0.8 look-alike rooms merged (docs/fingerprint.md)"
-        ),
-    )
-    near: float = declared(
-        1.5,
-        source=OURS,
-        reason=(
-            "a new node is linked to every node observed this close (odometry): the corridor before a"
-            " door and after it meet (docs/fingerprint.md)"
-        ),
-    )
-    recent: float = declared(
-        20.0,
-        source=OURS,
-        reason="... within this much travel: odometry drifts, farther back near means little (docs/fingerprint.md)",
-    )
-    kappa: float = declared(
-        2.0,
-        source=OURS,
-        reason="concentration of the link direction model (von Mises): weight exp(2 (cos - 1)) (docs/fingerprint.md)",
-    )
-    spread: float = declared(
-        1e-2,
-        source=OURS,
-        reason="belief spread to every node at each prediction (kidnapping, errors): 1% (docs/fingerprint.md)",
-    )
-    floor: float = declared(
-        1e-3, source=OURS, reason="likelihood floor: one bad match never rules a node out (docs/fingerprint.md)"
-    )
-    sharpness: float = declared(
-        1.0,
-        source=OURS,
-        reason=(
-            "the correction weighs each node by likelihood ** sharpness; 1 for the BG animat, the "
-            "fingerprint controller sets its own"
-        ),
-    )
-    closure_radius: float | None = declared(
-        None,
-        source=OURS,
-        reason=(
-            "a loop closes only onto a node this near by odometry; None, anywhere (the fingerprint "
-            "robot; the BG animat sets its own)"
-        ),
-    )
 
 
 @dataclass

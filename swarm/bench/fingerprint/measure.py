@@ -18,7 +18,8 @@ import time
 import numpy as np
 
 from agents.controllers.fingerprint.align import Matcher
-from agents.controllers.fingerprint.features import FeatureParams, Fingerprint, fingerprint
+from agents.controllers.fingerprint.features import Fingerprint, fingerprint
+from agents.controllers.fingerprint.params import FeatureParams
 from agents.controllers.fingerprint.signatures import FingerprintSignatures, pack
 from agents.controllers.navigation.topomap import Link, Node, TopoMap
 

@@ -2,31 +2,13 @@
 
 A robot may lower the mark of the cell it stands on to UPDATE-VALUE and no
 further (Algorithm 2 of Simonin et al. 2007): the controllers compute it to
-write, and the world checks every write against it before applying it.
+write, and the world checks every write against it before applying it.  Its
+numbers are MarkingRule's (world_server/grid/params.py), written here as literals.
 """
-
-from dataclasses import dataclass
 
 from numba import njit
 
-from swarm.core.params import PAPER, declared
 from world_server.grid.face.layout import MARK, MARK_NONE, OBST
-
-
-@dataclass(frozen=True)
-class MarkingRule:
-    """The marking agents' numbers (Algorithm 2): the marking, c-marking and ant controllers have no
-    other free number in their marks.  `update_value` and the world write them as literals; this
-    records their provenance (nothing reads it)."""
-
-    step: int = declared(
-        1, source=PAPER, where="section 3.1, Algorithm 2, UPDATE-VALUE: val = min(val, 1 + min(4-neighbour values))"
-    )
-    base: int = declared(
-        0,
-        source=PAPER,
-        where="section 3.2: the base cell c_0 is assigned its optimal value 0 before agents begin exploring",
-    )
 
 
 @njit(cache=True, inline="always")
