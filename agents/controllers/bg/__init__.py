@@ -18,7 +18,7 @@ CONTROLLERS = ControllerSpec(
         "agents.controllers.bg.params:SalienceWeights",
         "agents.controllers.bg.params:SenseParams",
         "agents.controllers.bg.params:NavParams",
-        "agents.controllers.navigation.topomap:MapParams",
+        "agents.controllers.navigation.params:MapParams",
         "world_server.arena.metabolism:MetabolismParams",
     ),
     table="agents.controllers.bg.controller:check_table",

@@ -45,7 +45,8 @@ import numpy as np
 from agents.controllers.bg.params import NavParams
 from agents.controllers.bg.senses import to_allocentric
 from agents.controllers.navigation.dijkstra import shortest_routes
-from agents.controllers.navigation.topomap import MapParams, TopoMap, topomap_from_data, topomap_to_data
+from agents.controllers.navigation.params import MapParams
+from agents.controllers.navigation.topomap import TopoMap, topomap_from_data, topomap_to_data
 from swarm.core.kernels import exported, njit
 from swarm.core.rng import fill_uniform
 
