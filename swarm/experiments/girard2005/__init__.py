@@ -20,22 +20,24 @@ _RATIOS = Option("--ratios", "right / left branch length ratios to run (default 
 _SIZES = Option("--sizes", "colony sizes to run (default 1,2,4,8)", type=f"{_OPTIONS}:sizes",
                 metavar="N,N,...")  # fmt: skip
 _RUN = "swarm.experiments.girard2005.bg:run_bg_experiment"
-# Smoke runs: reps 2, the least run_bg_experiment takes ("at least 2 runs per condition"), and one map for every test.
+# Smoke runs: reps 2, the least run_bg_experiment takes ("at least 2 runs per condition"), one map for every test,
+# mapping runs of 2 minutes and survival runs cut short: every file is written in seconds.
 EXPERIMENTS = (
     ExperimentSpec("bg-survival", "girard2005", "survival with and without its map", _RUN, options=(_FLOOR, _BG),
-                   smoke=(("reps", 2),)),
+                   smoke=(("reps", 2), ("max_ticks", 2000))),
     ExperimentSpec("bg-choice", "girard2005", "a new resource", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG),
-                   smoke=(("reps", 2), ("maps", 1))),
+                   smoke=(("reps", 2), ("maps", 1), ("mapping_seconds", 120.0))),
     ExperimentSpec("bg-forget", "girard2005", "a removed resource", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG),
-                   smoke=(("reps", 2), ("maps", 1))),
+                   smoke=(("reps", 2), ("maps", 1), ("mapping_seconds", 120.0))),
     ExperimentSpec("bg-fear", "girard2005", "fear against need", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG),
-                   smoke=(("reps", 2), ("maps", 1))),
+                   smoke=(("reps", 2), ("maps", 1), ("mapping_seconds", 120.0))),
     ExperimentSpec("bg-tmaze", "girard2005", "the T-maze", _RUN, options=(_FLOOR, _MAPS, _MAPPING, _BG, _RATIOS),
-                   smoke=(("reps", 2), ("maps", 1), ("ratios", (1.0,)))),
+                   smoke=(("reps", 2), ("maps", 1), ("ratios", (1.0,)), ("mapping_seconds", 120.0))),
     ExperimentSpec("bg-ablations", "girard2005", "eq. 10's cross term, the literal feedback, the wheels, dopamine, "
                    "biased odometry: what each does to experiments 1 and 3.2",
                    "swarm.experiments.girard2005.ablations:run_ablations", options=(_MAPS, _RATIOS),
-                   smoke=(("reps", 2), ("maps", 1), ("ratios", (1.0,)), ("max_ticks", 200))),
+                   smoke=(("reps", 2), ("maps", 1), ("ratios", (1.0,)), ("max_ticks", 200),
+                          ("mapping_seconds", 120.0))),
     ExperimentSpec("bg-colony", "girard2005", "survival against colony size, with and without a shared map",
                    "swarm.experiments.girard2005.colony:run_colony_experiment", options=(_SIZES,),
                    smoke=(("reps", 1), ("sizes", (1, 2)), ("max_ticks", 200))),

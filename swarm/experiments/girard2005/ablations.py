@@ -74,9 +74,9 @@ def run_test(job: tuple) -> dict:
 
 def run_ablations(experiment: str, reps: int | None, jobs: int | None, seed: int, out: Path | None,
                   progress: bool = True, max_ticks: int | None = None, ratios: tuple[float, ...] | None = None,
-                  maps: int | None = None) -> dict:  # fmt: skip
-    """Every condition on experiment 1 (A) and 3.2; `maps` mapping runs per T-maze (default one per test),
-    `max_ticks` a shorter cap on survival runs."""
+                  maps: int | None = None, mapping_seconds: float = bg.MAPPING_SECONDS) -> dict:  # fmt: skip
+    """Every condition on experiment 1 (A) and 3.2; `maps` mapping runs per T-maze (default one per test), each
+    at most `mapping_seconds`; `max_ticks` a shorter cap on survival runs (a smoke run)."""
     reps = REPS if reps is None else reps
     if reps < 2:
         raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
@@ -85,7 +85,7 @@ def run_ablations(experiment: str, reps: int | None, jobs: int | None, seed: int
         raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
     out_ = Outputs(out, experiment)
     floors = bg.check_floors("bg-tmaze", None, ratios, {})
-    made = bg._maps("bg-tmaze", maps, seed, floors, jobs, progress)
+    made = bg._maps("bg-tmaze", maps, seed, floors, jobs, progress, seconds=mapping_seconds)
     survival, tests = jobs_for(reps, seed, made, max_ticks)
     rows = batch_run(run_survival, survival, jobs=jobs, desc=f"{experiment} survival", progress=progress)
     rows += batch_run(run_test, tests, jobs=jobs, desc=f"{experiment} T-maze", progress=progress)

@@ -382,10 +382,12 @@ def plot_experiment(experiment: str, rows: list[dict], summary: list[dict], path
 def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
                       out: Path | None, ratios: tuple[float, ...] | None = None, maps: int | None = None,
                       progress: bool = True, bg: dict[str, Any] | None = None,
-                      mapping: str | None = None) -> dict:  # fmt: skip
+                      mapping: str | None = None, max_ticks: int | None = None,
+                      mapping_seconds: float = MAPPING_SECONDS) -> dict:  # fmt: skip
     """Run one experiment on its floor (or `scenario`, a file with the resources FLOOR_NEEDS names); `maps`
     mapping runs per floor for experiments 2 and 3 (default: one per test), made as `mapping` says
-    (MAPPING_MODES; default MAPPING); `bg` changes the [bg] table of every run (mapping runs included)."""
+    (MAPPING_MODES; default MAPPING), each at most `mapping_seconds`; `bg` changes the [bg] table of every run
+    (mapping runs included); `max_ticks` cuts survival runs short (a smoke run)."""
     changes = dict(bg or {})
     floors = check_floors(experiment, scenario, ratios, changes)
     reps = REPS[experiment] if reps is None else reps
@@ -403,7 +405,7 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
         raise ScenarioError("command line", "--mapping", f"one of {', '.join(MAPPING_MODES)}, not {mapping!r}")
     out = Outputs(out, experiment)
     if experiment == "bg-survival":
-        work = [(c, k, seed + k, changes, None, floors[0]) for c in ("A", "B") for k in range(reps)]
+        work = [(c, k, seed + k, changes, max_ticks, floors[0]) for c in ("A", "B") for k in range(reps)]
         rows = batch_run(run_survival, work, jobs=jobs, desc=experiment, progress=progress)
         rows.sort(key=lambda r: (r["condition"], r["run"]))
         out.runs(rows, list(rows[0]))
@@ -413,7 +415,7 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
             f"condition on {floors[0]}, at most 4 h; seed {seed}.\n\n"
         )
     else:
-        made = _maps(experiment, maps, seed, floors, jobs, progress, changes, mapping)
+        made = _maps(experiment, maps, seed, floors, jobs, progress, changes, mapping, mapping_seconds)
         (out / "maps.json").write_text(json.dumps(made))
         work = test_jobs(experiment, reps, seed, made, changes)
         rows = batch_run(run_test, work, jobs=jobs, desc=experiment, progress=progress)
@@ -475,10 +477,11 @@ def build_map_job(job: tuple) -> dict:
 
 
 def _maps(experiment: str, count: int, seed: int, floors: tuple[str, ...], jobs: int | None, progress: bool,
-          changes: dict[str, Any] | None = None, mode: str = MAPPING) -> dict[str, list[dict]]:  # fmt: skip
-    """`count` maps per map set, map k from a mapping run with seed + k (in parallel)."""
+          changes: dict[str, Any] | None = None, mode: str = MAPPING,
+          seconds: float = MAPPING_SECONDS) -> dict[str, list[dict]]:  # fmt: skip
+    """`count` maps per map set, map k from a mapping run with seed + k (in parallel), each at most `seconds`."""
     mapped = mapped_floors(experiment, floors)
-    work = [(name, k, seed + k, floor, absent, changes or {}, mode)
+    work = [(name, k, seed + k, floor, absent, changes or {}, mode, seconds)
             for name, (floor, absent) in mapped.items() for k in range(count)]  # fmt: skip
     rows = batch_run(build_map_job, work, jobs=jobs, desc=f"{experiment} mapping", progress=progress)
     made = {(m["scenario"], m["index"]): m["data"] for m in rows}
