@@ -426,6 +426,32 @@ def test_a_restored_controller_goes_on_exactly_as_the_one_it_was_taken_from():
     assert np.array_equal(ra.map.belief, rb.map.belief)
 
 
+def test_a_saved_map_holds_no_belief_and_localization_starts_uniform():
+    """What the mapping robot believed at the end of its tour is not in the map it saves, and a robot
+    localizing on a map starts from a uniform belief over its nodes whatever the map it is given holds: its
+    first fix is the matching alone."""
+    from swarm.engines.arena import ArenaEngine
+    from swarm.experiments.tapus2006.fingerprint import tour_scenario
+    from world_server.arena.scenario import controller_params
+
+    saved = mapping_tour()[1]["map"]
+    assert saved["belief"] == [] and len(saved["nodes"]) >= 10
+    s = tour_scenario("office", "localize", "low", 1000)
+    params = controller_params(s, 0)
+    params["fingerprint"] = {**params.get("fingerprint", {}), "mode": "localize"}
+    held = dict(saved, belief=np.eye(len(saved["nodes"]))[3].tolist(), current=3)  # a map that does hold one
+    first = []
+    for given in (saved, held):
+        engine = ArenaEngine(s)
+        c = engine.controllers[0]
+        c.reset(s.seed, 0, {**params, "topomap": given})
+        assert len(c.map.belief) == 0
+        while not c.log:
+            engine.step(1)
+        first.append(np.asarray(c.map.belief, np.float64).copy())
+    assert np.array_equal(first[0], first[1]) and first[1][3] < 0.5  # nothing of the held belief is left
+
+
 def test_localize_mode_needs_a_map_and_says_so():
     from swarm.engines.arena import ArenaEngine
     from swarm.experiments.tapus2006.fingerprint import tour_scenario

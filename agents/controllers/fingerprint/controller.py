@@ -69,6 +69,7 @@ class FingerprintController:
                     "(swarm experiment fingerprint-localize builds one with a mapping tour first)"
                 )
             self.map = map_from_data(params["topomap"], self.signatures, map_params)
+            self.map.belief = np.zeros(0)  # global localization: its first fix starts uniform, whatever the map held
             self.grid: GridBelief | None = GridBelief(self.map)
         else:
             self.map = TopoMap(self.signatures, map_params)
@@ -143,8 +144,12 @@ class FingerprintController:
         self.shared.receive(sender, data)
 
     def map_data(self) -> dict[str, Any]:
-        """The map as plain data (to save, to send, to localize on later)."""
-        return map_to_data(self.map)
+        """The map as plain data (to save, to send, to localize on later): places, links and fingerprints,
+        not where the mapping robot believed itself at the end (a robot localizing on it starts knowing
+        nothing)."""
+        data = map_to_data(self.map)
+        data["belief"] = []
+        return data
 
     def summary(self) -> dict[str, Any]:
         return {"map": {"fingerprints": len(self.log), "nodes": self.map.size, "links": len(self.map.links),
@@ -153,7 +158,7 @@ class FingerprintController:
 
     def snapshot(self) -> dict[str, Any]:
         return {"tick": self.tick, "position": self.position.tolist(), "last_position": self.last_position.tolist(),
-                "since": self.since, "map": self.map_data(), "log": [list(r) for r in self.log],
+                "since": self.since, "map": map_to_data(self.map), "log": [list(r) for r in self.log],
                 "driver": _plain(self.driver.snapshot()), "shared": self.shared.to_data(),
                 "params": asdict(self.p), "grid": self.grid.to_data() if self.grid is not None else None,
                 "belief": np.asarray(self.belief).tolist(), "believed": self.believed,

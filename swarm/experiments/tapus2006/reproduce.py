@@ -255,9 +255,6 @@ def _together(rows: Sequence[dict], quick: bool) -> tuple[str, str]:
 KNOWN_DIFFERENCES = "\n".join(f"- {line}" for line in (
     "The floor is ours (`office`, 32 x 12 m, 16 rooms, 20 places), designed with about 20 places: the paper's "
     "Figure 4 floor is not available, so the 20-node agreement is partly built in.",
-    "The map the localization tour uses carries the mapping robot's final belief, and the localization tour "
-    "starts where the mapping tour ended, so the links-only filter does not start from a uniform belief (the "
-    "grid filter does: it starts uniform over the mapped cells).",
     "False loop closures are not part of the scoring: a node joining both ends of the corridor counts as right "
     "at both ends (the descriptive rows above count such maps).",
     "The second tour retraces the first (about two thirds of its fingerprints lie within 10 cm of a mapping "
