@@ -262,11 +262,15 @@ def test_carrot_experiment_writes_its_table(tmp_path):
     from swarm.experiments.billing2015.carrot import run_carrot_experiment
 
     result = run_carrot_experiment("carrot", "zmaze", 3, 2, 0, tmp_path, progress=False)
-    assert result["runs"] == 9  # 3 pairs x none / low / high
+    assert result["runs"] == 18  # 3 pairs x ours and the paper's x none / low / high
     assert {"runs.csv", "summary.csv", "table.md", "plot.png"} <= {p.name for p in tmp_path.iterdir()}
     table = (tmp_path / "table.md").read_text()
-    assert "FTC-HN" in table and "paper F = 0.97" in table
-    assert [r["reached"] for r in result["summary"]] == [3, 3, 3]
+    assert "FTC-HN" in table and "FTCp-HN" in table and "paper F = 0.97" in table
+    conditions = [r["condition"] for r in result["summary"]]
+    assert conditions == ["FTC-NN", "FTC-LN", "FTC-HN", "FTCp-NN", "FTCp-LN", "FTCp-HN"]
+    assert [r["reached"] for r in result["summary"]][:3] == [3, 3, 3]
+    runs = (tmp_path / "runs.csv").read_text()
+    assert runs.count(",carrot,paper,") == 9 and runs.count(",carrot,ours,") == 9  # the same pairs, paired
 
 
 def test_large_maze_pairs_follow_the_seed_and_keep_40_mm_from_walls():
