@@ -185,6 +185,45 @@ def test_carrot_reaches_zmaze_goals_close_to_the_optimum():
         assert 0.9 < robot["path_ratio"] < 1.15
 
 
+def _folded_path() -> np.ndarray:
+    """Out east along y = 0, up 1.2 cm, back west along y = 0.012: a fold whose legs pass 1.2 cm apart."""
+    out = [(0.01 * k, 0.0) for k in range(21)]
+    back = [(0.01 * k, 0.012) for k in range(20, -1, -1)]
+    return np.array(out + back)
+
+
+def test_the_papers_carrot_is_the_nearest_point_of_the_whole_path():
+    from agents.controllers.navigation.follow import CarrotFollower, PaperCarrotFollower
+
+    path = _folded_path()
+    # at x = 5 cm on the way out, facing north: p_look (5, 1) cm is 2 mm from the way back, 1 cm from the way out
+    ours = CarrotFollower(path, 3.0, 0.01, 0.05, 40).carrot(0.05, 0.0, math.pi / 2)
+    papers = PaperCarrotFollower(path, 3.0, 0.01, 0.05, 40).carrot(0.05, 0.0, math.pi / 2)
+    np.testing.assert_allclose(ours, (0.05, 0.0))  # the window keeps to the way out
+    np.testing.assert_allclose(papers, (0.05, 0.012))  # eq. 18 jumps across the fold
+
+
+def test_the_papers_carrot_drives_forward_while_it_turns():
+    from agents.controllers.navigation.follow import CarrotFollower, PaperCarrotFollower
+
+    path = np.array([(0.5 - 0.01 * k, 0.5) for k in range(30)])  # the path runs west, behind the robot facing east
+    axle, top = 0.053, 0.129
+    left, right = PaperCarrotFollower(path, 3.0, 0.01, 0.05, 40).wheels(0.52, 0.5, 0.0, axle, top)
+    assert (left + right) / 2 == pytest.approx(0.05)  # cruise speed while it steers
+    assert abs(right - left) > 0.1 and max(abs(left), abs(right)) <= top + 1e-12  # a turn as hard as the wheels allow
+    left, right = CarrotFollower(path, 3.0, 0.01, 0.05, 40).wheels(0.52, 0.5, 0.0, axle, top)
+    assert (left + right) / 2 == pytest.approx(0.0, abs=1e-9) and abs(right - left) > 0.1  # ours turns on the spot
+
+
+def test_a_bad_carrot_variant_is_refused_in_one_line():
+    from agents.controllers.carrot.controller import CarrotParams
+
+    assert CarrotParams.from_table({"variant": "paper"}).variant == "paper"
+    assert CarrotParams.from_table(None).variant == "ours"
+    with pytest.raises(ValueError, match=r"^\[carrot\]: variant is 'ours' or 'paper', not 'barton'$"):
+        CarrotParams.from_table({"variant": "barton"})
+
+
 def test_arena_runs_are_deterministic_bit_for_bit():
     s = load_scenario("large-maze").with_overrides(noise="high")
     a, b = ArenaEngine(s), ArenaEngine(s)
@@ -223,11 +262,15 @@ def test_carrot_experiment_writes_its_table(tmp_path):
     from swarm.experiments.billing2015.carrot import run_carrot_experiment
 
     result = run_carrot_experiment("carrot", "zmaze", 3, 2, 0, tmp_path, progress=False)
-    assert result["runs"] == 9  # 3 pairs x none / low / high
+    assert result["runs"] == 18  # 3 pairs x ours and the paper's x none / low / high
     assert {"runs.csv", "summary.csv", "table.md", "plot.png"} <= {p.name for p in tmp_path.iterdir()}
     table = (tmp_path / "table.md").read_text()
-    assert "FTC-HN" in table and "paper F = 0.97" in table
-    assert [r["reached"] for r in result["summary"]] == [3, 3, 3]
+    assert "FTC-HN" in table and "FTCp-HN" in table and "paper F = 0.97" in table
+    conditions = [r["condition"] for r in result["summary"]]
+    assert conditions == ["FTC-NN", "FTC-LN", "FTC-HN", "FTCp-NN", "FTCp-LN", "FTCp-HN"]
+    assert [r["reached"] for r in result["summary"]][:3] == [3, 3, 3]
+    runs = (tmp_path / "runs.csv").read_text()
+    assert runs.count(",carrot,paper,") == 9 and runs.count(",carrot,ours,") == 9  # the same pairs, paired
 
 
 def test_large_maze_pairs_follow_the_seed_and_keep_40_mm_from_walls():

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from agents.controllers.navigation.astar import Planner
-from agents.controllers.navigation.follow import CarrotFollower
+from agents.controllers.navigation.follow import CarrotFollower, PaperCarrotFollower
 from swarm.core.params import OURS, PAPER, declared
 from swarm.core.tables import params_from_table
 
@@ -48,7 +48,19 @@ class CarrotParams:
         40,
         source=OURS,
         reason=(
-            "path points searched ahead of the last carrot: never back, never across a fold of the path (docs/arena.md)"
+            "variant 'ours': path points searched ahead of the last carrot: never back, never across a fold of "
+            "the path (docs/arena.md)"
+        ),
+    )
+    variant: str = declared(
+        "ours",
+        source=OURS,
+        reason=(
+            "which follow the carrot: 'ours' (the windowed carrot above, turning on the spot) or 'paper' "
+            "(Appendix B literally: eq. 18's carrot, the nearest point of the whole path, so it may jump across "
+            "a fold and cut corners; the robot drives at `speed` while it steers, its turn rate clipped to what "
+            "the wheels allow at that speed: Appendix B gives a steering angle and no speed law, and a steering "
+            "angle is a car's, which cannot turn on the spot; `window` is unused) (docs/arena.md)"
         ),
     )
     arrive: float = declared(
@@ -62,7 +74,13 @@ class CarrotParams:
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> CarrotParams:
-        return params_from_table(cls, table, "carrot", ints=("window",))
+        p = params_from_table(cls, table, "carrot", ints=("window",), texts=("variant",))
+        if p.variant not in VARIANTS:
+            raise ValueError(f"[carrot]: variant is 'ours' or 'paper', not {p.variant!r}")
+        return p
+
+
+VARIANTS = {"ours": CarrotFollower, "paper": PaperCarrotFollower}
 
 
 class CarrotController:
@@ -92,7 +110,11 @@ class CarrotController:
             legs.append(points)
             here = target
         path = np.concatenate(legs) if legs else np.zeros((1, 2))
-        self.follower = CarrotFollower(path, self.p.k_fic, self.p.k_look, self.p.speed, self.p.window)
+        self.follower = self._follower(path)
+
+    def _follower(self, path: np.ndarray) -> CarrotFollower:
+        p = self.p
+        return VARIANTS[p.variant](path, p.k_fic, p.k_look, p.speed, p.window)
 
     def step(self, perception: dict[str, np.ndarray]) -> np.ndarray:
         if "position" not in perception or "compass" not in perception:
@@ -122,8 +144,7 @@ class CarrotController:
         self.planned, self.stopped, self.no_path = state["planned"], state["stopped"], state["no_path"]
         self.follower = None
         if state["path"] is not None:
-            p = self.p
-            self.follower = CarrotFollower(np.asarray(state["path"]), p.k_fic, p.k_look, p.speed, p.window)
+            self.follower = self._follower(np.asarray(state["path"]))
             self.follower.index = int(state["index"])
 
     def route(self) -> np.ndarray | None:

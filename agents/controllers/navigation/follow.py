@@ -11,6 +11,11 @@ things open; our choices (docs/arena.md):
 - phi is the turn rate (rad/s) and the forward speed is speed * max(0, cos(error)),
   so the robot turns on the spot when the carrot is behind it;
 - the wheel speeds keep their ratio when one would exceed the wheel limit.
+
+PaperCarrotFollower is Appendix B literally ([carrot] variant = "paper"): the
+carrot is the nearest point of the whole path (eq. 18, no window: it may jump
+back or across a fold), and the robot drives at its cruise speed while it
+steers, its turn rate clipped so that neither wheel exceeds the wheel limit.
 """
 
 from __future__ import annotations
@@ -52,3 +57,21 @@ class CarrotFollower:
     @property
     def at_end(self) -> bool:
         return self.index >= len(self.path) - 1
+
+
+class PaperCarrotFollower(CarrotFollower):
+    """Appendix B as printed: p_c the path point nearest p_look over the whole path (the first of equals),
+    and forward at `speed` always, turning at k_fic * error at most as fast as the wheels allow."""
+
+    def carrot(self, x: float, y: float, heading: float) -> np.ndarray:
+        look = np.array([x + self.k_look * math.cos(heading), y + self.k_look * math.sin(heading)])
+        self.index = int(np.argmin(((self.path - look) ** 2).sum(axis=1)))
+        return self.path[self.index]
+
+    def wheels(self, x: float, y: float, heading: float, axle: float, max_wheel: float) -> tuple[float, float]:
+        cx, cy = self.carrot(x, y, heading)
+        error = wrap(math.atan2(cy - y, cx - x) - heading)
+        v = min(self.speed, max_wheel)
+        top = 2 * (max_wheel - v) / axle  # the fastest turn that keeps both wheels within the limit at speed v
+        turn = min(max(self.k_fic * error, -top), top)
+        return v - turn * axle / 2, v + turn * axle / 2

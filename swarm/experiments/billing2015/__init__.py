@@ -10,9 +10,9 @@ _STEPS = Option("--max-steps", "run length limit in steps of 64 ms (default 3000
 _DFT = "swarm.experiments.billing2015.dft:run_dft_experiment"
 _WRITES = "runs.csv, summary.csv, table.md, plot.png"
 EXPERIMENTS = (
-    ExperimentSpec("carrot", "billing2015", "follow the carrot in zmaze and large-maze at three noise levels "
-                   "(DFT paper, cases 1-2)", "swarm.experiments.billing2015.carrot:run_carrot_experiment",
-                   options=(_MAZE,)),
+    ExperimentSpec("carrot", "billing2015", "follow the carrot, ours and Appendix B's, in zmaze and large-maze "
+                   "at three noise levels (DFT paper, cases 1-2)",
+                   "swarm.experiments.billing2015.carrot:run_carrot_experiment", options=(_MAZE,)),
     ExperimentSpec("dft-case1", "billing2015", "the dft controller in zmaze beside follow the carrot", _DFT,
                    options=(_MAZE, _NOISE, _STEPS)),
     ExperimentSpec("dft-case2", "billing2015", "the dft controller in large-maze beside follow the carrot", _DFT,

@@ -2,9 +2,10 @@
 Billing, Lowe & Sandamirskaya (2015) with the dft controller, beside the
 follow-the-carrot baseline.
 
-Cases 1 and 2 run every start/goal pair under five conditions: SPA at low and
-high noise, FTC at no, low and high noise (the paper's Figures 7 and 8), and
-a one-way ANOVA of L_p / L_o across the five (the paper's F).  Case 3 puts a
+Cases 1 and 2 run every start/goal pair under the paper's five conditions: SPA
+at low and high noise, FTC at no, low and high noise (the paper's Figures 7 and
+8), and a one-way ANOVA of L_p / L_o across the five (the paper's F); FTC runs
+both as ours and as Appendix B prints it (FTCp), each pair under both.  Case 3 puts a
 fully or partly obstructing box across the Z-maze's north corridor at a
 random step t_i for t_p steps and classifies each run by the route it took
 (the paper's Figures 13, 15, 16).  docs/dft.md gives every choice.
@@ -21,15 +22,28 @@ from swarm.core.errors import ScenarioError
 from swarm.core.plots import pyplot, save_figure
 from swarm.experiments.billing2015.carrot import (
     LARGE_HEADING,
+    PAPER_FTC,
     RUN_FIELDS,
+    arm,
     fmt,
+    ftc_name,
     random_pairs,
     run_pair,
     zmaze_pairs,
 )
 from swarm.experiments.runner import Outputs, batch_run
 
-CONDITIONS = (("dft", "low"), ("dft", "high"), ("carrot", "none"), ("carrot", "low"), ("carrot", "high"))
+# The paper's five conditions with our follow the carrot (FTC), then its three FTC conditions with Appendix B's
+# follow the carrot as printed (FTCp, "carrot-paper": [carrot] variant = "paper"), on the same pairs and seeds.
+PAPER_FIVE = (("dft", "low"), ("dft", "high"), ("carrot", "none"), ("carrot", "low"), ("carrot", "high"))
+CONDITIONS = (*PAPER_FIVE, (PAPER_FTC, "none"), (PAPER_FTC, "low"), (PAPER_FTC, "high"))
+
+
+def five(controller: str) -> tuple[tuple[str, str], ...]:
+    """The paper's five conditions with this follow the carrot ("carrot" or "carrot-paper")."""
+    return tuple((controller if c == "carrot" else c, n) for c, n in PAPER_FIVE)
+
+
 PAPER_F = {"zmaze": 0.97, "large-maze": 0.98}
 CASE_SCENARIO = {"dft-case1": "zmaze", "dft-case2": "large-maze", "dft-case3": "zmaze", "dft-together": "zmaze"}
 
@@ -49,7 +63,7 @@ ROUTE_COLOUR = {"north": "#3a3", "south": "#37c", "north-then-south": "#d33", "s
 
 
 def label(controller: str, noise: str) -> str:
-    return f"{'SPA' if controller == 'dft' else 'FTC'}-{noise[0].upper()}N"
+    return f"{'SPA' if controller == 'dft' else ftc_name(controller)}-{noise[0].upper()}N"
 
 
 # ---------------------------------------------------------------- cases 1, 2
@@ -72,7 +86,7 @@ def summarise_pairs(rows: list[dict]) -> tuple[list[dict], str]:
     name = rows[0]["scenario"]
     summary, lines, groups = [], [], {}
     for controller, noise in CONDITIONS:
-        sel = [r for r in rows if r["controller"] == controller and r["noise"] == noise]
+        sel = [r for r in rows if arm(r) == controller and r["noise"] == noise]
         if not sel:  # --noise leaves some conditions out
             continue
         ratios = np.array([r["path_ratio"] for r in sel if r["path_ratio"] not in (None, "")], float)
@@ -88,28 +102,34 @@ def summarise_pairs(rows: list[dict]) -> tuple[list[dict], str]:
                      f"{fmt(ratios.mean() if len(ratios) else math.nan)} ± "
                      f"{fmt(ratios.std(ddof=1) if len(ratios) > 1 else math.nan)} | "
                      f"{fmt(float(np.median(ticks)) if ticks else math.nan, 0)} |")  # fmt: skip
-    usable = [g for g in groups.values() if len(g) > 1]
-    f = f_oneway(*usable) if len(usable) > 1 else None
+    anovas = []
+    for ftc in ("carrot", PAPER_FTC):
+        usable = [groups[k] for k in five(ftc) if k in groups and len(groups[k]) > 1]
+        f = f_oneway(*usable) if len(usable) > 1 else None
+        anovas.append(f"with {ftc_name(ftc)}: F = {fmt(f.statistic if f else math.nan, 2)}, "
+                      f"p = {fmt(f.pvalue if f else math.nan, 3)}")  # fmt: skip
     spa = [g for (c, _), g in groups.items() if c == "dft" and len(g) > 1]
     f_spa = f_oneway(*spa) if len(spa) == 2 else None
     head = ("| condition | reached | L_p / L_o (mean ± sd, reached runs) | median ticks to goal |\n"
             "|---|---|---|---|\n")  # fmt: skip
-    tail = (f"\nOne-way ANOVA of L_p / L_o over the five conditions: F = {fmt(f.statistic if f else math.nan, 2)}, "
-            f"p = {fmt(f.pvalue if f else math.nan, 3)}; paper F = {PAPER_F[name]} (no significant difference).  "
+    tail = (f"\nOne-way ANOVA of L_p / L_o over the paper's five conditions, {'; '.join(anovas)}; paper F = "
+            f"{PAPER_F[name]} (no significant difference).  "
             f"SPA low against high noise alone: F = {fmt(f_spa.statistic if f_spa else math.nan, 2)}, "
             f"p = {fmt(f_spa.pvalue if f_spa else math.nan, 3)}.\n"
             "\nThe paper shows successes and L_p / L_o as bar charts (Figures 7 and 8), which we do not have; its "
             "text says SPA succeeds in most runs, is robust to noise, and that FTC succeeds notably less often "
-            "than SPA in the large maze.\n")  # fmt: skip
+            "than SPA in the large maze.  FTC is our follow the carrot, FTCp Appendix B's as printed ([carrot] "
+            "variant = \"paper\"), on the same pairs and seeds.\n")  # fmt: skip
     return summary, head + "\n".join(lines) + "\n" + tail
 
 
 def plot_pairs(rows: list[dict], path: Path) -> None:
     plt = pyplot()
     labels = [label(c, n) for c, n in CONDITIONS]
-    sel = [[r for r in rows if r["controller"] == c and r["noise"] == n] for c, n in CONDITIONS]
-    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
-    axes[0].bar(labels, [sum(bool(r["reached"]) for r in s) for s in sel], color=["#c63", "#c63"] + ["#4a7"] * 3)
+    sel = [[r for r in rows if arm(r) == c and r["noise"] == n] for c, n in CONDITIONS]
+    fig, axes = plt.subplots(1, 2, figsize=(13, 3.8))
+    colours = ["#c63", "#c63"] + ["#4a7"] * 3 + ["#47c"] * 3
+    axes[0].bar(labels, [sum(bool(r["reached"]) for r in s) for s in sel], color=colours)
     axes[0].set(title=f"{rows[0]['scenario']}: successful runs (Figure 7)")
     ratios = [[r["path_ratio"] for r in s if r["path_ratio"] not in (None, "")] or [math.nan] for s in sel]
     axes[1].boxplot(ratios, tick_labels=labels)
@@ -433,7 +453,7 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
             work = [j for j in work if j[1] == noise]
         rows = batch_run(run_pair, work, jobs=jobs, desc=case, progress=progress)
         order = [label(c, n) for c, n in CONDITIONS]
-        rows.sort(key=lambda r: (order.index(label(r["controller"], r["noise"])), r["pair"]))
+        rows.sort(key=lambda r: (order.index(label(arm(r), r["noise"])), r["pair"]))
         out.runs(rows, RUN_FIELDS)
         summary, md = summarise_pairs(rows)
         plot_pairs(rows, out / "plot.png")

@@ -1,8 +1,9 @@
 """`swarm reproduce billing2015`: the claims of section 5 (cases 1, 2 and 3) beside ours, on the confirmation seeds.
 
 Cases 1 and 2 run every start/goal pair under the paper's five conditions (SPA at low and high noise, follow
-the carrot at none, low and high).  A pair's seed is the same in every condition, so success is compared
-pair by pair (McNemar) and the paper's one-way ANOVA of L_p / L_o is given beside it.  Case 3 draws the
+the carrot at none, low and high), follow the carrot both as ours (FTC) and as Appendix B prints it (FTCp).
+A pair's seed is the same in every condition, so success is compared pair by pair (McNemar) and the paper's
+one-way ANOVA of L_p / L_o is given beside it, over the five with each follow the carrot.  Case 3 draws the
 obstacle's appearance t_i and duration t_p per run, as the paper did, and judges the paper's three
 statements about the route the robot takes.
 """
@@ -18,13 +19,14 @@ from swarm.experiments import protocol as P
 from swarm.experiments import report as R
 from swarm.experiments import stats as S
 from swarm.experiments.billing2015 import paper
-from swarm.experiments.billing2015.carrot import RUN_FIELDS, run_pair
+from swarm.experiments.billing2015.carrot import PAPER_FTC, RUN_FIELDS, arm, ftc_name, run_pair
 from swarm.experiments.billing2015.dft import (
     CASE3_BOXES,
     CASE3_FIELDS,
     CONDITIONS,
     ROUTE_COLOUR,
     case3_jobs,
+    five,
     label,
     pair_jobs,
     plot_case3,
@@ -44,7 +46,8 @@ CASE_OF = {"case1": "dft-case1", "case2": "dft-case2"}
 SUCCESS_RADIUS = 0.07  # m: a pair whose goal is this close to its start is reached before it starts
 PAIR_FIELDS = ["case", "seed", *RUN_FIELDS]
 CASE3_CSV_FIELDS = ["case", "seed", *CASE3_FIELDS]
-DESIGN = ("Cases 1 and 2: every start/goal pair under the five conditions, a pair's seed shared by all five, so "
+DESIGN = ("Cases 1 and 2: every start/goal pair under the five conditions, follow the carrot both as ours (FTC) and "
+          "as Appendix B prints it (FTCp), a pair's seed shared by all, so "
           "success is compared pair by pair (exact McNemar); 'most runs' is tested against one half (exact "
           "binomial); L_p / L_o by the paper's one-way ANOVA over the reached runs. Case 3: t_i and t_p drawn per "
           "run. Proportions with Wilson 95% intervals, means with bootstrap (BCa) ones.")  # fmt: skip
@@ -74,7 +77,7 @@ def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = N
     rows = batch_run(run_job, plan(reps, quick), jobs=jobs, desc="billing2015", progress=progress)
     order = [label(c, n) for c, n in CONDITIONS]
     pairs = sorted((r for r in rows if r["case"] != "case3"),
-                   key=lambda r: (r["case"], order.index(label(r["controller"], r["noise"])), r["pair"]))  # fmt: skip
+                   key=lambda r: (r["case"], order.index(label(arm(r), r["noise"])), r["pair"]))  # fmt: skip
     case3 = sorted((r for r in rows if r["case"] == "case3"), key=lambda r: (r["obstacle"], r["noise"], r["run"]))
     out_.runs(pairs, PAIR_FIELDS)
     out_.runs(case3, CASE3_CSV_FIELDS, file="case3.csv")
@@ -106,19 +109,19 @@ def _degenerate(r: dict) -> bool:
 
 
 def _by_pair(rows: list[dict], controller: str, noise: str) -> dict[int, dict]:
-    return {r["pair"]: r for r in rows if r["controller"] == controller and r["noise"] == noise}
+    return {r["pair"]: r for r in rows if arm(r) == controller and r["noise"] == noise}
 
 
 def _pairs_section(case: str, rows: list[dict], quick: bool):
     maze = "the Z-maze" if case == "case1" else "the large maze"
     kept = [r for r in rows if not _degenerate(r)]
     left_out = len({r["pair"] for r in rows}) - len({r["pair"] for r in kept})
-    lines, groups = [], []
+    lines, groups = [], {}
     for controller, noise in CONDITIONS:
-        sel = [r for r in kept if r["controller"] == controller and r["noise"] == noise]
+        sel = [r for r in kept if arm(r) == controller and r["noise"] == noise]
         ok = sum(bool(r["reached"]) for r in sel)
         ratios = np.array([r["path_ratio"] for r in sel if r["path_ratio"] not in (None, "")], float)
-        groups.append(ratios)
+        groups[(controller, noise)] = ratios
         ticks = [r["ticks_to_goal"] for r in sel if r["ticks_to_goal"] not in (None, "")]
         lines.append([label(controller, noise), S.proportion_ci(ok, len(sel)).text(3),
                       S.mean_ci(ratios).text(3) if len(ratios) > 1 else "–",
@@ -126,31 +129,40 @@ def _pairs_section(case: str, rows: list[dict], quick: bool):
     spa_low, spa_high = _by_pair(kept, "dft", "low"), _by_pair(kept, "dft", "high")
     common = sorted(spa_low.keys() & spa_high.keys())
     low_ok = [bool(spa_low[k]["reached"]) for k in common]
-    anova = S.anova(groups)
+    anovas = {ftc: S.anova([groups[k] for k in five(ftc)]) for ftc in ("carrot", PAPER_FTC)}
     claims = [
         P.Claim(f"{case}: SPA (low noise) reaches the goal in most runs in {maze}", "most (Fig. 7)",
                 S.proportion_ci(sum(low_ok), len(low_ok)).text(3), S.binomial(sum(low_ok), len(low_ok), 0.5)),
         P.Claim(f"{case}: noise does not change SPA's successes (low against high)", "no significant effect",
                 S.proportion_ci(sum(bool(spa_high[k]["reached"]) for k in common), len(common)).text(3) + " at high",
                 S.mcnemar(low_ok, [bool(spa_high[k]["reached"]) for k in common]), expected=0),
-        P.Claim(f"{case}: L_p / L_o does not differ between the five conditions (one-way ANOVA)",
-                f"F = {paper.ANOVA_F[case]}", f"F = {anova.statistic:.2f}", anova, expected=0),
     ]  # fmt: skip
+    for ftc, anova in anovas.items():
+        which = "" if ftc == "carrot" else ", follow the carrot as Appendix B prints it (FTCp)"
+        claims.append(P.Claim(f"{case}: L_p / L_o does not differ between the five conditions{which} (one-way "
+                              "ANOVA)", f"F = {paper.ANOVA_F[case]}", f"F = {anova.statistic:.2f}", anova,
+                              expected=0))  # fmt: skip
     if case == "case2":
-        ftc = _by_pair(kept, "carrot", "low")
-        both = sorted(spa_low.keys() & ftc.keys())
-        claims.append(P.Claim("case2: follow the carrot (low noise) succeeds notably less often than SPA in the "
-                              "large maze", "notably fewer (Fig. 7)",
-                              "SPA - FTC = " + S.number(np.mean([bool(spa_low[k]["reached"]) - bool(ftc[k]["reached"])
-                                                                  for k in both]), 3),
-                              S.mcnemar([bool(spa_low[k]["reached"]) for k in both],
-                                        [bool(ftc[k]["reached"]) for k in both])))  # fmt: skip
+        for controller in ("carrot", PAPER_FTC):
+            ftc = _by_pair(kept, controller, "low")
+            both = sorted(spa_low.keys() & ftc.keys())
+            which = "" if controller == "carrot" else " as Appendix B prints it (FTCp)"
+            claims.append(P.Claim(f"case2: follow the carrot{which} (low noise) succeeds notably less often than SPA "
+                                  "in the large maze", "notably fewer (Fig. 7)",
+                                  f"SPA - {ftc_name(controller)} = "
+                                  + S.number(np.mean([bool(spa_low[k]["reached"]) - bool(ftc[k]["reached"])
+                                                      for k in both]), 3),
+                                  S.mcnemar([bool(spa_low[k]["reached"]) for k in both],
+                                            [bool(ftc[k]["reached"]) for k in both])))  # fmt: skip
     table = R.markdown_table(["condition", "reached (Wilson 95% CI)", "L_p / L_o, reached runs (95% CI)",
                               "median steps to goal"], lines)  # fmt: skip
     dropped = f"; {left_out} pairs with the goal within {SUCCESS_RADIUS * 100:.0f} cm of the start left out"
     limit = (f"--quick stops the runs at {QUICK_CASE2_STEPS} steps" if quick and case == "case2"
              else f"at most {paper.MAX_STEPS} steps of 64 ms")  # fmt: skip
-    note = f"\n{len({r['pair'] for r in kept})} pairs{dropped if left_out else ''}; {limit}.\n"
+    note = (
+        f"\n{len({r['pair'] for r in kept})} pairs{dropped if left_out else ''}; {limit}.  FTC is our follow "
+        'the carrot, FTCp Appendix B\'s as printed ([carrot] variant = "paper"), on the same pairs and seeds.\n'
+    )
     return f"Case {case[-1]}: SPA beside follow the carrot in {maze}", table + note, claims
 
 
