@@ -417,6 +417,24 @@ def test_loop_closures_are_judged_true_or_false_and_revisits_recalled():
     assert revisits_recalled(missed, HAND_ZONES) == (1, 0)
 
 
+def test_the_floors_place_graph_joins_places_through_doors_and_the_corridor_only():
+    from swarm.experiments.tapus2006.fingerprint import link_topology, place_graph, places
+    from swarm.scenario import load_scenario
+
+    s = load_scenario("office")
+    index = {name: k for k, (name, _) in enumerate(places(s))}
+    graph = place_graph(s)
+    assert len(graph) == 16 + 3  # every room's door onto the corridor, the corridor's four zones in a row
+    assert frozenset((index["room_n0"], index["corridor_0"])) in graph
+    assert frozenset((index["corridor_0"], index["corridor_1"])) in graph
+    assert frozenset((index["room_n0"], index["room_n1"])) not in graph  # a wall, no door
+    run = _hand_run([1.0, 5.0, 11.0, 6.0], [0, 1, 2, 3])  # room a, corridor, room b, corridor
+    run["map"]["links"] = [[0, 1], [1, 3], [3, 2], [0, 2]]
+    hand = {frozenset((0, 1)), frozenset((1, 2))}
+    assert link_topology(run, HAND_ZONES, hand) == {"links_same_place": 1, "links_adjacent": 2,
+                                                    "links_not_adjacent": 1}  # fmt: skip
+
+
 def test_localization_on_the_second_tour_beats_matching_alone_and_chance():
     from swarm.experiments.tapus2006.fingerprint import localize_job
 

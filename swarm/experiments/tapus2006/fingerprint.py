@@ -68,6 +68,53 @@ def place_of(xy: np.ndarray, zones: list) -> int:
     return where
 
 
+def place_graph(scenario, door: float = 0.5, gap: float = 0.3) -> set[frozenset[int]]:
+    """The floor's place graph: pairs of place zones (indices into places()) that the robot can pass
+    between directly, those whose rectangles lie within `gap` of each other along a stretch at least
+    `door` wide that no wall blocks (a door, or the corridor going on).  Ground truth, for judging maps."""
+    zones = places(scenario)
+    walls = [w.coords for w in scenario.walls if w.shape == "rect"]
+    graph = set()
+    for a, (_, ra) in enumerate(zones):
+        for b in range(a + 1, len(zones)):
+            rb = zones[b][1]
+            for axis in (0, 1):  # the gap lies across `axis`, the shared stretch along the other
+                lo, hi = sorted((ra, rb), key=lambda r: r[axis])
+                between = hi[axis] - lo[axis + 2]
+                other = 1 - axis
+                start, end = max(ra[other], rb[other]), min(ra[other + 2], rb[other + 2])
+                if not (-1e-9 <= between <= gap) or end - start < door:
+                    continue
+                mid = (lo[axis + 2] + hi[axis]) / 2
+                free = stretch = 0.0
+                for t in np.arange(start, end, 0.05):
+                    pt = [0.0, 0.0]
+                    pt[axis], pt[other] = mid, t
+                    blocked = any(w[0] <= pt[0] <= w[2] and w[1] <= pt[1] <= w[3] for w in walls)
+                    stretch = 0.0 if blocked else stretch + 0.05
+                    free = max(free, stretch)
+                if free >= door:
+                    graph.add(frozenset((a, b)))
+    return graph
+
+
+def link_topology(run: dict, zones: list, graph: set[frozenset[int]]) -> dict[str, int]:
+    """The map's links against the floor's place graph (place_graph), each link's ends at their nodes'
+    places (node_places): within one place, between places adjacent on the floor, or between places
+    that are not (a link the floor does not have)."""
+    labels = node_places(run, zones)
+    held = set(run["believed"].tolist())
+    same = adjacent = apart = 0
+    for a, b, *_ in run["map"]["links"]:
+        if a not in held or b not in held:
+            continue
+        pa, pb = int(labels[a]), int(labels[b])
+        same += pa == pb
+        adjacent += pa != pb and frozenset((pa, pb)) in graph
+        apart += pa != pb and frozenset((pa, pb)) not in graph
+    return {"links_same_place": same, "links_adjacent": adjacent, "links_not_adjacent": apart}
+
+
 def tour_scenario(name: str, route: str, noise: str, seed: int, table: dict | None = None):
     from swarm.scenario import load_scenario
 
@@ -128,7 +175,8 @@ def node_places(run: dict, zones: list) -> np.ndarray:
     return counts.argmax(axis=1)
 
 
-def judge_map(run: dict, zones: list) -> dict[str, Any]:
+def judge_map(run: dict, zones: list, graph: set[frozenset[int]] | None = None) -> dict[str, Any]:
+    """The map against the floor's places; with the floor's place graph, its links against it too."""
     labels = node_places(run, zones)
     truth = np.array([place_of(xy, zones) for xy in run["truth"][:, :2]])
     visited = set(truth.tolist())
@@ -145,7 +193,8 @@ def judge_map(run: dict, zones: list) -> dict[str, Any]:
             "room_revisits_closed": closed, "false_closures": false_closures(run, zones),
             **closure_scores(run, zones),
             "corridor_seen_again_on_old_node": round(ground_seen_again(run["truth"][:, :2], first, truth, ~rooms),
-                                                     4)}  # fmt: skip
+                                                     4),
+            **(link_topology(run, zones, graph) if graph is not None else {})}  # fmt: skip
 
 
 def far_apart(zones: list) -> float:
@@ -275,7 +324,7 @@ def map_job(job: tuple) -> dict:
     s = tour_scenario(name, route, noise, seed, {"theta": theta})
     run = drive_tour(s)
     return {"scenario": name, "route": route, "noise": noise, "seed": seed, "theta": theta, "ticks": run["ticks"],
-            **judge_map(run, places(s)), "wall_seconds": round(run["wall_seconds"], 2)}  # fmt: skip
+            **judge_map(run, places(s), place_graph(s)), "wall_seconds": round(run["wall_seconds"], 2)}  # fmt: skip
 
 
 def right_nodes(mapped: dict, xy: np.ndarray, aliased: dict[int, int] | None = None,

@@ -30,7 +30,7 @@ from swarm.experiments import protocol as P
 from swarm.experiments import report as R
 from swarm.experiments import stats as S
 from swarm.experiments.runner import Outputs, batch_run
-from swarm.experiments.tapus2006 import paper
+from swarm.experiments.tapus2006 import fingerprint, paper
 from swarm.experiments.tapus2006.fingerprint import NOISES, drive_tour, judge_map, localize_run, places, tour_scenario
 from swarm.experiments.tapus2006.team import TEAMS, team_job
 
@@ -40,7 +40,8 @@ REPS = {"localize": 60, "loops": 40, "together": 10}
 QUICK_REPS = {"localize": 2, "loops": 2, "together": 1}
 QUICK_TEAMS = (1, 2)  # --quick surveys with one and two robots only
 MAP_FIELDS = ("nodes", "places_visited", "places_with_node", "purity", "false_closures", "closure_events",
-              "true_closures", "closure_precision", "room_revisits", "revisits_recalled", "closure_recall")  # fmt: skip
+              "true_closures", "closure_precision", "room_revisits", "revisits_recalled", "closure_recall",
+              "links_same_place", "links_adjacent", "links_not_adjacent")  # fmt: skip
 TITLE = "Tapus, Battaglia & Siegwart (2006)"
 CONTROLLERS = ("fingerprint",)
 DESIGN = (
@@ -71,11 +72,13 @@ def run_job(job: tuple[str, str | int, int]) -> dict:
     head = {"experiment": kind, "noise": noise, "seed": seed}
     if kind == "localize":
         mapped, counts = localize_run(FLOOR, noise, seed, "localize")
-        judged = judge_map(mapped, places(tour_scenario(FLOOR, "mapping", noise, seed)))
+        s = tour_scenario(FLOOR, "mapping", noise, seed)
+        judged = judge_map(mapped, places(s), fingerprint.place_graph(s))
         return head | {"localize_seed": seed + 1000} | {k: judged[k] for k in MAP_FIELDS} | counts
     s = tour_scenario(FLOOR, "localize", noise, seed)
     run = drive_tour(s)
-    return head | judge_map(run, places(s)) | {"wall_seconds": round(run["wall_seconds"], 2)}
+    judged = judge_map(run, places(s), fingerprint.place_graph(s))
+    return head | judged | {"wall_seconds": round(run["wall_seconds"], 2)}
 
 
 def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = None, progress: bool = True) -> dict:
@@ -120,6 +123,13 @@ def against(values: np.ndarray, target: float) -> S.Comparison:
     return S.wilcoxon_paired(values, np.full(len(values), target))
 
 
+def _links(sel: Sequence[dict]) -> str:
+    """The map's links a run: within one place / between adjacent places / between places not adjacent
+    (the last with its 95% CI over runs)."""
+    not_adjacent = S.mean_ci(_col(sel, "links_not_adjacent")).text(3)
+    return f"{np.mean(_col(sel, 'links_same_place')):.1f} / {np.mean(_col(sel, 'links_adjacent')):.1f} / {not_adjacent}"
+
+
 def _share_of_runs(sel: Sequence[dict], right: str, total: str = "on_map") -> tuple[np.ndarray, S.Estimate,
                                                                                      S.Estimate]:  # fmt: skip
     """(per-run shares, their mean with the bootstrap interval over runs, the pooled Wilson interval)."""
@@ -143,20 +153,22 @@ def _mapping(rows: Sequence[dict]):
                       S.mean_ci(_col(sel, "purity")).text(3),
                       f"{false}/{len(sel)}: {_pct(S.proportion_ci(false, len(sel)))}",
                       f"{np.mean(_col(sel, 'closure_events')):.1f}",
-                      _pct(S.mean_ci(_col(sel, "closure_precision")))])  # fmt: skip
+                      _pct(S.mean_ci(_col(sel, "closure_precision"))), _links(sel)])  # fmt: skip
         claims.append(P.Claim(f"noise {noise}: the map of the {paper.MAPPING_TOUR_M} m tour has {paper.NODES} nodes",
                               f"{paper.NODES} (1 run)", f"{est.text(3)} (mean of {len(sel)} runs)",
                               against(nodes, paper.NODES), expected=0))  # fmt: skip
     table = R.markdown_table(["noise", "runs", "nodes (95% CI)", "paper", "places with a node / visited",
                               "purity (95% CI)", "runs with a false closure (Wilson 95% CI)",
-                              "loop closures a run", "closure precision (95% CI over runs)"], lines)  # fmt: skip
+                              "loop closures a run", "closure precision (95% CI over runs)",
+                              "links a run: in one place / adjacent places / places not adjacent"], lines)  # fmt: skip
     note = ("\nPurity: the share of fingerprints whose node's place (where most of its fingerprints were taken) is "
             "where they were taken. A false closure: a node holding fingerprints taken farther apart than the "
             "diagonal of the floor's largest place zone (8.2 m), which no one place can hold: an aliased node. A loop "
             "closure: a fingerprint joining a node made before that is not the node of the fingerprint before; true "
             "when the robot stood in the place where most of the node's earlier fingerprints were taken, or within "
             "1 m of one of them. Precision: true closures over closures, per run (runs without a closure left "
-            "out).\n")  # fmt: skip
+            "out). Links: the map's links, each end at its node's place, against the floor's place graph (places "
+            "joined by a door or the corridor going on, from the floor's zones and walls: 19 pairs).\n")  # fmt: skip
     return f"Mapping: the {paper.MAPPING_TOUR_M} m tour (ours 76 m)", table + note, claims
 
 
@@ -224,7 +236,8 @@ def _loops(rows: Sequence[dict]):
         false = int((_col(sel, "false_closures") > 0).sum())
         lines.append([noise, str(len(sel)), f"{np.mean(_col(sel, 'room_revisits')):.1f}", _pct(r_est), _pct(r_pool),
                       _pct(est), f"{np.mean(_col(sel, 'closure_events')):.1f}",
-                      _pct(S.mean_ci(_col(sel, "closure_precision"))), S.mean_ci(_col(sel, "nodes")).text(3),
+                      _pct(S.mean_ci(_col(sel, "closure_precision"))), _links(sel),
+                      S.mean_ci(_col(sel, "nodes")).text(3),
                       _pct(S.mean_ci(_col(sel, "corridor_seen_again_on_old_node"))),
                       f"{false}/{len(sel)}: {_pct(S.proportion_ci(false, len(sel)))}"])  # fmt: skip
         claims.append(P.Claim(f"noise {noise}: the robot closes the loops every time (room revisits joining the "
@@ -233,7 +246,8 @@ def _loops(rows: Sequence[dict]):
                               expected=0))  # fmt: skip
     table = R.markdown_table(["noise", "runs", "room revisits a run", "recall: closed onto the room (95% CI over "
                               "runs)", "recall, pooled (Wilson)", "closed onto any old node", "loop closures a run",
-                              "closure precision (95% CI over runs)", "nodes (95% CI)",
+                              "closure precision (95% CI over runs)", "links: one place / adjacent / not",
+                              "nodes (95% CI)",
                               "corridor seen again: on an old node", "runs with a false closure (Wilson 95% CI)"],
                              lines)  # fmt: skip
     note = ("\nA room revisit: a visit (3 fingerprints or more) to a room seen on an earlier visit. Recall: the "
