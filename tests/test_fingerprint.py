@@ -415,6 +415,10 @@ def test_loop_closures_are_judged_true_or_false_and_revisits_recalled():
     missed = _hand_run(xs, [0, 0, 0, 1, 1, 1, 2, 2, 2, 1, 1, 1, 3, 3, 3])  # room a again on a new node
     assert closure_events(missed, HAND_ZONES) == (1, 1)
     assert revisits_recalled(missed, HAND_ZONES) == (1, 0)
+    for x, true in ((1.0, 1), (11.0, 0)):  # a young node 2 folded into node 0, in room a (true), in room b (false)
+        folded = _hand_run([1.0] * 3 + [5.0] * 3 + [x] * 3, [0, 0, 0, 1, 1, 1, 2, 0, 0])
+        folded["believed"] = np.array([0, 0, 0, 1, 1, 1, 0, 0, 0])  # node 2 stands for node 0
+        assert closure_events(folded, HAND_ZONES) == (1, true)
 
 
 def test_the_floors_place_graph_joins_places_through_doors_and_the_corridor_only():

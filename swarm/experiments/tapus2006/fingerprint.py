@@ -236,7 +236,7 @@ def closure_events(run: dict, zones: list) -> tuple[int, int]:
     fingerprint joined a node that existed before it and is not the node of the fingerprint before
     (the map's `closures`: a move onto a known node, or a young node folded into one).  It is true when
     the robot stood within the place of the node's earlier fingerprints: in the place where most of
-    them were taken, or within OFF_MAP of one of them."""
+    them were taken (a young node folded into it counts not), or within OFF_MAP of one of them."""
     joined, after = run["joined"], run["nodes_after"]
     xy, nodes = run["truth"][:, :2], run["believed"]
     where = np.array([place_of(p, zones) for p in xy], np.int64)
@@ -245,7 +245,8 @@ def closure_events(run: dict, zones: list) -> tuple[int, int]:
         if joined[i] == joined[i - 1] or joined[i] >= after[i - 1]:
             continue
         events += 1
-        earlier = np.flatnonzero(nodes[:i] == nodes[i])
+        # the node's fingerprints before, less those of a young node folded into it right here
+        earlier = np.flatnonzero((nodes[:i] == nodes[i]) & (joined[:i] != joined[i - 1]))
         if not len(earlier):
             continue
         home = np.bincount(where[earlier]).argmax()
