@@ -371,6 +371,74 @@ def test_a_room_revisit_counts_as_closed_when_it_joins_the_nodes_made_before():
     assert revisits([0, 0, 0, 1, 1, 1, 0, 0, 0, 1], ~rooms) == (0, 0)  # the corridor's second visit is one print
 
 
+def _hand_run(xs: list[float], joined: list[int]) -> dict:
+    """A hand-made mapping run along y = 1: true x per fingerprint, the node each joined (no folds)."""
+    joined_ = np.array(joined, np.int64)
+    return {"truth": np.array([[x, 1.0, 0.0] for x in xs]), "believed": joined_, "joined": joined_,
+            "nodes_after": np.maximum.accumulate(joined_) + 1, "size": int(joined_.max()) + 1,
+            "map": {"nodes": [{}] * (int(joined_.max()) + 1), "links": []}}  # fmt: skip
+
+
+HAND_ZONES = [("room-a", (0.0, 0.0, 2.0, 2.0)), ("corridor", (2.0, 0.0, 10.0, 2.0)), ("room-b", (10.0, 0.0, 12.0, 2.0))]
+
+
+def test_an_aliased_node_is_right_only_at_its_own_place():
+    from swarm.experiments.tapus2006.fingerprint import aliased_nodes, localization_counts, right_nodes
+
+    # node 0: three fingerprints in room a and one in room b, 10 m away (more than the corridor's 8.2 m
+    # diagonal): aliased, its place room a; node 1 in room b beside that one
+    mapped = _hand_run([1.0, 1.1, 1.2, 11.0, 11.2, 11.3], [0, 0, 0, 0, 1, 1])
+    aliased = aliased_nodes(mapped, HAND_ZONES)
+    assert aliased == {0: 0}
+    assert right_nodes(mapped, np.array([1.0, 1.0]), aliased, HAND_ZONES) == {0}
+    assert right_nodes(mapped, np.array([11.0, 1.0]), aliased, HAND_ZONES) == {1}  # wrong at the far end
+    assert right_nodes(mapped, np.array([11.0, 1.0])) == {0, 1}  # the loose rule: right at both ends
+    loc = {"truth": np.array([[1.0, 1.0, 0.0], [11.0, 1.0, 0.0]]), "matched": np.array([0, 0]),
+           "believed": np.array([0, 0]), "believed_links": np.array([0, 1]),
+           "likelihoods": [np.array([0.9, 0.1])] * 2}  # fmt: skip
+    c = localization_counts(mapped, loc, HAND_ZONES)
+    assert (c["aliased_nodes"], c["on_map"]) == (1, 2)
+    assert (c["match_right"], c["markov_right"], c["links_right"]) == (1, 1, 2)
+    assert (c["match_right_loose"], c["markov_right_loose"], c["links_right_loose"]) == (2, 2, 2)
+    assert c["missed_rank2"] == 1  # at room b the right node, 1, came second
+
+
+def test_loop_closures_are_judged_true_or_false_and_revisits_recalled():
+    from swarm.experiments.tapus2006.fingerprint import closure_events, closure_scores, revisits_recalled
+
+    xs = [1.0] * 3 + [5.0] * 3 + [1.0] * 3 + [5.0] * 3 + [11.0] * 3  # room a, corridor, a, corridor, room b
+    run = _hand_run(xs, [0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0])
+    assert closure_events(run, HAND_ZONES) == (3, 2)  # back into room a and the corridor: true; room b onto a: false
+    assert revisits_recalled(run, HAND_ZONES) == (1, 1)  # room a seen again, on its old node
+    scores = closure_scores(run, HAND_ZONES)
+    assert (scores["closure_precision"], scores["closure_recall"]) == (0.6667, 1.0)
+    missed = _hand_run(xs, [0, 0, 0, 1, 1, 1, 2, 2, 2, 1, 1, 1, 3, 3, 3])  # room a again on a new node
+    assert closure_events(missed, HAND_ZONES) == (1, 1)
+    assert revisits_recalled(missed, HAND_ZONES) == (1, 0)
+    for x, true in ((1.0, 1), (11.0, 0)):  # a young node 2 folded into node 0, in room a (true), in room b (false)
+        folded = _hand_run([1.0] * 3 + [5.0] * 3 + [x] * 3, [0, 0, 0, 1, 1, 1, 2, 0, 0])
+        folded["believed"] = np.array([0, 0, 0, 1, 1, 1, 0, 0, 0])  # node 2 stands for node 0
+        assert closure_events(folded, HAND_ZONES) == (1, true)
+
+
+def test_the_floors_place_graph_joins_places_through_doors_and_the_corridor_only():
+    from swarm.experiments.tapus2006.fingerprint import link_topology, place_graph, places
+    from swarm.scenario import load_scenario
+
+    s = load_scenario("office")
+    index = {name: k for k, (name, _) in enumerate(places(s))}
+    graph = place_graph(s)
+    assert len(graph) == 16 + 3  # every room's door onto the corridor, the corridor's four zones in a row
+    assert frozenset((index["room_n0"], index["corridor_0"])) in graph
+    assert frozenset((index["corridor_0"], index["corridor_1"])) in graph
+    assert frozenset((index["room_n0"], index["room_n1"])) not in graph  # a wall, no door
+    run = _hand_run([1.0, 5.0, 11.0, 6.0], [0, 1, 2, 3])  # room a, corridor, room b, corridor
+    run["map"]["links"] = [[0, 1], [1, 3], [3, 2], [0, 2]]
+    hand = {frozenset((0, 1)), frozenset((1, 2))}
+    assert link_topology(run, HAND_ZONES, hand) == {"links_same_place": 1, "links_adjacent": 2,
+                                                    "links_not_adjacent": 1}  # fmt: skip
+
+
 def test_localization_on_the_second_tour_beats_matching_alone_and_chance():
     from swarm.experiments.tapus2006.fingerprint import localize_job
 

@@ -24,7 +24,9 @@ only, to judge the maps; the controller never sees it.  A node's place is
 the place where most of its fingerprints were taken (for the map against
 the floor's places).  A fingerprint of the second tour is localized right
 when its node holds a mapping fingerprint taken where the nearest one was
-(within TOLERANCE more); fingerprints farther than OFF_MAP from every
+(within TOLERANCE more) and, for an aliased node (one holding fingerprints
+taken farther apart than one place spans: a false loop closure), only where
+the node's place is (right_nodes); fingerprints farther than OFF_MAP from every
 mapping fingerprint (off the mapped floor) are left out of the shares
 (their count is reported).
 """
@@ -64,6 +66,53 @@ def place_of(xy: np.ndarray, zones: list) -> int:
         if d < best:
             best, where = d, k
     return where
+
+
+def place_graph(scenario, door: float = 0.5, gap: float = 0.3) -> set[frozenset[int]]:
+    """The floor's place graph: pairs of place zones (indices into places()) that the robot can pass
+    between directly, those whose rectangles lie within `gap` of each other along a stretch at least
+    `door` wide that no wall blocks (a door, or the corridor going on).  Ground truth, for judging maps."""
+    zones = places(scenario)
+    walls = [w.coords for w in scenario.walls if w.shape == "rect"]
+    graph = set()
+    for a, (_, ra) in enumerate(zones):
+        for b in range(a + 1, len(zones)):
+            rb = zones[b][1]
+            for axis in (0, 1):  # the gap lies across `axis`, the shared stretch along the other
+                lo, hi = sorted((ra, rb), key=lambda r: r[axis])
+                between = hi[axis] - lo[axis + 2]
+                other = 1 - axis
+                start, end = max(ra[other], rb[other]), min(ra[other + 2], rb[other + 2])
+                if not (-1e-9 <= between <= gap) or end - start < door:
+                    continue
+                mid = (lo[axis + 2] + hi[axis]) / 2
+                free = stretch = 0.0
+                for t in np.arange(start, end, 0.05):
+                    pt = [0.0, 0.0]
+                    pt[axis], pt[other] = mid, t
+                    blocked = any(w[0] <= pt[0] <= w[2] and w[1] <= pt[1] <= w[3] for w in walls)
+                    stretch = 0.0 if blocked else stretch + 0.05
+                    free = max(free, stretch)
+                if free >= door:
+                    graph.add(frozenset((a, b)))
+    return graph
+
+
+def link_topology(run: dict, zones: list, graph: set[frozenset[int]]) -> dict[str, int]:
+    """The map's links against the floor's place graph (place_graph), each link's ends at their nodes'
+    places (node_places): within one place, between places adjacent on the floor, or between places
+    that are not (a link the floor does not have)."""
+    labels = node_places(run, zones)
+    held = set(run["believed"].tolist())
+    same = adjacent = apart = 0
+    for a, b, *_ in run["map"]["links"]:
+        if a not in held or b not in held:
+            continue
+        pa, pb = int(labels[a]), int(labels[b])
+        same += pa == pb
+        adjacent += pa != pb and frozenset((pa, pb)) in graph
+        apart += pa != pb and frozenset((pa, pb)) not in graph
+    return {"links_same_place": same, "links_adjacent": adjacent, "links_not_adjacent": apart}
 
 
 def tour_scenario(name: str, route: str, noise: str, seed: int, table: dict | None = None):
@@ -111,6 +160,7 @@ def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000) -> dict[
     believed, matched, by_links = (resolve(log[:, k]) if len(log) else log[:, k] for k in (1, 2, 4))
     return {"ticks": engine.tick, "truth": np.array(truth).reshape(-1, 3), "believed": believed,
             "matched": matched, "believed_links": by_links, "size": c.map.size, "likelihoods": likelihoods,
+            "joined": log[:, 1], "nodes_after": log[:, 3],
             "map": c.map_data(),
             "closures": c.map.closures, "fingerprints": prints, "finished": c.finished,
             "wall_seconds": engine.wall_seconds}  # fmt: skip
@@ -125,7 +175,8 @@ def node_places(run: dict, zones: list) -> np.ndarray:
     return counts.argmax(axis=1)
 
 
-def judge_map(run: dict, zones: list) -> dict[str, Any]:
+def judge_map(run: dict, zones: list, graph: set[frozenset[int]] | None = None) -> dict[str, Any]:
+    """The map against the floor's places; with the floor's place graph, its links against it too."""
     labels = node_places(run, zones)
     truth = np.array([place_of(xy, zones) for xy in run["truth"][:, :2]])
     visited = set(truth.tolist())
@@ -140,21 +191,91 @@ def judge_map(run: dict, zones: list) -> dict[str, Any]:
             "nodes_per_place": round(run["size"] / max(len(visited), 1), 2), "purity": round(float(pure), 4),
             "links": len(run["map"]["links"]), "closures": run["closures"], "room_revisits": revisits,
             "room_revisits_closed": closed, "false_closures": false_closures(run, zones),
+            **closure_scores(run, zones),
             "corridor_seen_again_on_old_node": round(ground_seen_again(run["truth"][:, :2], first, truth, ~rooms),
-                                                     4)}  # fmt: skip
+                                                     4),
+            **(link_topology(run, zones, graph) if graph is not None else {})}  # fmt: skip
+
+
+def far_apart(zones: list) -> float:
+    """The distance no one place spans: the diagonal of the floor's largest place zone."""
+    return max(math.hypot(x1 - x0, y1 - y0) for _, (x0, y0, x1, y1) in zones)
+
+
+def aliased_nodes(run: dict, zones: list) -> dict[int, int]:
+    """The aliased nodes, each with its place (node_places): nodes holding fingerprints taken farther apart
+    than any two points of one place (far_apart), loops closed onto the wrong place, e.g. the corridor's two
+    look-alike ends joined in one node.  Ground truth judges the map here; the controller never sees it."""
+    far, labels = far_apart(zones), node_places(run, zones)
+    xy, nodes = run["truth"][:, :2], run["believed"]
+    aliased = {}
+    for node in np.unique(nodes):
+        p = xy[nodes == node]
+        if np.hypot(*(p[:, None, :] - p[None, :, :]).transpose(2, 0, 1)).max() > far:
+            aliased[int(node)] = int(labels[node])
+    return aliased
+
+
+def closure_scores(run: dict, zones: list) -> dict[str, Any]:
+    """Loop-closure precision (true closures / closures, closure_events) and recall (room revisits
+    recalled / room revisits, revisits_recalled); nan where there is nothing to divide."""
+    events, true = closure_events(run, zones)
+    revisits, recalled = revisits_recalled(run, zones)
+    return {"closure_events": events, "true_closures": true, "revisits_recalled": recalled,
+            "closure_precision": round(true / events, 4) if events else math.nan,
+            "closure_recall": round(recalled / revisits, 4) if revisits else math.nan}  # fmt: skip
 
 
 def false_closures(run: dict, zones: list) -> int:
-    """Nodes holding fingerprints taken farther apart than any two points of one place (the diagonal of
-    the floor's largest place zone): loops closed onto the wrong place, e.g. the corridor's two look-alike
-    ends joined in one node.  Ground truth judges the map here; the controller never sees it."""
-    far = max(math.hypot(x1 - x0, y1 - y0) for _, (x0, y0, x1, y1) in zones)
+    """How many nodes are aliased (aliased_nodes)."""
+    return len(aliased_nodes(run, zones))
+
+
+def closure_events(run: dict, zones: list) -> tuple[int, int]:
+    """The map's loop closures judged against ground truth: (closures, true ones).  A closure: a
+    fingerprint joined a node that existed before it and is not the node of the fingerprint before
+    (the map's `closures`: a move onto a known node, or a young node folded into one).  It is true when
+    the robot stood within the place of the node's earlier fingerprints: in the place where most of
+    them were taken (a young node folded into it counts not), or within OFF_MAP of one of them."""
+    joined, after = run["joined"], run["nodes_after"]
     xy, nodes = run["truth"][:, :2], run["believed"]
-    wrong = 0
-    for node in np.unique(nodes):
-        p = xy[nodes == node]
-        wrong += int(np.hypot(*(p[:, None, :] - p[None, :, :]).transpose(2, 0, 1)).max() > far)
-    return wrong
+    where = np.array([place_of(p, zones) for p in xy], np.int64)
+    events = true = 0
+    for i in range(1, len(joined)):
+        if joined[i] == joined[i - 1] or joined[i] >= after[i - 1]:
+            continue
+        events += 1
+        # the node's fingerprints before, less those of a young node folded into it right here
+        earlier = np.flatnonzero((nodes[:i] == nodes[i]) & (joined[:i] != joined[i - 1]))
+        if not len(earlier):
+            continue
+        home = np.bincount(where[earlier]).argmax()
+        true += int(home == where[i] or np.hypot(*(xy[earlier] - xy[i]).T).min() <= OFF_MAP)
+    return events, true
+
+
+def revisits_recalled(run: dict, zones: list, least: int = 3) -> tuple[int, int]:
+    """The loops the map should close, judged against ground truth: (room revisits, those recalled).  A
+    room revisit as in room_revisits; recalled when most of its fingerprints joined nodes made before the
+    visit began that hold a fingerprint taken in that room before it (a true closure onto the room)."""
+    nodes = run["believed"]
+    place = np.array([place_of(p, zones) for p in run["truth"][:, :2]], np.int64)
+    rooms = np.array([name.startswith("room") for name, _ in zones], np.bool_)
+    first = first_use(nodes)
+    seen, revisits, recalled, i = set(), 0, 0, 0
+    while i < len(place):
+        j = i
+        while j < len(place) and place[j] == place[i]:
+            j += 1
+        if j - i >= least and rooms[place[i]]:
+            if place[i] in seen:
+                revisits += 1
+                before = set(nodes[:i][place[:i] == place[i]].tolist())
+                right = [first[k] < i and int(nodes[k]) in before for k in range(i, j)]
+                recalled += int(np.mean(right) >= 0.5)
+            seen.add(int(place[i]))
+        i = j
+    return revisits, recalled
 
 
 def first_use(believed: np.ndarray) -> np.ndarray:
@@ -204,51 +325,68 @@ def map_job(job: tuple) -> dict:
     s = tour_scenario(name, route, noise, seed, {"theta": theta})
     run = drive_tour(s)
     return {"scenario": name, "route": route, "noise": noise, "seed": seed, "theta": theta, "ticks": run["ticks"],
-            **judge_map(run, places(s)), "wall_seconds": round(run["wall_seconds"], 2)}  # fmt: skip
+            **judge_map(run, places(s), place_graph(s)), "wall_seconds": round(run["wall_seconds"], 2)}  # fmt: skip
 
 
-def right_nodes(mapped: dict, xy: np.ndarray) -> set[int] | None:
-    """The nodes that stand for where `xy` is: those holding a mapping fingerprint
-    taken within TOLERANCE of the nearest one; None off the mapped floor (no
-    mapping fingerprint within OFF_MAP)."""
+def right_nodes(mapped: dict, xy: np.ndarray, aliased: dict[int, int] | None = None,
+                zones: list | None = None) -> set[int] | None:  # fmt: skip
+    """The nodes that stand for where `xy` is: those holding a mapping fingerprint taken within TOLERANCE
+    of the nearest one, less each aliased node (aliased_nodes: node -> its place) whose place is not the
+    place of `xy`: an aliased node is right only at its place, where most of its fingerprints were taken,
+    and wrong at the far end it was joined to.  None off the mapped floor (no mapping fingerprint within
+    OFF_MAP).  Without `aliased` every node is right wherever it holds a fingerprint (the loose rule)."""
     d = np.hypot(*(mapped["truth"][:, :2] - xy).T)
     if not len(d) or d.min() > OFF_MAP:
         return None
-    return set(mapped["believed"][d <= d.min() + TOLERANCE].tolist())
+    right = set(mapped["believed"][d <= d.min() + TOLERANCE].tolist())
+    if aliased:
+        here = place_of(xy, zones)
+        right = {n for n in right if aliased.get(n, here) == here}
+    return right
 
 
 def localize_run(name: str, noise: str, seed: int, route: str) -> tuple[dict, dict]:
     """The map of the mapping tour (odometry and sensor noise drawn from `seed`), then the `route` tour
     localizing on it (drawn from seed + 1000): (the mapping run, localization_counts)."""
-    mapped = drive_tour(tour_scenario(name, "mapping", noise, seed))
+    s = tour_scenario(name, "mapping", noise, seed)
+    mapped = drive_tour(s)
     loc = drive_tour(tour_scenario(name, route, noise, seed + 1000), topomap=mapped["map"])
-    return mapped, {**localization_counts(mapped, loc), "ticks": loc["ticks"], "finished": loc["finished"],
+    return mapped, {**localization_counts(mapped, loc, places(s)), "ticks": loc["ticks"],
+                    "finished": loc["finished"],
                     "wall_seconds": round(mapped["wall_seconds"] + loc["wall_seconds"], 2)}  # fmt: skip
 
 
-def localization_counts(mapped: dict, loc: dict) -> dict:
+def localization_counts(mapped: dict, loc: dict, zones: list) -> dict:
     """Per second tour: how many fingerprints were on the mapped floor, how many of them each of matching
-    alone, the grid filter and the links-only filter put at a right node, the mean chance of a node drawn
-    at random being right, and where the right node ranked among the matches when matching missed."""
+    alone, the grid filter and the links-only filter put at a right node (right_nodes: an aliased node
+    counts right only at its own place), the same by the loose rule (`*_right_loose`: an aliased node
+    right at both ends), the mean chance of a node drawn at random being right, and where the right node
+    ranked among the matches when matching missed."""
     k = mapped["size"]
-    by_match, by_markov, by_links, ranks, chance, off = [], [], [], [], [], 0
+    aliased = aliased_nodes(mapped, zones)
+    by_match, by_markov, by_links, loose, ranks, chance, off = [], [], [], [], [], [], 0
     for xy, matched, believed, linked, like in zip(loc["truth"][:, :2], loc["matched"], loc["believed"],
                                                    loc["believed_links"], loc["likelihoods"], strict=True):  # fmt: skip
-        right = right_nodes(mapped, xy)
+        right = right_nodes(mapped, xy, aliased, zones)
         if right is None:
             off += 1
             continue
+        wide = right_nodes(mapped, xy) or set()
+        loose.append([int(n) in wide for n in (matched, believed, linked)])
         by_match.append(int(matched) in right)
         by_markov.append(int(believed) in right)
         by_links.append(int(linked) in right)
         chance.append(len(right) / k)
-        if not by_match[-1]:  # where the right node comes among the matches
+        if not by_match[-1] and right:  # where the right node comes among the matches
             order = np.argsort(-like, kind="stable")
             ranks.append(int(np.flatnonzero(np.isin(order, list(right)))[0]) + 1)
     ranks = np.array(ranks, np.int64)
+    loose_sums = np.array(loose, np.int64).reshape(-1, 3).sum(axis=0)
     return {"map_nodes": k, "fingerprints": len(loc["matched"]), "on_map": len(by_match), "off_map": off,
-            "match_right": int(sum(by_match)), "markov_right": int(sum(by_markov)),
-            "links_right": int(sum(by_links)), "chance": round(float(np.mean(chance)), 4),
+            "aliased_nodes": len(aliased), "match_right": int(sum(by_match)), "markov_right": int(sum(by_markov)),
+            "links_right": int(sum(by_links)), "match_right_loose": int(loose_sums[0]),
+            "markov_right_loose": int(loose_sums[1]), "links_right_loose": int(loose_sums[2]),
+            "chance": round(float(np.mean(chance)), 4),
             "missed_rank2": int((ranks == 2).sum()), "missed_rank3": int((ranks == 3).sum()),
             "missed_rank_over3": int((ranks > 3).sum())}  # fmt: skip
 
@@ -256,9 +394,10 @@ def localization_counts(mapped: dict, loc: dict) -> dict:
 def localize_job(job: tuple) -> dict:
     name, noise, seed, route = job
     _, c = localize_run(name, noise, seed, route)
-    share = {f"{key}_correct": round(c[f"{right}_right"] / c["on_map"], 4) if c["on_map"] else math.nan
-             for key, right in (("match", "match"), ("markov", "markov"), ("links_markov", "links"))}  # fmt: skip
-    head = ("map_nodes", "fingerprints", "on_map", "off_map")
+    share = {f"{key}_correct": round(c[right] / c["on_map"], 4) if c["on_map"] else math.nan
+             for key, right in (("match", "match_right"), ("markov", "markov_right"),
+                                ("links_markov", "links_right"), ("markov_loose", "markov_right_loose"))}  # fmt: skip
+    head = ("map_nodes", "fingerprints", "on_map", "off_map", "aliased_nodes")
     tail = ("chance", "missed_rank2", "missed_rank3", "missed_rank_over3", "ticks", "finished", "wall_seconds")
     return {"scenario": name, "route": route, "noise": noise, "seed": seed, **{k: c[k] for k in head}, **share,
             **{k: c[k] for k in tail}}  # fmt: skip
