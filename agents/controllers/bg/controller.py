@@ -121,7 +121,8 @@ class BgController:
         self.nav.move(float(perception["odometry"][0]), heading)
         prox, seen = sense(grey, heading)
         # A(res): mProx(res) = 1, the resource fills a whole 7-pixel window (section 3.2): the camera's, not the world's
-        usable = {r: bool(prox[k].max() == 1.0) for k, r in enumerate(RESOURCES)}
+        full = (prox == 1.0).any(axis=1)
+        usable = {r: bool(full[k]) for k, r in enumerate(RESOURCES)}
         if self.p.planning:
             if self.nav.due():
                 self.colony.adopt(self.nav.observe(grey, sonar, heading))

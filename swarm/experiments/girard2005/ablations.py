@@ -85,7 +85,7 @@ def run_ablations(experiment: str, reps: int | None, jobs: int | None, seed: int
         raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
     out_ = Outputs(out, experiment)
     floors = bg.check_floors("bg-tmaze", None, ratios, {})
-    made = bg._maps("bg-tmaze", maps, seed, floors, jobs, progress, seconds=mapping_seconds)
+    made = bg.make_maps("bg-tmaze", maps, seed, floors, jobs, progress, seconds=mapping_seconds)
     survival, tests = jobs_for(reps, seed, made, max_ticks)
     rows = batch_run(run_survival, survival, jobs=jobs, desc=f"{experiment} survival", progress=progress)
     rows += batch_run(run_test, tests, jobs=jobs, desc=f"{experiment} T-maze", progress=progress)

@@ -415,7 +415,7 @@ def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, j
             f"condition on {floors[0]}, at most 4 h; seed {seed}.\n\n"
         )
     else:
-        made = _maps(experiment, maps, seed, floors, jobs, progress, changes, mapping, mapping_seconds)
+        made = make_maps(experiment, maps, seed, floors, jobs, progress, changes, mapping, mapping_seconds)
         (out / "maps.json").write_text(json.dumps(made))
         work = test_jobs(experiment, reps, seed, made, changes)
         rows = batch_run(run_test, work, jobs=jobs, desc=experiment, progress=progress)
@@ -476,7 +476,7 @@ def build_map_job(job: tuple) -> dict:
     return {"scenario": name, "index": k, "data": build_map(floor, seed, absent, changes, mode, *seconds)}
 
 
-def _maps(experiment: str, count: int, seed: int, floors: tuple[str, ...], jobs: int | None, progress: bool,
+def make_maps(experiment: str, count: int, seed: int, floors: tuple[str, ...], jobs: int | None, progress: bool,
           changes: dict[str, Any] | None = None, mode: str = MAPPING,
           seconds: float = MAPPING_SECONDS) -> dict[str, list[dict]]:  # fmt: skip
     """`count` maps per map set, map k from a mapping run with seed + k (in parallel), each at most `seconds`."""
