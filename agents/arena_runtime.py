@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from agents.controllers.arena import as_action, deliver, make_controller, publications
+from agents.controllers.arena import StepGuard, deliver, make_controller, publications
 from agents.runtime import AgentRuntime
 from swarm.core import heap, kernels, memory_codec, wire
 from world_server.arena.face import wire as arena_proto
@@ -25,6 +25,8 @@ class ArenaAgentRuntime(AgentRuntime):
     def _prepare(self, count: int) -> None:
         kernels.use_ahead_of_time()  # before any controller is imported: no numba in this process when built
         self.brains: list = [None] * count
+        self.names: list[str] = [self.controller] * count  # each slot's controller, as the welcome names it
+        self.guard = StepGuard(self.on_error)
         self.sent_plans: dict[int, tuple] = {}  # agent -> (length, first, last point) of the last plan sent
         self.refused_shared = 0  # other robots' publications this process's controllers refused
         self.refused_memory = 0  # memories handed back that could not be decoded
@@ -32,7 +34,8 @@ class ArenaAgentRuntime(AgentRuntime):
 
     def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
         blob = msg.pop("memory", None)  # a missing agent's place, taken over where it was saved
-        brain = make_controller(msg.get("controller", self.controller))
+        self.names[slot] = msg.get("controller", self.controller)
+        brain = make_controller(self.names[slot])
         brain.reset(int(msg["seed"]), agent, msg["params"])
         self.brains[slot] = brain
         heap.give_back()  # what building the controller used and freed (a DFT robot's kernels: ~5 MB)
@@ -67,7 +70,8 @@ class ArenaAgentRuntime(AgentRuntime):
             if slot is None:
                 continue
             agents.append(agent)
-            wheels.append(np.zeros(3) if self.null else as_action(self.brains[slot].step(reading)))
+            wheels.append(np.zeros(3) if self.null else
+                          self.guard.action(self.brains[slot], reading, agent, self.names[slot], obs.tick))  # fmt: skip
         shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
         if self.kept:  # the message that carried last tick's memory (MBs for a DFT robot) and zenoh's copy
             heap.give_back()  # of it are freed by now: all of it back to the system, not kept in the heap

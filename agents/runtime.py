@@ -30,9 +30,10 @@ class AgentRuntime:
 
     def __init__(self, run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
                  join_timeout: float = 60.0, idle_timeout: float = 120.0, null: bool = False,
-                 rejoin_after: float = 5.0):  # fmt: skip
+                 rejoin_after: float = 5.0, on_error: str = "idle"):  # fmt: skip
         self.keys = wire.Keys(run_id)
         self.controller = controller
+        self.on_error = on_error  # a controller that raises: its robot holds still, or the process stops
         self.null = null  # benchmark floor: answer without running the controller
         self._prepare(count)  # before joining: the world observes us at once
         self.idle_timeout = idle_timeout

@@ -18,6 +18,18 @@ from world_server import WORLD_KINDS, kind_of
 from world_server.grid.scenario import DEFAULT_CONTROLLER
 
 CONTROLLERS = CONTROLLER_REGISTRY.names()
+CONTROLLER_HELP = f"controller to run: {', '.join(CONTROLLERS)}, or your own as module:Class"
+
+
+def controller_name(text: str) -> str:
+    """--controller: a registered name, or a user's class as module:Class (loaded now, so that a
+    bad one is one line before anything starts)."""
+    try:
+        CONTROLLER_REGISTRY[text]
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
 
 DESCRIPTION = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
@@ -82,7 +94,7 @@ def _add_run(sub) -> None:
         help=f"a TOML file, a preset ({PRESET_HELP}) or a bundled name ({', '.join(bundled_scenarios())})",
     )
     run.add_argument("--agents", type=positive, help="number of agents (default: the scenario's)")
-    run.add_argument("--controller", choices=CONTROLLERS, help="controller to run")
+    run.add_argument("--controller", type=controller_name, metavar="NAME", help=CONTROLLER_HELP)
     run.add_argument("--seed", type=seed, help="seed of the map and of every random choice")
     _kind_options(run, titled=False)
     _kind_options(run, titled=True)
@@ -143,7 +155,15 @@ def _add_agent(sub) -> None:
         help="run agent process(es) that join a world",
         description="Join a world over zenoh and run one controller (or K with --count).",
     )
-    agent.add_argument("--controller", choices=CONTROLLERS, default=DEFAULT_CONTROLLER)
+    agent.add_argument(
+        "--controller", type=controller_name, default=DEFAULT_CONTROLLER, metavar="NAME", help=CONTROLLER_HELP
+    )
+    agent.add_argument(
+        "--on-controller-error",
+        choices=("idle", "stop"),
+        default="idle",
+        help="an arena controller that raises: its robot holds still (idle) or the process stops",
+    )
     _client_args(agent)
     agent.add_argument("--count", type=positive, default=1, metavar="K", help="independent agents in this process")
     agent.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
@@ -359,7 +379,7 @@ def _kind_options(p: argparse.ArgumentParser, titled: bool) -> None:
 def _scenario_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", metavar="SCENARIO", help=f"a TOML file, a preset ({PRESET_HELP}) or a bundled name")
     p.add_argument("--agents", type=positive, help="number of agents (default: the scenario's)")
-    p.add_argument("--controller", choices=CONTROLLERS, help="controller to run")
+    p.add_argument("--controller", type=controller_name, metavar="NAME", help=CONTROLLER_HELP)
     p.add_argument("--seed", type=seed, help="seed of the map and of every random choice")
     _kind_options(p, titled=False)
     p.add_argument("--until", choices=["foraged", "converged", "both"], default="foraged", help="when the run ends")
@@ -424,7 +444,7 @@ def cmd_agent(args) -> int:
 
     try:
         runtime = make_runtime(args.run_id, args.controller, args.connect, args.count, null=args.null,
-                               join_timeout=args.join_timeout)  # fmt: skip
+                               join_timeout=args.join_timeout, on_error=args.on_controller_error)  # fmt: skip
     except JoinRefused as exc:
         print(f"swarm: {exc}", file=sys.stderr)
         return 0 if ENDED in str(exc) else 2  # a late agent of a finished run has nothing to do

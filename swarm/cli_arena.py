@@ -10,6 +10,7 @@ import sys
 
 import numpy as np
 
+from agents.controllers.arena import ON_ERROR
 from swarm.core.errors import ScenarioError
 
 
@@ -33,6 +34,9 @@ def add_arena_run_args(g) -> None:
     g.add_argument("--goal", type=_floats(2, 2, "X,Y (metres)"), metavar="X,Y", help="goal of a one-robot run")
     g.add_argument("--noise", choices=["none", "low", "high"], help="sensor noise level (the DFT paper's)")
     g.add_argument("--max-ticks", type=int, metavar="T", help="stop after T control periods")
+    g.add_argument("--on-controller-error", choices=ON_ERROR, metavar="{idle,stop}",
+                   help="a robot whose controller raises: holds still while the others go on (idle, the default), "
+                        "or ends the run (stop)")  # fmt: skip
 
 
 def arena_overrides(scenario, args, common: dict):
@@ -45,7 +49,9 @@ def arena_overrides(scenario, args, common: dict):
 def arena_up_options(scenario, args) -> dict:
     """swarm_up's keywords for an arena run: the controller asked for (None: each group's own) and
     the arena options for the world process."""
-    return {"controller": args.controller, "world_args": arena_world_args(args)}
+    on_error = getattr(args, "on_controller_error", None)
+    return {"controller": args.controller, "world_args": arena_world_args(args),
+            "agent_args": ["--on-controller-error", on_error] if on_error else []}  # fmt: skip
 
 
 def arena_world_args(args) -> list[str]:
@@ -67,7 +73,7 @@ def run_arena(scenario, args, viewer: str | None = None) -> dict:
 
     from swarm.engines.arena import ArenaEngine
 
-    engine = ArenaEngine(scenario)
+    engine = ArenaEngine(scenario, on_error=getattr(args, "on_controller_error", None) or "idle")
     recorder = None
     if getattr(args, "record", None):
         from swarm.recording.arena import ArenaRecorder
@@ -97,6 +103,8 @@ def print_arena_summary(summary: dict, as_json: bool, until: str | None = None) 
             f"  {goals}collisions {summary['collisions']}, "
             f"rejected actions {summary.get('rejected_actions', 'n/a')}"
         )
+        for agent, why in summary.get("controller_failures", {}).items():
+            print(f"  robot {agent}'s controller failed: {why}; it held still from then on")
         for r in summary["robots"][:20]:
             ratio = "n/a" if r["path_ratio"] is None else f"{r['path_ratio']:.3f}"
             lo = "n/a" if r["optimal_length"] is None else f"{r['optimal_length']:.3f}"

@@ -51,7 +51,7 @@ def swarm_up(
     until: str = "foraged", max_iterations: int = 1_000_000, deadline: float = 2.0, progress: bool = True,
     per_process: int = 1, null: bool = False, mode: str = "lockstep", rate: float = 20.0,
     physics: PhysicsParams | None = None, record: str | None = None, viewer: str | None = None,
-    world_args: list[str] | None = None,
+    world_args: list[str] | None = None, agent_args: list[str] | None = None,
 ) -> dict:  # fmt: skip
     """Run the swarm as processes; `per_process` agents share one agent process
     (`swarm agent --count`), `null` runs the benchmark floor (messaging only).
@@ -73,7 +73,18 @@ def swarm_up(
     if viewer:
         world_options += ["--viewer", viewer]
     try:
-        return _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null)
+        return _swarm_up(
+            scenario_ref,
+            agents,
+            controller,
+            run_id,
+            listen,
+            world_options,
+            progress,
+            per_process,
+            null,
+            agent_args or [],
+        )
     finally:
         signal.signal(signal.SIGTERM, previous)
 
@@ -112,7 +123,8 @@ def _agent_counts(scenario_ref: str, agents: int, controller: str | None) -> lis
     return load_scenario(scenario_ref).agent_processes(agents)
 
 
-def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null) -> dict:
+def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null,
+              agent_args) -> dict:  # fmt: skip
     prepare(scenario_ref, progress)
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
@@ -125,7 +137,7 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
         agent_cmds = []
         for name, n in _agent_counts(scenario_ref, agents, controller):
             cmd = [*python, "agent", "--controller", name, "--connect", listen, "--run-id", run_id,
-                   "--count", str(per_process)]  # fmt: skip
+                   "--count", str(per_process), *agent_args]  # fmt: skip
             agent_cmds += [cmd + (["--null"] if null else [])] * (n // per_process)
         if null:
             world_cmd.append("--null")

@@ -64,7 +64,7 @@ def parse_scenario_text(text: str, source: str = "<string>", kind: str | None = 
         spec = world_kind(kind or data.get("kind", world_kind().name))
     except UnknownPart as exc:
         raise ScenarioError(source, "kind", str(exc)) from None
-    controllers = {c.name: c for c in CONTROLLERS if c.world == spec.name}  # what its groups may name
+    controllers = CONTROLLERS.where("world", spec.name)  # what its groups may name ("module:Class" too)
     return resolve(spec.parse)(data, text, source, name or Path(source).stem, controllers)
 
 

@@ -14,11 +14,13 @@ process holds K.
 
 from __future__ import annotations
 
+import sys
 from typing import Any, Protocol
 
 import numpy as np
 
 from agents.controllers import CONTROLLERS
+from swarm.core.errors import RunError
 
 MAX_SHARE_BYTES = 4 * 1024 * 1024
 
@@ -50,6 +52,57 @@ def as_action(step_result) -> np.ndarray:
     if len(a) == 2:
         return np.array([a[0], a[1], 0.0])
     return a if len(a) == 3 else np.full(3, np.nan)
+
+
+ON_ERROR = ("idle", "stop")  # what a run does with a robot whose controller raised: hold it still, or end
+
+
+class ControllerFailed(RunError):
+    """A controller raised (or answered NaN or the wrong shape) and the run was told to stop on it."""
+
+
+class StepGuard:
+    """Steps controllers as both runtimes must, so that a user's controller that raises, answers NaN
+    or the wrong shape is one line naming it, not a traceback that ends every robot's run.
+
+    A controller that raises is out of the run: from that tick on its robot holds still (wheel
+    speeds 0, a valid answer, so a lock-step world does not wait out its deadline for it) and its
+    controller is not asked again (its state may be half-written).  A NaN or wrong-shaped answer
+    goes to the world, which refuses and counts it; it is told once per robot.  With on_error
+    "stop" either ends the run (ControllerFailed).  Both runtimes do the same, so lock-step runs
+    stay equal to in-process ones."""
+
+    def __init__(self, on_error: str = "idle", tell=None):
+        if on_error not in ON_ERROR:
+            raise ValueError(f"on_error {on_error!r}: expected one of {', '.join(ON_ERROR)}")
+        self.on_error = on_error
+        self.failed: dict[int, str] = {}  # agent -> what its controller raised
+        self.told: set[int] = set()
+        self.tell = tell or (lambda line: print(f"swarm: {line}", file=sys.stderr, flush=True))
+
+    def action(self, controller, perception, agent: int, name: str, tick: int) -> np.ndarray:
+        if agent in self.failed:
+            return np.zeros(3)
+        try:
+            answer = controller.step(perception)
+        except Exception as exc:  # whatever a user's controller raises
+            text = str(exc).strip().splitlines()
+            self.failed[agent] = f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
+            self._fault(f"controller {name!r} of robot {agent} raised {self.failed[agent]} at tick {tick}",
+                        "the robot holds still for the rest of the run")  # fmt: skip
+            return np.zeros(3)
+        action = as_action(answer)
+        if not np.isfinite(action).all() and agent not in self.told:
+            self.told.add(agent)
+            what = "NaN or infinite wheel speeds" if np.size(answer) in (2, 3) else f"shape {np.shape(answer)}"
+            self._fault(f"controller {name!r} of robot {agent} answered {what} at tick {tick}",
+                        "the world refuses such answers and counts them (rejected actions)")  # fmt: skip
+        return action
+
+    def _fault(self, what: str, then: str) -> None:
+        if self.on_error == "stop":
+            raise ControllerFailed(f"{what}; the run stops (--on-controller-error idle lets it go on)")
+        self.tell(f"{what}; {then} (--on-controller-error stop ends the run instead)")
 
 
 def make_controller(name: str) -> ArenaController:

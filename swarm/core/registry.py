@@ -13,8 +13,10 @@ world_server.WORLD_KINDS).
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
 import pkgutil
-from collections.abc import Callable, Iterator
+import sys
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from typing import Any, Generic, Protocol, TypeVar
 
@@ -60,6 +62,49 @@ class ControllerSpec:
     records: tuple[str, ...] = ()  # "module:Class" of the logs that show what explains its choices (swarm.core.series)
     parameters: tuple[str, ...] = ()  # "module:Class" of its parameter dataclasses (swarm.core.params)
     example: str = "setup1"
+
+    @classmethod
+    def of_class(cls, name: str, reference: str) -> ControllerSpec:
+        """The entry of a user's arena controller class ("module:Class"), from what the class says
+        of itself: `description` (default: its docstring's first line), `requires`, `shares`,
+        `check_table` (a static or class method raising ValueError for a bad table), `parameters`
+        and `records` ("module:Class" references), `example`.  A grid controller is a compiled kind
+        of the grid's step, not a class: docs/controllers.md says how to add one."""
+        target = resolve(reference)
+        if not isinstance(target, type):
+            raise TypeError(f"{reference} is not a class; expected module:Class of an arena controller")
+        if getattr(target, "world", "arena") != "arena":
+            raise TypeError(
+                f"{reference} says world = {target.world!r}; a controller loaded from outside the "
+                "package drives in the arena (a grid controller is a compiled kind: docs/controllers.md)"
+            )
+        face = ("reset", "step", "snapshot", "restore", "record")
+        missing = [f"{m}()" for m in face if not callable(getattr(target, m, None))]
+        if missing:
+            raise TypeError(f"{reference} lacks {', '.join(missing)}: an arena controller has reset, step, "
+                            "snapshot, restore and record (agents/controllers/arena.py)")  # fmt: skip
+        doc = (target.__doc__ or "").strip().splitlines()
+        return cls(
+            name=name,
+            world="arena",
+            description=str(getattr(target, "description", doc[0] if doc else reference)),
+            factory=reference,
+            table=f"{reference}.check_table" if callable(getattr(target, "check_table", None)) else None,
+            requires=tuple(getattr(target, "requires", ())),
+            shares=getattr(target, "shares", None),
+            records=tuple(getattr(target, "records", ())),
+            parameters=tuple(getattr(target, "parameters", ())),
+            example=str(getattr(target, "example", "zmaze")),
+        )
+
+    @classmethod
+    def of_plugin(cls, name: str, reference: str) -> ControllerSpec:
+        """An installed package's entry (entry point group `swarm.controllers`): a ControllerSpec
+        the package declares, or its controller class."""
+        target = resolve(reference)
+        if isinstance(target, ControllerSpec):
+            return target
+        return cls.of_class(name, reference)
 
     def make(self) -> Any:
         """A fresh controller (arena), or the kind code of the compiled step (grid)."""
@@ -203,13 +248,21 @@ class Registry(Generic[E]):
     `attribute`: an entry or a tuple of entries), folder by folder in name order, each folder's
     entries in the order it declares them.  With `modules`, a plain module of `package` may
     declare entries too (one module per part); with `key`, the entries are in its order instead
-    (a part that declares its own place: the arena's sensors)."""
+    (a part that declares its own place: the arena's sensors).
+
+    Parts from outside the package: with `plugins` (an entry point group), every installed
+    package's entry point of that group is an entry, made by `external(name, "module:attribute")`;
+    with `external`, a name that is itself a "module:attribute" reference is one too (made when
+    first asked for, then kept)."""
 
     def __init__(self, what: str, package: str, attribute: str, *, modules: bool = False,
-                 key: Callable[[E], Any] | None = None):  # fmt: skip
+                 key: Callable[[E], Any] | None = None, plugins: str | None = None,
+                 external: Callable[[str, str], E] | None = None):  # fmt: skip
         self.what, self.package, self.attribute = what, package, attribute
         self.modules, self.key = modules, key
+        self.plugins, self.external = plugins, external
         self._entries: dict[str, E] | None = None
+        self._loaded: dict[str, E] = {}  # "module:attribute" names made so far
 
     def _found(self) -> dict[str, E]:
         if self._entries is None:
@@ -225,20 +278,97 @@ class Registry(Generic[E]):
                     found[entry.name] = entry
             if self.key is not None:
                 found = {e.name: e for e in sorted(found.values(), key=self.key)}
-            self._entries = found
+            self._entries = found | self._installed(found)
         return self._entries
+
+    def _installed(self, found: dict[str, E]) -> dict[str, E]:
+        """The entries installed packages declare.  One that cannot be loaded is left out with one
+        line on stderr (a broken plugin must not stop every command)."""
+        if self.plugins is None or self.external is None:
+            return {}
+        out: dict[str, E] = {}
+        for point in importlib.metadata.entry_points(group=self.plugins):
+            if point.name in found or point.name in out:
+                print(f"swarm: {self.what} {point.name!r} of {point.value} left out: the name is taken",
+                      file=sys.stderr)  # fmt: skip
+                continue
+            try:
+                out[point.name] = self.external(point.name, point.value)
+            except Exception as exc:  # whatever a user's package raises on import
+                print(f"swarm: {self.what} {point.name!r} ({point.value}) left out: {_one_line(exc)}", file=sys.stderr)
+        return out
+
+    def load(self, reference: str) -> E:
+        """The entry of a "module:attribute" name (`external`), made once; UnknownPart in one line
+        saying why it cannot be."""
+        if reference not in self._loaded:
+            if self.external is None or ":" not in reference:
+                raise UnknownPart(f"unknown {self.what} {reference!r}; expected one of {', '.join(self._found())}")
+            try:
+                self._loaded[reference] = self.external(reference, reference)
+            except ModuleNotFoundError as exc:
+                raise UnknownPart(f"cannot load {self.what} {reference!r}: {_one_line(exc)}; install its package "
+                                  "or put its folder on PYTHONPATH") from None  # fmt: skip
+            except Exception as exc:  # whatever a user's module raises on import
+                raise UnknownPart(f"cannot load {self.what} {reference!r}: {_one_line(exc)}") from None
+        return self._loaded[reference]
 
     def __getitem__(self, name: str) -> E:
         entries = self._found()
-        if not isinstance(name, str) or name not in entries:
-            raise UnknownPart(f"unknown {self.what} {name!r}; expected one of {', '.join(entries)}")
-        return entries[name]
+        if isinstance(name, str) and name in entries:
+            return entries[name]
+        if isinstance(name, str) and ":" in name and self.external is not None:
+            return self.load(name)
+        raise UnknownPart(f"unknown {self.what} {name!r}; expected one of {', '.join(entries)}"
+                          + (" or module:Class" if self.external is not None else ""))  # fmt: skip
 
     def __contains__(self, name: object) -> bool:
-        return name in self._found()
+        if name in self._found():
+            return True
+        try:
+            return isinstance(name, str) and ":" in name and self.external is not None and bool(self.load(name))
+        except UnknownPart:
+            return False
 
     def __iter__(self) -> Iterator[E]:
         return iter(self._found().values())
 
     def names(self, where: Callable[[E], bool] = lambda _: True) -> tuple[str, ...]:
         return tuple(e.name for e in self if where(e))
+
+    def where(self, field: str, value: Any) -> Selection[E]:
+        """The entries whose `field` is `value`, "module:attribute" names included (a scenario's
+        controllers: those of its world kind)."""
+        return Selection(self, field, value)
+
+
+class Selection(Mapping[str, E]):
+    """Some entries of a registry by name (Registry.where): iterating gives the registered ones and
+    the loaded "module:attribute" ones; looking a reference up loads it."""
+
+    def __init__(self, registry: Registry[E], field: str, value: Any):
+        self.registry, self.field, self.value = registry, field, value
+
+    def _fits(self, entry: E) -> bool:
+        return getattr(entry, self.field) == self.value
+
+    def __getitem__(self, name: str) -> E:
+        entry = self.registry[name]
+        if not self._fits(entry):
+            raise KeyError(name)
+        return entry
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.registry and self._fits(self.registry[name])  # type: ignore[index]
+
+    def __iter__(self) -> Iterator[str]:
+        yield from (e.name for e in self.registry if self._fits(e))
+        yield from (name for name, e in self.registry._loaded.items() if self._fits(e))
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from agents.controllers.arena import as_action, deliver, make_controller, publications
+from agents.controllers.arena import StepGuard, deliver, make_controller, publications
 from swarm.engines.goals import ArenaGoals
 from swarm.engines.stepper import step_world
 from world_server.arena.scenario import ArenaScenario, controller_params
@@ -19,11 +19,15 @@ from world_server.history import ShareLog
 
 
 class ArenaEngine:
-    def __init__(self, scenario: ArenaScenario):
+    def __init__(self, scenario: ArenaScenario, on_error: str = "idle"):
+        """`on_error`: what a controller that raises does to the run (agents.controllers.arena.StepGuard):
+        "idle" holds its robot still and goes on, "stop" ends the run."""
         self.scenario = scenario
         self.world = ArenaWorld(scenario)
         self.goals = ArenaGoals(scenario)
         self.controllers = []
+        self.names = [g.controller for g in scenario.groups for _ in range(g.count)]
+        self.guard = StepGuard(on_error)
         for a, group in enumerate(g for g in scenario.groups for _ in range(g.count)):
             c = make_controller(group.controller)
             c.reset(scenario.seed, a, controller_params(scenario, a))
@@ -51,7 +55,7 @@ class ArenaEngine:
 
         def decide(perceptions, tick: int) -> np.ndarray:
             for a, (c, p) in enumerate(zip(self.controllers, perceptions, strict=True)):
-                self.actions[a] = as_action(c.step(p))
+                self.actions[a] = self.guard.action(c, p, a, self.names[a], tick)
             shared = publications(self.controllers, self.agent_ids)
             if shared:  # what each wrote this tick, every other robot of its share reads before the next
                 self.shares.add(tick, shared)
@@ -93,6 +97,8 @@ class ArenaEngine:
             if (shared := self.shares.of(robot["agent"])) is not None:
                 robot["shared"] = shared
         out["rejected_shared"] = self.refused_shared
+        if self.guard.failed:  # only then: a summary of a run without failures is what it always was
+            out["controller_failures"] = {str(a): why for a, why in sorted(self.guard.failed.items())}
         return out
 
 

@@ -16,7 +16,8 @@ Layout (timeline `tick`; the record at tick t shows the world after tick t):
     world/optimum/<agent> static: the A* optimum from the robot's start to its goal (L_o; not for routes)
     …/<agent>/…           what explains a controller's choices, by the logs its registry entry names
                           (ControllerSpec.records: its map, its fields, its channels; in process, and a
-                          map from its publications when distributed): each log's module lists its paths
+                          map from its publications when distributed): each log's module lists its paths;
+                          a controller whose entry names none: its record() by shape (swarm/recording/records.py)
     metrics/<name>        reached, collisions, distance, agents_alive, tick_ms, rejected_messages
                           (in-process: the actions the world refused)
     metrics/robots/<name> per robot, one scalar each: path_length, collisions, in_goal, finished (dwelt)
@@ -35,6 +36,8 @@ import numpy as np
 from swarm.core.registry import resolve
 from swarm.engines.goals import ArenaGoals, optimum_planner
 from swarm.recording.grid import FORMAT_VERSION, software_versions
+
+RECORD_LOG = "swarm.recording.records:RecordLog"
 
 ARENA_METRICS = ("reached", "collisions", "distance", "agents_alive", "tick_ms", "rejected_messages")
 ROBOT_SERIES = ("path_length", "collisions", "in_goal", "finished")
@@ -66,6 +69,32 @@ def arena_meta(scenario, world, goals: ArenaGoals, run_id: str, runtime: str) ->
             "optimal_lengths": [v if v is not None and math.isfinite(v) else None for v in goals.optimum]}  # fmt: skip
 
 
+def records_of(scenario, any_record: bool = True) -> list[tuple[str, ...]]:
+    """Each robot's logs ("module:Class"): those its controller's registry entry names, or (with
+    `any_record`: in process, where the recorder holds the controllers) the log that shows any
+    record() by its shape (swarm.recording.records) for one that names none."""
+    specs = scenario.known_controllers
+    fallback = (RECORD_LOG,) if any_record else ()
+    return [(specs[g.controller].records if g.controller in specs else ()) or fallback
+            for g in scenario.groups for _ in range(g.count)]  # fmt: skip
+
+
+def blueprint(rrb, scenario, logs: list[tuple[str, ...]]):
+    """The viewer's layout: the arena, the run's plots, and beside them what explains each group's
+    controller (its logs' `views`, for the group's first robot)."""
+    plots = [rrb.TimeSeriesView(origin=f"/metrics/{n}", name=n.replace("_", " ")) for n in ARENA_METRICS[:3]]
+    explained, first = [], 0
+    for g in scenario.groups:
+        for ref in logs[first] if first < len(logs) else ():
+            views = getattr(resolve(ref), "views", None)
+            explained += views(rrb, first, g.controller) if views is not None else []
+        first += g.count
+    columns = [rrb.Spatial2DView(origin="/world", name="arena"), rrb.Vertical(*plots)]
+    if explained:
+        columns.append(rrb.Tabs(*explained))
+    return rrb.Blueprint(rrb.Horizontal(*columns, column_shares=[3, 2, 2][: len(columns)]), collapse_panels=True)
+
+
 class ArenaRecorder:
     def __init__(self, path, world, goals: ArenaGoals, meta: dict, viewer: str | None = None, flush_every: int = 256,
                  controllers=None):  # fmt: skip
@@ -84,14 +113,8 @@ class ArenaRecorder:
         sinks = [rr.FileSink(str(self.path))]
         if viewer:
             sinks.append(rr.GrpcSink(viewer))
-        plots = [rrb.TimeSeriesView(origin=f"/metrics/{n}", name=n.replace("_", " ")) for n in ARENA_METRICS[:3]]
-        blueprint = rrb.Blueprint(
-            rrb.Horizontal(
-                rrb.Spatial2DView(origin="/world", name="arena"), rrb.Vertical(*plots), column_shares=[3, 2]
-            ),
-            collapse_panels=True,
-        )
-        self.rec.set_sinks(*sinks, default_blueprint=blueprint)
+        self._records_of = records_of(world.scenario, any_record=controllers is not None)
+        self.rec.set_sinks(*sinks, default_blueprint=blueprint(rrb, world.scenario, self._records_of))
         self._meta_given = meta
         self.meta: dict = {}
         n = world.n
@@ -105,9 +128,6 @@ class ArenaRecorder:
         self._obstacles_on: tuple | None = None
         self._plans_logged: set[int] = set()
         self._logs: dict = {}  # each controller log (ControllerSpec.records) in use, by its class
-        specs = world.scenario.known_controllers
-        self._records_of = [specs[g.controller].records if g.controller in specs else ()
-                            for g in world.scenario.groups for _ in range(g.count)]  # fmt: skip
         self._published = None
         self._static_done = False
 

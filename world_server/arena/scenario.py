@@ -367,7 +367,8 @@ def parse_section(data: dict, text: str, source: str, name: str,
 def parse_arena(data: dict, source: str, default_name: str, controllers: Mapping[str, ControllerSpec]) -> ArenaScenario:
     """The ArenaScenario of a scenario file's tables.  `controllers`: the arena controllers a group
     may name (each may have its own [name] table)."""
-    no_unknown(data, _TOP | set(controllers), source, "top level")
+    tables = [c for c in controllers if c in data] + [k for k in data if ":" in k and k in controllers]
+    no_unknown(data, _TOP | set(tables), source, "top level")
     size = _numbers(data, "size", source, "size", 2)
     if not all(0 < v <= 10_000 for v in size):
         raise ScenarioError(source, "size", f"expected two positive sizes in metres, got {list(size)}")
@@ -398,7 +399,7 @@ def parse_arena(data: dict, source: str, default_name: str, controllers: Mapping
     if not groups:
         raise ScenarioError(source, "group", "missing: add at least one [[group]] with count and controller")
     kw["groups"] = tuple(_group(g, robot, controllers, source, f"group {i + 1}") for i, g in enumerate(groups))
-    kw["controller_params"] = {c: _table(data, c, source) for c in controllers if c in data}
+    kw["controller_params"] = {c: _table(data, c, source) for c in tables}
     kw["known_controllers"] = controllers
     if "metabolism" in data:
         try:
@@ -585,9 +586,17 @@ def _group(g, robot: RobotModel, controllers: Mapping[str, ControllerSpec], sour
 
 
 def _check_controller(name: str, controllers: Mapping[str, ControllerSpec], source: str, where: str) -> None:
-    if name not in controllers:
-        raise ScenarioError(source, where, f"unknown arena controller {name!r}; expected one of "
-                            f"{', '.join(controllers)}")  # fmt: skip
+    if name in controllers:
+        return
+    reason = f"unknown arena controller {name!r}; expected one of {', '.join(controllers)} or module:Class"
+    if ":" in name:  # a user's class: why it cannot be loaded, or that it drives in another world
+        try:
+            controllers[name]
+        except KeyError as exc:  # UnknownPart (cannot load) is a KeyError's sibling: ValueError
+            reason = f"{name!r} is not an arena controller ({exc})"
+        except ValueError as exc:
+            reason = str(exc)
+    raise ScenarioError(source, where, reason)
 
 
 def check_arena(s: ArenaScenario, source: str) -> None:
@@ -758,4 +767,5 @@ def controller_params(s: ArenaScenario, agent: int) -> dict[str, Any]:
         ],
         **s.controller_params,  # every controller's table: one may drive with another's (fingerprint: carrot)
         group.controller: s.controller_params.get(group.controller, {}),
+        "table": s.controller_params.get(group.controller, {}),  # its own table, whatever name it runs under
     }

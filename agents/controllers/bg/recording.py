@@ -41,3 +41,10 @@ class ChannelLog(SeriesLog):
 
     def columns(self, agent: int, name: str, rows: list) -> list[tuple[str, np.ndarray]]:
         return [(f"bg/{agent}/{name}", np.array(rows))]
+
+    @staticmethod
+    def views(rrb, agent: int, name: str) -> list:
+        """The viewer's panels for one animat: its variables and motivations, and both loops' channels."""
+        return [rrb.TimeSeriesView(origin=f"/bg/{agent}", name=f"{name} {agent}"),
+                rrb.BarChartView(origin=f"/bg/{agent}/dorsal", name=f"{name} {agent} dorsal"),
+                rrb.BarChartView(origin=f"/bg/{agent}/ventral", name=f"{name} {agent} ventral")]  # fmt: skip

@@ -58,3 +58,13 @@ class FieldLog(SeriesLog):
     def columns(self, agent: int, name: str, rows: list) -> list[tuple[str, np.ndarray]]:
         values = np.stack(rows)
         return [(f"fields/{agent}/{name}/{d}", values[:, k]) for k, d in enumerate(EBS)]
+
+    @staticmethod
+    def views(rrb, agent: int, name: str) -> list:
+        """The viewer's panels for one robot: its motivation and intention fields, and the intentions
+        and actions over time (the paper's Figure 10)."""
+        root = f"/fields/{agent}"
+        return [rrb.Spatial2DView(origin=f"{root}/M", name=f"{name} {agent} motivation"),
+                rrb.Spatial2DView(origin=f"{root}/I", name=f"{name} {agent} intention"),
+                rrb.TimeSeriesView(origin=f"{root}/intention", name=f"{name} {agent} max intention"),
+                rrb.TimeSeriesView(origin=f"{root}/action", name=f"{name} {agent} action")]  # fmt: skip

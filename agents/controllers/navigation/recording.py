@@ -111,3 +111,9 @@ class MapLog:
             from agents.controllers.fingerprint.align import to_string
 
             rec.log(f"map/{agent}/fingerprint", rr.TextDocument(to_string(np.asarray(record["fingerprint"]))))
+
+    @staticmethod
+    def views(rrb, agent: int, name: str) -> list:
+        """The viewer's panels for one robot's map: its graph and its belief over the nodes."""
+        return [rrb.GraphView(origin=f"/map/{agent}", name=f"{name} {agent} map"),
+                rrb.BarChartView(origin=f"/map/{agent}/belief", name=f"{name} {agent} belief")]  # fmt: skip
