@@ -77,7 +77,7 @@ class Sensor:
     @classmethod
     def from_table(cls, table: dict[str, Any], base: Sensor | None = None) -> Sensor:
         """This sensor's spec from a scenario's table, over `base` (default: its defaults).  A list
-        is a tuple of numbers, a field whose value is an integer an integer, the rest numbers;
+        is a tuple of numbers, a switch (a bool field) true or false, an integer field an integer, the rest numbers;
         ValueError("field: what is expected") on a bad one."""
         base = base if base is not None else cls()
         known = cls.field_names()
@@ -86,6 +86,11 @@ class Sensor:
             if k not in known:
                 raise ValueError(f"{k}: unknown field; expected one of {', '.join(sorted(known))}")
             was = getattr(base, k)
+            if isinstance(was, bool):  # a switch: true or false, not a number
+                if not isinstance(v, bool):
+                    raise ValueError(f"{k}: expected true or false, got {v!r}")
+                typed[k] = v
+                continue
             try:
                 typed[k] = (tuple(float(x) for x in v) if isinstance(v, list) else
                             int(v) if isinstance(was, int) and not isinstance(was, bool) else float(v))  # fmt: skip
