@@ -85,7 +85,8 @@ class Talker:
         self.say, self.wheels = say, wheels
 
     def step(self, perception):
-        self.heard.append((perception["rab_data"].copy(), perception["rab_distance"].copy()))
+        if "rab_data" in perception:
+            self.heard.append((perception["rab_data"].copy(), perception["rab_distance"].copy()))
         self.tick += 1
         return (self.wheels or (lambda t: [0.0, 0.0]))(self.tick - 1)
 
@@ -118,6 +119,24 @@ def test_a_refused_actions_broadcast_is_dropped_and_a_payload_is_cut_or_padded()
     talker = Talker(5)
     talker.tick = 1
     assert broadcasts([talker, object()], [5, 6]) == [(5, bytes([5, 0]))]  # a controller without broadcast() is silent
+
+
+def test_robots_without_the_sensor_are_not_heard_and_payloads_of_two_sizes_meet():
+    group = '[[group]]\ncount = 1\ncontroller = "wander"\nstart = {start}\nrobot = {{ model = "epuck"{rab} }}\n'
+    body = (group.format(start=[0.5, 0.5, 0.0], rab=', range_and_bearing = { payload = 4 }')
+            + group.format(start=[0.6, 0.5, 0.0], rab=', range_and_bearing = { payload = 4 }')
+            + group.format(start=[0.5, 0.7, 0.0], rab=', range_and_bearing = { payload = 2 }')
+            + group.format(start=[0.3, 0.3, 0.0], rab=""))  # fmt: skip
+    engine = ArenaEngine(arena(body))
+    engine.controllers = [Talker(a, say=lambda t, a=a: bytes([a, t, 5, 6])) for a in range(4)]
+    engine.step(2)
+    assert engine.world.rab_sent.tolist() == [[0, 1, 5, 6], [1, 1, 5, 6], [2, 1, 0, 0], [0, 0, 0, 0]]
+    _, (data, distance) = engine.controllers[0].heard
+    assert int(np.isfinite(distance).sum()) == 2 and distance[:2] == pytest.approx([0.1, 0.2])  # not robot 3
+    assert data[:2].tolist() == [[1, 0, 5, 6], [2, 0, 0, 0]]  # robot 2 sends 2 bytes
+    data, distance = engine.controllers[2].heard[1]
+    assert distance[:2] == pytest.approx([0.2, math.hypot(0.1, 0.2)]) and data[:2].tolist() == [[0, 0], [1, 0]]
+    assert engine.controllers[3].heard == []
 
 
 def test_noise_is_drawn_per_seed_robot_tick_and_neighbour_slot():

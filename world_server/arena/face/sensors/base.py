@@ -42,10 +42,11 @@ class Reading:
     this tick (uniform in [-1, 1), standard normal); `per_run(stream, k)` the robots' uniform draws
     that stay the same every tick of the run (a sensor's bias).  `noise` is the run's noise
     (world_server.arena.sensors.Noise: `factor(name)` scales a sensor's specified error).
-    `state` is the world, indexed by global robot id: pose, motion, contact, zones,
-    hit_colours(what).  `ranges`, `what` and `rgb` are this sensor's rays, (n, rays[, 3]): the
-    range from the sensor, what each hit (raycast.py: a segment >= 0, nothing -1, robot -2 - id)
-    and its colour (only for rays that asked for colours)."""
+    `state` is the world, indexed by global robot id: pose, motion, contact, zones, in_world,
+    present, hit_colours(what), in_sight(...) and the broadcasts (range_bearing.py).  `ranges`,
+    `what` and `rgb` are this sensor's rays, (n, rays[, 3]): the range from the sensor, what each
+    hit (raycast.py: a segment >= 0, nothing -1, robot -2 - id) and its colour (only for rays that
+    asked for colours)."""
 
     robots: np.ndarray
     tick: int

@@ -101,9 +101,10 @@ class RangeAndBearing(Sensor):
 
 def _pairs(robots: np.ndarray, state, reach: float) -> tuple[np.ndarray, np.ndarray]:
     """(row in `robots`, other robot's global id) of the pairs that may be within `reach`: both
-    robots in the world with an agent, not the same.  Every pair in a small world; a k-d tree's
-    candidates (a hair beyond `reach`: the caller cuts at the exact distance) in a large one."""
-    live = state.in_world & state.present
+    robots in the world with an agent and the sensor (a robot without it sends nothing), not the
+    same.  Every pair in a small world; a k-d tree's candidates (a hair beyond `reach`: the caller
+    cuts at the exact distance) in a large one."""
+    live = state.in_world & state.present & (state.rab_size > 0)
     hearing = np.flatnonzero(live[robots])
     others = np.flatnonzero(live)
     if len(others) <= DENSE_UP_TO:
