@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from agents.controllers.arena import StepGuard, deliver, make_controller, publications
+from agents.controllers.arena import StepGuard, broadcasts, deliver, make_controller, publications
 from agents.runtime import AgentRuntime
 from swarm.core import heap, kernels, memory_codec, wire
 from world_server.arena.face import wire as arena_proto
@@ -73,12 +73,13 @@ class ArenaAgentRuntime(AgentRuntime):
             wheels.append(np.zeros(3) if self.null else
                           self.guard.action(self.brains[slot], reading, agent, self.names[slot], obs.tick))  # fmt: skip
         shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
+        rab = [] if self.null else broadcasts([b for _, b in mine], [a for a, _ in mine], self.guard.failed)
         if self.kept:  # the message that carried last tick's memory (MBs for a DFT robot) and zenoh's copy
             heap.give_back()  # of it are freed by now: all of it back to the system, not kept in the heap
         self.kept = keep = obs.keep and not self.null
         # the memory's arrays are written once, straight into the message (the save-tick peak)
         memory = [(a, memory_codec.pieces(b.snapshot())) for a, b in mine] if keep else []
-        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory)
+        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory, rab)
         self.act_publisher.put(payload)
         if not self.null:
             self._send_plans(obs.tick, agents)

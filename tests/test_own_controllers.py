@@ -152,8 +152,9 @@ def test_the_viewer_opens_on_the_arena_and_what_explains_each_groups_controller(
 
     from swarm.recording.arena import blueprint, records_of
 
+    own = {"/controllers/0/series", "/controllers/0/bars", "/controllers/0/images"}
     cases = (("dft", 1, {"/fields/0/M", "/fields/0/I", "/fields/0/intention", "/fields/0/action"}),
-             ("circlers:Circler", 2, {"/controllers/0/series", "/controllers/0/bars", "/controllers/0/images"}))  # fmt: skip
+             ("circlers:Circler", 2, own))  # fmt: skip
     for controller, agents, origins in cases:
         scenario = zmaze(controller, agents=agents)
         arena_view, _, explained = blueprint(rrb, scenario, records_of(scenario)).root_container.contents

@@ -40,6 +40,8 @@ class ArenaController(Protocol):
     # that one raising has changed nothing (the agent then keeps no rollback copy of the old state).
     # Optional: restore_copies = True when restore() copies the arrays it is given into its own and keeps
     # none of them: it is then given read-only views of the message that carried its memory, not copies.
+    # Optional: broadcast() -> bytes (or None: as before) its robot sends its range-and-bearing neighbours
+    # this tick (world_server/arena/face/sensors/range_bearing.py); read after step(), in both runtimes.
     # Optional: route() -> the path (N x 2 metres) a controller follows, or None.  An agent process asks
     # for it every tick to send a new plan to the recording, so it must be cheap (record() need not be).
 
@@ -119,6 +121,18 @@ def publications(controllers, agents) -> list[tuple[int, str, bytes]]:
         share = getattr(c, "shares", None)
         if share and (data := c.publish()) is not None:
             out.append((int(a), share, pack(data)))
+    return out
+
+
+def broadcasts(controllers, agents, failed=()) -> list[tuple[int, bytes]]:
+    """(agent, bytes) of every controller that broadcasts this tick (its optional `broadcast()`), in
+    agent order: the world hands them to its range-and-bearing neighbours at the next tick.  The
+    robots in `failed` (StepGuard.failed: their controllers raised) send nothing."""
+    out = []
+    for a, c in zip(agents, controllers, strict=True):
+        send = None if a in failed else getattr(c, "broadcast", None)
+        if send is not None and (data := send()) is not None:
+            out.append((int(a), bytes(data)))
     return out
 
 

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from agents.controllers.arena import StepGuard, deliver, make_controller, publications
+from agents.controllers.arena import StepGuard, broadcasts, deliver, make_controller, publications
 from swarm.engines.goals import ArenaGoals
 from swarm.engines.stepper import step_world
 from world_server.arena.scenario import ArenaScenario, controller_params
@@ -56,6 +56,7 @@ class ArenaEngine:
         def decide(perceptions, tick: int) -> np.ndarray:
             for a, (c, p) in enumerate(zip(self.controllers, perceptions, strict=True)):
                 self.actions[a] = self.guard.action(c, p, a, self.names[a], tick)
+            w.broadcast(broadcasts(self.controllers, self.agent_ids, self.guard.failed))
             shared = publications(self.controllers, self.agent_ids)
             if shared:  # what each wrote this tick, every other robot of its share reads before the next
                 self.shares.add(tick, shared)

@@ -206,6 +206,7 @@ class ArenaKind:
         if received is None:
             return
         msg, group = received
+        taken = set()  # the agents whose action this message gave
         for a, wheels in zip(msg.agents.tolist(), msg.wheels, strict=True):
             if not s.acting(a, group, msg.tick):
                 continue
@@ -216,8 +217,10 @@ class ArenaKind:
                 self.wheels[a, : len(wheels)] = wheels
                 self.ok[a] = True
                 s.acted[a] = True
+                taken.add(a)
         if msg.shared:
             self._take_shared(msg, group)
+        self.world.broadcast([(a, data) for a, data in msg.rab if a in taken])  # heard next tick, as in-process
         for a, blob in msg.memory:
             if s.acted[a] and s.group_of.get(a) == group and s.saves_after(msg.tick):
                 self.memory[a] = blob

@@ -63,6 +63,11 @@ class ArenaWorld:
         self.max_speed = np.array([m.max_speed for m in models])
         self.max_turn = np.array([m.max_turn_rate for m in models])
         self.robot_rgb = np.array([m.colour for m in models], np.uint8).reshape(-1, 3)
+        # what each robot broadcasts to its range-and-bearing neighbours (`broadcast`), 0 bytes without the sensor
+        rab = [m.sensors.range_and_bearing for m in models]
+        self.rab_size = np.array([0 if s is None else s.payload for s in rab], np.int64)
+        self.rab_sent = np.zeros((self.n, int(self.rab_size.max(initial=0))), np.uint8)  # what neighbours hear
+        self.rab_next = self.rab_sent.copy()  # this tick's, heard from the next tick on
 
     def _init_geometry(self, index_cell: float | None) -> None:
         """Wall rectangles and segments, then every obstacle's edges (switched by seg_on), and the
@@ -205,6 +210,23 @@ class ArenaWorld:
                   ranges, what)  # fmt: skip
         return ranges, what
 
+    def in_sight(self, robots: np.ndarray, others: np.ndarray, bearing: np.ndarray,
+                 distance: np.ndarray) -> np.ndarray:  # fmt: skip
+        """Whether each robot others[k] is the first solid thing (wall, box or robot) that a ray from
+        robots[k]'s centre meets at `bearing` (from its heading) within `distance` (the centres')."""
+        _, what = self.cast(robots, bearing, distance, mask=np.full(len(robots), SOLID, np.uint8))
+        return what == -2 - others
+
+    def broadcast(self, sent: list[tuple[int, bytes]]) -> None:
+        """What robots broadcast this tick (agent, bytes): each its range-and-bearing payload, cut or
+        padded with zeros to it (nothing without the sensor).  Neighbours hear it from the next tick on,
+        if the world takes the robot's action this tick (`apply`); else they hear what it sent before."""
+        for agent, data in sent:
+            size = int(self.rab_size[agent])
+            row = np.frombuffer(bytes(data[:size]), np.uint8)
+            self.rab_next[agent, :size] = 0
+            self.rab_next[agent, : len(row)] = row
+
     def hit_colours(self, what: np.ndarray) -> np.ndarray:
         rgb = np.zeros((len(what), 3), np.uint8)
         wall = what >= 0
@@ -262,6 +284,8 @@ class ArenaWorld:
             if actions.shape[1] == ACTION_WIDTH:
                 acts[ok] = actions[ok, -1].astype(np.int64)
         wheels = self._limit(wheels)
+        self.rab_sent[ok] = self.rab_next[ok]  # a refused action's broadcast is dropped with it
+        self.rab_next[...] = self.rab_sent
         before = self.pose[:, :2].copy()
         moving = ok & ~self.finished & self.present & self.in_world
         if self.metabolism is not None:  # the start-of-tick zones: where the robot was when it acted
@@ -346,6 +370,8 @@ class ArenaWorld:
         out["tick"] = np.array(self.tick)
         out["sim_seconds"] = np.array(self.bodies.sim_seconds)
         out["rejected"] = np.array([self.rejected[k] for k in REJECT_REASONS])
+        if self.rab_sent.size:
+            out["rab_sent"] = self.rab_sent.copy()
         if self.metabolism is not None:
             out.update(self.metabolism.snapshot())
         return out
@@ -356,6 +382,9 @@ class ArenaWorld:
         self.tick = int(state["tick"])
         self.rejected = dict.fromkeys(REJECT_REASONS, 0)
         self.rejected.update({k: int(v) for k, v in zip(REJECT_REASONS, state["rejected"], strict=False)})
+        if "rab_sent" in state:
+            self.rab_sent[...] = state["rab_sent"]
+            self.rab_next[...] = self.rab_sent
         if self.metabolism is not None:
             self.metabolism.restore(state)
         self._rebuild_bodies(state)

@@ -60,6 +60,7 @@ class WanderController:
         # where the IR sensors look and sit (their readings count from their mounts); none without IR
         self.ir_bearings = np.asarray(robot.get("ir_bearings") or (), np.float64)
         self.ir_mounts = np.asarray(robot.get("ir_mounts") or (), np.float64)
+        self.rab_payload = robot.get("rab_payload")  # bytes it broadcasts to its neighbours; None without the sensor
         self.tick = 0
         self.turning = 0  # ticks of random turn left (sign: direction)
 
@@ -105,6 +106,13 @@ class WanderController:
         if top > self.max_wheel:
             left, right = left * self.max_wheel / top, right * self.max_wheel / top
         return np.array([left, right])
+
+    def broadcast(self) -> bytes | None:
+        """Who it is and how many ticks it has wandered (little-endian uint16 each; the world cuts or pads it
+        to the payload) to the neighbours its range-and-bearing sensor reaches: a tag to build a swarm on."""
+        if self.rab_payload is None:
+            return None
+        return (np.array([self.agent, self.tick], np.int64) % 65536).astype("<u2").tobytes()
 
     def snapshot(self) -> dict[str, Any]:
         return {"tick": self.tick, "turning": self.turning, "params": asdict(self.p)}

@@ -8,6 +8,8 @@
                   on <share>/<agent> and hands them to every agent process with the next
                   tick's observations (`shared` there too), so in lock-step every robot reads
                   tick t's writes at tick t + 1, as in the in-process engine
+                  and what their robots broadcast to their range-and-bearing neighbours
+                  (`rab`: [agent, bytes], at most MAX_PAYLOAD each), heard from the next tick on
                   At the ticks after which the world saves its state (`keep` in the
                   observation), the action also carries each controller's memory
                   (`memory`: [agent, bytes of swarm.core.memory_codec]); the world stores it
@@ -44,6 +46,7 @@ from swarm.core.wire import (
     pack_ending_with,
     unpack,
 )
+from world_server.arena.face.sensors.range_bearing import MAX_PAYLOAD
 
 MAX_OBS_BYTES = 64 * 1024 * 1024  # observations come from the world; 100 animats take ~100 KB
 MAX_ACT_BYTES = 64 * 1024 * 1024  # an action may carry shared maps and, at a save, the controllers' memory
@@ -56,6 +59,7 @@ MAX_PLAN_POINTS = 2000  # 32 KB: a plan message stays under the world's message 
 MAX_SHARED = 4 * 1024 * 1024  # bytes of shared payloads in one message
 Shared = list[tuple[int, str, bytes]]  # (agent, share, payload)
 Memories = list[tuple[int, bytes | memoryview]]  # (agent, its controller's memory, swarm.core.memory_codec)
+Broadcasts = list[tuple[int, bytes]]  # (agent, what its robot broadcasts: sensors/range_bearing.py)
 MemoryPieces = list[tuple[int, list]]  # (agent, its memory as swarm.core.memory_codec.pieces): sent without a blob
 
 
@@ -75,6 +79,7 @@ class ArenaActs:
     wheels: np.ndarray  # (K, 2), or (K, 3) with acts; not yet judged
     shared: Shared = ()  # what these agents publish this tick, not yet judged
     memory: Memories = ()  # at a save: each controller's memory after this tick's step
+    rab: Broadcasts = ()  # what these agents' robots broadcast this tick, not yet judged
 
 
 @dataclass(frozen=True)
@@ -138,6 +143,23 @@ def parse_shared(raw) -> Shared | Rejected:
     return out
 
 
+def parse_rab(raw, agents: np.ndarray) -> Broadcasts | Rejected:
+    """[[agent, bytes], ...], only of the agents the action is for."""
+    if raw is None:
+        return []
+    if not isinstance(raw, list):
+        return Rejected("rab: expected a list of [agent, bytes]")
+    named, out = set(agents.tolist()), []
+    for item in raw:
+        if not (isinstance(item, list) and len(item) == 2 and type(item[0]) is int and isinstance(item[1], bytes)
+                and len(item[1]) <= MAX_PAYLOAD):  # fmt: skip
+            return Rejected(f"rab: expected [agent, at most {MAX_PAYLOAD} bytes]")
+        if item[0] not in named:
+            return Rejected("rab: names an agent the message does not act for")
+        out.append((item[0], item[1]))
+    return out
+
+
 def _encode(value) -> list:
     a = np.asarray(value)
     kind = {np.dtype(np.float64): "<f8", np.dtype(np.int64): "<i8", np.dtype(np.uint8): "|u1",
@@ -158,11 +180,12 @@ def observations(tick: int, agents, perceptions: list[dict[str, np.ndarray]], sh
     return pack(m)
 
 
-def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = (), memory: Memories | MemoryPieces = ()) -> bytes:
+def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = (), memory: Memories | MemoryPieces = (),
+            rab: Broadcasts = ()) -> bytes:  # fmt: skip
     """(K, 2) wheel speeds, or (K, 3) with a consummatory act each: the acts go
     in their own field, and only when one is not 0 (the message of robots
-    without a metabolism stays as it was).  Memory given as pieces is written
-    into the message once (the same bytes as its blob would give)."""
+    without a metabolism stays as it was); so do broadcasts, only when there are.
+    Memory given as pieces is written into the message once (the same bytes as its blob would give)."""
     wheels = np.asarray(wheels, np.float64).reshape(len(agents), -1)
     m = {"type": "act", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
          "wheels": np.ascontiguousarray(wheels[:, :2]).astype("<f8").tobytes()}  # fmt: skip
@@ -170,6 +193,8 @@ def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = (), memory: 
         m["acts"] = np.ascontiguousarray(wheels[:, 2]).astype("<f8").tobytes()
     if shared:
         m["shared"] = _shared_field(shared)
+    if rab:
+        m["rab"] = [[int(a), bytes(b)] for a, b in rab]
     if memory:
         return pack_ending_with(m, "memory", _memory_pieces(memory))
     return pack(m)
@@ -248,9 +273,9 @@ def parse_acts(data: bytes) -> ArenaActs | Rejected:
         if not isinstance(acts, bytes) or len(acts) != 8 * len(agents):
             return Rejected(f"acts: expected {len(agents)} binary float64")
         wheels = np.column_stack([wheels, np.frombuffer(acts, dtype="<f8").astype(np.float64)])
-    if bad := first_rejection(memory := parse_memory(m.get("memory"), agents)):
+    if bad := first_rejection(memory := parse_memory(m.get("memory"), agents), rab := parse_rab(m.get("rab"), agents)):
         return bad
-    return ArenaActs(tick, agents, wheels, shared, memory)
+    return ArenaActs(tick, agents, wheels, shared, memory, rab)
 
 
 @dataclass(frozen=True)

@@ -42,10 +42,11 @@ class Reading:
     this tick (uniform in [-1, 1), standard normal); `per_run(stream, k)` the robots' uniform draws
     that stay the same every tick of the run (a sensor's bias).  `noise` is the run's noise
     (world_server.arena.sensors.Noise: `factor(name)` scales a sensor's specified error).
-    `state` is the world, indexed by global robot id: pose, motion, contact, zones,
-    hit_colours(what).  `ranges`, `what` and `rgb` are this sensor's rays, (n, rays[, 3]): the
-    range from the sensor, what each hit (raycast.py: a segment >= 0, nothing -1, robot -2 - id)
-    and its colour (only for rays that asked for colours)."""
+    `state` is the world, indexed by global robot id: pose, motion, contact, zones, in_world,
+    present, hit_colours(what), in_sight(...) and the broadcasts (range_bearing.py).  `ranges`,
+    `what` and `rgb` are this sensor's rays, (n, rays[, 3]): the range from the sensor, what each
+    hit (raycast.py: a segment >= 0, nothing -1, robot -2 - id) and its colour (only for rays that
+    asked for colours)."""
 
     robots: np.ndarray
     tick: int
@@ -77,7 +78,7 @@ class Sensor:
     @classmethod
     def from_table(cls, table: dict[str, Any], base: Sensor | None = None) -> Sensor:
         """This sensor's spec from a scenario's table, over `base` (default: its defaults).  A list
-        is a tuple of numbers, a field whose value is an integer an integer, the rest numbers;
+        is a tuple of numbers, a switch (a bool field) true or false, an integer field an integer, the rest numbers;
         ValueError("field: what is expected") on a bad one."""
         base = base if base is not None else cls()
         known = cls.field_names()
@@ -86,6 +87,11 @@ class Sensor:
             if k not in known:
                 raise ValueError(f"{k}: unknown field; expected one of {', '.join(sorted(known))}")
             was = getattr(base, k)
+            if isinstance(was, bool):  # a switch: true or false, not a number
+                if not isinstance(v, bool):
+                    raise ValueError(f"{k}: expected true or false, got {v!r}")
+                typed[k] = v
+                continue
             try:
                 typed[k] = (tuple(float(x) for x in v) if isinstance(v, list) else
                             int(v) if isinstance(was, int) and not isinstance(was, bool) else float(v))  # fmt: skip
