@@ -1,0 +1,1 @@
+"""Reynolds flocking for swarm's arena: a controller package outside swarm (docs/controllers.md)."""
