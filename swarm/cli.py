@@ -408,8 +408,9 @@ def main(argv: list[str] | None = None) -> int:
         return 130
 
 
-def _scenario(args):
-    scenario = load_scenario(args.scenario)
+def resolve_scenario(args, loaded=None):
+    """The scenario the command line names (or `loaded`, already read) with its options applied."""
+    scenario = loaded if loaded is not None else load_scenario(args.scenario)
     common = {"agents": args.agents, "controller": args.controller, "seed": args.seed}
     return resolve(kind_of(scenario).overrides)(scenario, args, common)
 
@@ -424,7 +425,7 @@ def _check(scenario, until: str) -> None:
 def cmd_world(args) -> int:
     from swarm.world_process import serve
 
-    scenario = _scenario(args)
+    scenario = resolve_scenario(args)
     _check(scenario, args.until)
     summary = serve(scenario, args.run_id, args.summary_file, quiet=args.quiet,
                     listen=None if args.connect else args.listen,
@@ -459,7 +460,7 @@ def cmd_up(args) -> int:
     from swarm.launcher import swarm_up
     from world_server.server import new_run_id
 
-    scenario = _scenario(args)
+    scenario = resolve_scenario(args)
     _check(scenario, args.until)
     run_id = args.run_id or new_run_id()
     record = None if args.no_record else (args.record or f"runs/{run_id}.rrd")
@@ -479,7 +480,7 @@ def _print_any(summary: dict, as_json: bool, until: str) -> int:
 
 
 def cmd_run(args) -> int:
-    scenario = _scenario(args)
+    scenario = resolve_scenario(args)
     kind = kind_of(scenario)
     summary = resolve(kind.run)(scenario, args, _viewer_url(args.viewer) if args.record else None)
     if args.record:
