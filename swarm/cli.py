@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from agents.controllers import CONTROLLERS as CONTROLLER_REGISTRY
+from swarm.cli_check import add_check_parsers
 from swarm.cli_reproduce import add_reproduce_parser, cmd_reproduce
 from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_interrupt
 from swarm.core.registry import Option, Registry, resolve
@@ -73,6 +74,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_report(sub)
     _add_monitor(sub)
     _add_status(sub)
+    add_check_parsers(sub)
     _add_router(sub)
     _add_prepare(sub)
     for kind in WORLD_KINDS:  # a world kind's own commands (swarm sense); each sets its handler

@@ -71,3 +71,15 @@ def parse_scenario_text(text: str, source: str = "<string>", kind: str | None = 
 def parse_arena_text(text: str, source: str = "<string>", default_name: str = "arena") -> ArenaScenario:
     """An arena scenario from TOML text (kind = "arena" may be left out)."""
     return parse_scenario_text(text, source, "arena", default_name)
+
+
+def scenario_schema() -> dict:
+    """The JSON Schema of a scenario file: one of the world kinds' schemas (each kind's `schema`,
+    given that kind's controllers from the registry)."""
+    from world_server import WORLD_KINDS
+
+    kinds = [resolve(k.schema)({c.name: c for c in CONTROLLERS if c.world == k.name})
+             for k in WORLD_KINDS if k.schema is not None]  # fmt: skip
+    return {"$schema": "https://json-schema.org/draft/2020-12/schema", "title": "swarm scenario file",
+            "description": "A scenario of any world kind (`kind`; a file that names none is the default kind's).",
+            "oneOf": kinds}  # fmt: skip

@@ -234,6 +234,7 @@ class WorldKindSpec:
     options_title: str | None = None  # its options' own section of --help (None: among the command's own)
     check: str | None = None
     commands: tuple[str, ...] = ()
+    schema: str | None = None  # "module:function": schema(controllers) -> the JSON Schema of its scenario files
 
 
 class Entry(Protocol):

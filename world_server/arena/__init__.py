@@ -21,6 +21,7 @@ WORLD_KIND = WorldKindSpec(
     review="swarm.review.arena:arena_summary_from",
     plots="swarm.review.arena:write_arena_plots",
     metrics="swarm.recording.arena:ARENA_METRICS",
+    schema="world_server.arena.schema:schema",
     progress=("reached", "with_goal"),
     options="swarm.cli_arena:add_arena_run_args",
     options_title="arena scenarios",

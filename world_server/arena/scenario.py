@@ -32,6 +32,7 @@ import numpy as np
 from swarm.core.errors import ScenarioError
 from swarm.core.registry import ControllerSpec
 from swarm.core.tables import no_unknown, typed
+from world_server.arena import schema as fields
 from world_server.arena.face.robots import MODELS, RobotModel
 from world_server.arena.face.sensors import SENSORS, Sensors
 from world_server.arena.face.sensors.zones import ZONE_KINDS
@@ -92,9 +93,7 @@ class Obstacle:
         return ((self.rect[0] + self.rect[2]) / 2, (self.rect[1] + self.rect[3]) / 2)
 
 
-# The BG paper's resources: 50 x 50 cm squares, usable within 70 cm of their centre.
-RESOURCE_GREY = {"ingesting": 127, "digesting": 255, "dangerous": 31}
-RESOURCE_SIZE, RESOURCE_REACH = 0.5, 0.7
+RESOURCE_GREY, RESOURCE_SIZE, RESOURCE_REACH = fields.RESOURCE_GREY, fields.RESOURCE_SIZE, fields.RESOURCE_REACH
 
 
 @dataclass(frozen=True)
@@ -329,28 +328,7 @@ def clearance_at(xy: np.ndarray, rects: np.ndarray, segs: np.ndarray) -> np.ndar
 
 # --------------------------------------------------------------------- parsing
 
-_TOP = {
-    "kind",
-    "name",
-    "description",
-    "seed",
-    "size",
-    "robot",
-    "noise",
-    "control_period",
-    "substeps",
-    "checkpoint",
-    "max_ticks",
-    "goal_radius",
-    "goal_dwell",
-    "wall",
-    "zone",
-    "obstacle",
-    "resource",
-    "group",
-    "routes",
-    "metabolism",
-}
+_TOP = set(fields.TOP)  # the tables' keys are the schema's (world_server/arena/schema.py)
 
 
 def _tabled() -> tuple[str, ...]:
@@ -420,8 +398,7 @@ def _robot(value, source: str, where: str) -> RobotModel:
         return MODELS[value]
     if not isinstance(value, dict):
         raise ScenarioError(source, where, "expected a model name or a [robot] table")
-    allowed = {"model", "name", "radius", "axle", "max_wheel_speed", "max_speed", "max_turn_rate", "colour",
-               "sensors", *_tabled()}  # fmt: skip
+    allowed = {*fields.ROBOT, *_tabled()}
     no_unknown(value, allowed, source, f"[{where}]")
     model = _robot(value.get("model", "epuck"), source, f"{where}.model")
     changes: dict[str, Any] = {"name": _get(value, "name", str, source, model.name, f"{where}.name")}
@@ -485,7 +462,7 @@ def _noise(value, source: str) -> Noise:
 def _wall(w, source: str, where: str) -> Wall:
     if not isinstance(w, dict):
         raise ScenarioError(source, where, "expected a [[wall]] table")
-    no_unknown(w, {"rect", "segment", "colour", "name"}, source, f"[[wall]] ({where})")
+    no_unknown(w, set(fields.WALL), source, f"[[wall]] ({where})")
     if ("rect" in w) == ("segment" in w):
         raise ScenarioError(source, where, "give exactly one of rect = [x0, y0, x1, y1] or segment = [x0, y0, x1, y1]")
     shape = "rect" if "rect" in w else "segment"
@@ -501,7 +478,7 @@ def _wall(w, source: str, where: str) -> Wall:
 def _zone(z, source: str, where: str) -> Zone:
     if not isinstance(z, dict):
         raise ScenarioError(source, where, "expected a [[zone]] table")
-    no_unknown(z, {"kind", "rect", "disc", "name"}, source, f"[[zone]] ({where})")
+    no_unknown(z, set(fields.ZONE), source, f"[[zone]] ({where})")
     kind = _get(z, "kind", str, source, None, f"{where}.kind")
     if kind not in ZONE_KINDS:
         raise ScenarioError(source, f"{where}.kind", f"unknown {kind!r}; expected one of {', '.join(ZONE_KINDS)}")
@@ -519,7 +496,7 @@ def _zone(z, source: str, where: str) -> Zone:
 def _obstacle(o, source: str, where: str) -> Obstacle:
     if not isinstance(o, dict):
         raise ScenarioError(source, where, "expected an [[obstacle]] table")
-    no_unknown(o, {"rect", "appear", "vanish", "colour", "name"}, source, f"[[obstacle]] ({where})")
+    no_unknown(o, set(fields.OBSTACLE), source, f"[[obstacle]] ({where})")
     rect = _rect(_numbers(o, "rect", source, f"{where}.rect", 4), source, f"{where}.rect")
     appear = _get(o, "appear", int, source, 0, f"{where}.appear")
     vanish = _get(o, "vanish", int, source, None, f"{where}.vanish")
@@ -533,8 +510,7 @@ def _obstacle(o, source: str, where: str) -> Obstacle:
 def _resource(r, source: str, where: str) -> Obstacle:
     if not isinstance(r, dict):
         raise ScenarioError(source, where, "expected a [[resource]] table")
-    no_unknown(r, {"kind", "centre", "size", "reach", "appear", "vanish", "colour", "name"}, source,
-                f"[[resource]] ({where})")  # fmt: skip
+    no_unknown(r, set(fields.RESOURCE), source, f"[[resource]] ({where})")
     kind = _get(r, "kind", str, source, None, f"{where}.kind")
     if kind not in RESOURCE_GREY:
         raise ScenarioError(source, f"{where}.kind", f"unknown {kind!r}; expected one of {', '.join(RESOURCE_GREY)}")
@@ -557,8 +533,7 @@ def _resource(r, source: str, where: str) -> Obstacle:
 def _group(g, robot: RobotModel, controllers: Mapping[str, ControllerSpec], source: str, where: str) -> Group:
     if not isinstance(g, dict):
         raise ScenarioError(source, where, "expected a [[group]] table")
-    no_unknown(g, {"count", "controller", "robot", "start", "starts", "clearance", "goal", "goals", "route"},
-                source, f"[[group]] ({where})")  # fmt: skip
+    no_unknown(g, set(fields.GROUP), source, f"[[group]] ({where})")
     count = _get(g, "count", int, source, 1, f"{where}.count")
     controller = _get(g, "controller", str, source, "carrot", f"{where}.controller")
     _check_controller(controller, controllers, source, f"{where}.controller")

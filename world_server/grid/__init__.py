@@ -20,6 +20,7 @@ WORLD_KIND = WorldKindSpec(
     review="swarm.review.grid:grid_summary_from",
     plots="swarm.review.grid:write_grid_plots",
     metrics="swarm.recording.grid:METRICS",
+    schema="world_server.grid.schema:schema",
     progress=("delivered", "total"),
     options="swarm.cli_grid:add_grid_options",
     overrides="swarm.cli_grid:grid_overrides",

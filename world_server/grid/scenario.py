@@ -167,6 +167,7 @@ def paper_setup(number: int, size: int | None = None) -> Scenario:
 _TOP_KEYS = {"name", "seed", "agents", "controller", "q_max", "quantity", "map", "generator"}
 _TOP_KEYS |= {"ant", "cmarking", "physics"}
 _CMARKING_TEXTS = ("return_on_trail", "at_base")
+GENERATOR_KEYS = {"width", "height", "obstacle_density", "resources"}
 
 
 def parse_section(data: dict, text: str, source: str, name: str, controllers: Mapping) -> Scenario:
@@ -236,9 +237,9 @@ def _parse_map(data: dict, text: str, source: str, kw: dict[str, Any]) -> None:
 def _parse_generator(data: dict, source: str) -> Generator:
     """The [generator] table, every key required."""
     section = section_of(data, "generator", source)
-    keys = {"width", "height", "obstacle_density", "resources"}
+    keys = GENERATOR_KEYS
     no_unknown(section, keys, source, "[generator]")
-    for key in keys:
+    for key in sorted(keys):
         if key not in section:
             raise ScenarioError(source, f"generator.{key}", "missing")
     return Generator(
