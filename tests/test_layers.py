@@ -6,7 +6,7 @@ Layers, bottom to top (docs/architecture.md):
     worlds    world_server: one folder per world kind (its world, server, controller face), the world process
     agents    agents: the controllers and the agent process; of the worlds only a kind's face and the
               world kinds' declarations (world_server.WORLD_KINDS: plain data, found by the runtimes)
-    runners   engines, launcher, monitor, recording, review, scenario loading
+    runners   engines, envs, launcher, monitor, recording, review, scenario loading
     top       experiments, benchmarks, the command line
 
 Imports are read by grimp from the source, those inside functions included.
@@ -29,6 +29,7 @@ LAYERS = {  # module prefix -> layer (the longest prefix wins)
     "world_server": 1,
     "agents": 2,
     "swarm.engines": 3,
+    "swarm.envs": 3,
     "swarm.launcher": 3,
     "swarm.world_process": 3,
     "swarm.monitor": 3,
