@@ -32,7 +32,7 @@ def controller_name(text: str) -> str:
     return text
 
 
-DESCRIPTION = """\
+DESCRIPTION_TEMPLATE = """\
 swarm: multi-robot foraging with c-marking agents (Simonin et al. 2007),
 the plain marking agents and the pheromone ant baseline, on a grid; and the
 arena, a continuous world of walls and differential-drive robots.
@@ -53,14 +53,22 @@ examples:
   swarm experiment dft-case1                    # SPA beside follow the carrot on the paper's 100 pairs
   swarm run bg-exp1                             # the basal-ganglia animat survives (Girard et al. 2005)
   swarm up bg-colony                            # four animats, each its own process, sharing one map
-  swarm bench engine | distributed | recording | arena | fingerprint | dft | bg
+  swarm run zmaze --controller my_pkg.mod:Mine  # your own controller class (docs/controllers.md)
+  swarm check my_floor.toml                     # a scenario judged and its floor drawn to my_floor.png
+  swarm bench {benchmarks}
   docker compose up swarm                       # the same in containers (compose.yaml, docs/docker.md)
 """
 
 
+def _description() -> str:
+    from swarm.bench import BENCHMARKS
+
+    return DESCRIPTION_TEMPLATE.format(benchmarks=" | ".join(BENCHMARKS.names()))
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="swarm", description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter
+        prog="swarm", description=_description(), formatter_class=argparse.RawDescriptionHelpFormatter
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     _add_run(sub)
