@@ -19,7 +19,7 @@ from swarm.core.errors import RunError, ScenarioError
 from swarm.core.registry import ControllerSpec, Registry, UnknownPart
 from swarm.engines.arena import ArenaEngine
 from swarm.scenario import load_scenario
-from tests.arena_helpers import arena, rrd_rows
+from tests.arena_helpers import arena, resumed_pair, rrd_rows
 from tests.distributed import run_world
 
 OUTSIDE = Path(__file__).parent / "outside"
@@ -89,6 +89,12 @@ def test_agent_processes_run_a_users_controller_lock_step_equal_to_in_process():
     expected.run()
     _, world = run_world(scenario, "own-lockstep", [("circlers:Circler", 1, 3)], deadline=60.0)
     np.testing.assert_array_equal(world.pose, expected.world.pose)
+
+
+def test_a_users_controller_resumes_exactly_from_its_snapshot():
+    a, b = resumed_pair(zmaze("circlers:Circler", agents=3, ticks=80), 40)
+    np.testing.assert_array_equal(a.world.pose, b.world.pose)
+    assert [c.ticks for c in a.controllers] == [c.ticks for c in b.controllers] == [80] * 3
 
 
 def test_a_controller_that_raises_stops_its_robot_and_the_run_goes_on_alike_in_both_runtimes(capsys):
