@@ -7,7 +7,7 @@ Layers, bottom to top (docs/architecture.md):
     agents    agents: the controllers and the agent process; of the worlds only a kind's face and the
               world kinds' declarations (world_server.WORLD_KINDS: plain data, found by the runtimes)
     runners   engines, launcher, monitor, recording, review, scenario loading
-    top       experiments, benchmarks, the command line
+    top       experiments, benchmarks, sweeps, the command line
 
 Imports are read by grimp from the source, those inside functions included.
 """
@@ -40,6 +40,8 @@ LAYERS = {  # module prefix -> layer (the longest prefix wins)
     "swarm.cli": 4,
     "swarm.cli_arena": 4,
     "swarm.cli_reproduce": 4,
+    "swarm.cli_sweep": 4,
+    "swarm.sweep": 4,
     "swarm.cli_grid": 4,
     "swarm.__main__": 4,
 }
