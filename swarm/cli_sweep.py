@@ -24,7 +24,7 @@ a sweep file:
   "wander.speed" = [0.4, 0.6, 0.8]
   "wander.turn_chance" = [0.02, 0.05]
 
-writes runs.csv (one row a run, kept as runs end: rerunning resumes), runs.parquet (with pyarrow),
+writes runs.csv (one row a run, kept as runs end: rerunning resumes), runs.parquet,
 summary.csv (n, mean, std, 95% t interval per condition) and METRIC.png per metric."""
 
 
@@ -60,6 +60,6 @@ def cmd_sweep(args) -> int:
         return 0
     print(f"swarm sweep {args.file}: {len(result['rows'])} runs ({result['ran']} run now, {result['reused']} "
           f"already in runs.csv) in {wall:.1f} s")  # fmt: skip
-    parquet = "" if result["parquet"] else " (no runs.parquet: pyarrow is not installed)"
+    parquet = f" (no runs.parquet: {result['no_parquet']})" if result["no_parquet"] else ""
     print(f"wrote {', '.join(result['files'])}{parquet}")
     return 0

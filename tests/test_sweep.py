@@ -5,13 +5,16 @@ from __future__ import annotations
 import argparse
 import csv
 import math
+import pickle
 from dataclasses import replace
 
+import pandas as pd
 import pytest
 
 from swarm.cli import main
 from swarm.cli_arena import run_arena
 from swarm.cli_grid import run_grid
+from swarm.core.errors import ScenarioError
 from swarm.scenario import load_scenario, parse_scenario_data, parse_scenario_text, scenario_path, scenario_tables
 from swarm.sweep import run_sweep
 from swarm.sweep.jobs import assign
@@ -49,6 +52,7 @@ def test_a_tiny_sweep_writes_its_runs_summary_and_plots(tiny):
     assert [(r["wander.speed"], r["n"]) for r in summary] == [("0.4", "2"), ("0.8", "2")]
     assert {"distance_mean", "distance_std", "distance_ci_low", "distance_ci_high"} <= set(summary[0])
     assert all((out / f"{m}.png").stat().st_size > 1000 for m in METRICS)
+    assert result["no_parquet"] is None and len(pd.read_parquet(out / "runs.parquet")) == 4
     # wander drives at a share of the wheel limit: twice the speed, about twice the distance
     assert float(summary[1]["distance_mean"]) > 1.5 * float(summary[0]["distance_mean"])
 
@@ -90,6 +94,8 @@ def test_a_sweep_run_equals_the_run_of_a_scenario_file_with_the_same_table(tiny)
         ('controller = "nope"', "unknown arena controller 'nope'"),
         ("seeds = { first = 1, count = 0 }", "seeds"),
         ("grid = 3", "expected a [grid] table"),
+        ('metrics = ["builtins:abs"]', "raised TypeError"),
+        ('metrics = ["no_such_module:f"]', "cannot use 'no_such_module:f'"),
     ],
 )
 def test_a_bad_sweep_is_refused_in_one_line_before_any_run(tmp_path, capsys, body, says):
@@ -108,10 +114,12 @@ def test_a_bad_sweep_is_refused_in_one_line_before_any_run(tmp_path, capsys, bod
 
 def test_a_grid_preset_sweeps_its_generator_and_agents(tmp_path):
     spec = {"scenarios": ["setup1"], "agents": [2, 3], "max_iterations": 30, "seeds": [1],
-            "metrics": ["delivered", "explored_cells"], "grid": {"generator.obstacle_density": [0.1, 0.3]}}  # fmt: skip
+            "metrics": ["delivered", "explored_cells", "builtins:len"],
+            "grid": {"generator.obstacle_density": [0.1, 0.3]}}  # fmt: skip
     rows = run_sweep(spec, jobs=1, out=tmp_path, progress=False)["rows"]
     assert [(r["generator.obstacle_density"], r["agents"]) for r in rows] == [(0.1, 2), (0.1, 3), (0.3, 2), (0.3, 3)]
     assert (tmp_path / "delivered.png").exists() and (tmp_path / "summary.csv").exists()
+    assert all(r["builtins:len"] > 5 for r in rows)  # a metric of yours: module:function(summary)
     preset = load_scenario("setup1")
     assert parse_scenario_data(*scenario_tables("setup1")) == preset  # a preset's tables are the preset
     scenario = replace(preset, generator=replace(preset.generator, obstacle_density=0.3)).with_overrides(
@@ -120,6 +128,11 @@ def test_a_grid_preset_sweeps_its_generator_and_agents(tmp_path):
     args = argparse.Namespace(record=None, until="foraged", max_iterations=30, json=True)
     summary = run_grid(scenario, args)
     assert [rows[3]["delivered"], rows[3]["explored_cells"]] == [summary["delivered"], summary["explored_cells"]]
+
+
+def test_a_scenario_error_raised_in_a_worker_reaches_the_parent_whole():
+    exc = pickle.loads(pickle.dumps(ScenarioError("f.toml", "metrics", "no 'x'")))
+    assert (exc.source, exc.where, str(exc)) == ("f.toml", "metrics", "f.toml: metrics: no 'x'")
 
 
 def test_dotted_keys_reach_arrays_of_tables_and_user_controllers():

@@ -31,7 +31,8 @@ def sweep(path_or_dict: str | Path | Mapping[str, Any], jobs: int | None = None,
 
 def run_sweep(path_or_dict: str | Path | Mapping[str, Any], jobs: int | None = None, out: str | Path | None = None,
               fresh: bool = False, progress: bool = True) -> dict:  # fmt: skip
-    """sweep(), and what it did: {"rows", "ran", "reused", "out", "files", "parquet"}.  The folder also keeps
+    """sweep(), and what it did: {"rows", "ran", "reused", "out", "files", "no_parquet"
+    (why there is no runs.parquet, or None)}.  The folder also keeps
     sweep.json: the settings every run shares."""
     from swarm.experiments.runner import batch_run, cross, processes_for
     from swarm.sweep.jobs import check_metrics, run_job, warm_up
@@ -87,9 +88,9 @@ def _finish(spec: SweepSpec, work: list[Job], runs: RunsFile, folder: Path) -> d
     runs.write([runs.rows[k] for k in keys] + [r for k, r in runs.rows.items() if k not in mine])
     numbers = [{v: float(runs.rows[k][v]) for v in runs.values} for k in keys]
     rows = [columns(job, spec) | values for job, values in zip(work, numbers, strict=True)]
-    parquet = write_parquet(rows, folder / "runs.parquet")
+    no_parquet = write_parquet(rows, folder / "runs.parquet")
     summary = summarise(rows, ["scenario", *spec.axes], spec.metrics)
     write_csv(folder / "summary.csv", summary)
     plots = plot_metrics(summary, [*spec.axes, "scenario"], spec.metrics, folder)
-    files = [folder / "runs.csv", *([parquet] if parquet else []), folder / "summary.csv", *plots]
-    return {"rows": rows, "out": str(folder), "files": [str(f) for f in files], "parquet": parquet is not None}
+    files = [folder / "runs.csv", *([] if no_parquet else [folder / "runs.parquet"]), folder / "summary.csv", *plots]
+    return {"rows": rows, "out": str(folder), "files": [str(f) for f in files], "no_parquet": no_parquet}

@@ -119,7 +119,11 @@ def metric(summary: dict, name: str) -> float:
     """A summary's value of `name`: its top-level key, else the robots' mean of their key ("distance"),
     else a "module:function" of the summary (nan: no value, as a path ratio without a goal)."""
     if ":" in name:
-        return _number(resolve(name)(summary), name)
+        try:
+            value = resolve(name)(summary)
+        except Exception as exc:  # whatever a user's function raises: one line naming it
+            raise ScenarioError("metrics", name, f"raised {type(exc).__name__}: {exc}") from None
+        return _number(value, name)
     if name in summary:
         return _number(summary[name], name)
     values = [_number(r[name], name) for r in summary.get("robots", ()) if name in r]

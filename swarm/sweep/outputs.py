@@ -80,15 +80,19 @@ def _is_number(text: str) -> bool:
     return True
 
 
-def write_parquet(rows: Sequence[dict], path: Path) -> Path | None:
-    """runs.parquet, where pyarrow (and pandas) are installed; None where they are not."""
+def write_parquet(rows: Sequence[dict], path: Path) -> str | None:
+    """runs.parquet (pandas and pyarrow); None when written, else why not, in a few words."""
     if importlib.util.find_spec("pyarrow") is None or importlib.util.find_spec("pandas") is None:
-        return None
+        return "pandas or pyarrow is not installed"
     import pandas as pd
 
     frame = pd.DataFrame([{k: cell(v) if isinstance(v, list | dict) else v for k, v in r.items()} for r in rows])
-    frame.to_parquet(path, index=False)
-    return path
+    try:
+        frame.to_parquet(path, index=False)
+    except (TypeError, ValueError) as exc:  # pyarrow's ArrowTypeError, ArrowInvalid: a column of mixed types
+        path.unlink(missing_ok=True)
+        return f"pyarrow refused the rows ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
+    return None
 
 
 def summarise(rows: Sequence[dict], conditions: Sequence[str], metrics: Sequence[str]) -> list[dict]:
