@@ -34,9 +34,6 @@ class Condition:
     grid: tuple[tuple[str, Any], ...]
     settings: tuple[tuple[str, Any], ...]
 
-    def setting(self, key: str) -> Any:
-        return dict(self.settings).get(key)
-
     def with_setting(self, key: str, value: Any) -> Condition:
         return replace(self, settings=tuple((k, value if k == key else v) for k, v in self.settings))
 
