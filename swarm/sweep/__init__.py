@@ -42,10 +42,10 @@ def run_sweep(path_or_dict: str | Path | Mapping[str, Any], jobs: int | None = N
     folder = Path(out) if out is not None else Path("results") / "sweeps" / spec.name
     runs = RunsFile(folder / "runs.csv", ["scenario", *spec.axes, "seed"], [*spec.metrics, "wall_s"], fresh)
     todo = [job for job in work if runs.key(columns(job, spec)) not in runs.rows]
+    fixed = _fixed(spec, folder, fresh)
     firsts = list({job.condition.scenario: job for job in reversed(todo)}.values())
     for job in firsts:  # an unknown metric is refused before any run (and the kernels are loaded here)
         check_metrics(job)
-    fixed = _fixed(spec, folder, fresh)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "sweep.json").write_text(json.dumps(fixed, indent=1) + "\n")
     runs.write(list(runs.rows.values()))  # a row a kill cut short is left out, so appending goes on cleanly
