@@ -142,3 +142,10 @@ def test_dotted_keys_reach_arrays_of_tables_and_user_controllers():
     assert data == {"group": [{"count": 3}], "my.pkg:Ctl": {"gain": 0.5}}
     with pytest.raises(ValueError, match="a number from 1 to 1"):
         assign(data, "group.2.count", 1, "f")
+
+
+def test_the_help_shows_a_sweep_file(capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["sweep", "--help"])
+    out = capsys.readouterr().out
+    assert stop.value.code == 0 and "a sweep file:" in out and '"wander.speed" = [0.4, 0.6, 0.8]' in out
