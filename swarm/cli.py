@@ -11,6 +11,7 @@ from pathlib import Path
 from agents.controllers import CONTROLLERS as CONTROLLER_REGISTRY
 from swarm.cli_check import add_check_parsers
 from swarm.cli_reproduce import add_reproduce_parser, cmd_reproduce
+from swarm.cli_sweep import add_sweep_parser
 from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_interrupt
 from swarm.core.registry import Option, Registry, resolve
 from swarm.core.tables import positive, seed
@@ -45,6 +46,7 @@ examples:
   swarm run maze --physics physical --record maze.rrd
   swarm run maze --controller marking --until converged --json
   swarm experiment table1 --reps 100
+  swarm sweep my-sweep.toml --jobs 4            # scenarios x a parameter grid x seeds: runs.csv, summary, plots
   swarm run zmaze --noise high                  # an arena: the carrot e-puck in the DFT paper's Z-maze
   swarm sense zmaze --pose 0.2,0.5,0            # what a robot senses there
   swarm run office --controller fingerprint     # the scout maps the office floor with fingerprints of places
@@ -74,6 +76,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_run(sub)
     _add_experiment(sub)
     add_reproduce_parser(sub)
+    add_sweep_parser(sub)
     _add_bench(sub)
     _add_world(sub)
     _add_agent(sub)

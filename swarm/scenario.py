@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 import tomllib
+from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -31,15 +32,29 @@ def bundled_scenarios() -> list[str]:
 
 def load_scenario(ref: str) -> Scenario:
     """A preset name, a bundled scenario name, or a path to a TOML file."""
+    preset = _preset(ref)
+    if preset is not None:
+        return preset
+    path = scenario_path(ref)
+    return parse_scenario_text(path.read_text(encoding="utf-8", errors="replace"), str(path))
+
+
+def _preset(ref: str) -> Scenario | None:
+    """The paper's setup `ref` names (None: `ref` names no preset)."""
     m = re.fullmatch(r"setup([123])(?:-(\d+))?", ref)
-    if m:
-        number = int(m.group(1))
-        if number != 3 and m.group(2):
-            raise ScenarioError(f"preset {ref}", "name", f"setup{number} takes no size")
-        size = int(m.group(2)) if m.group(2) else None
-        if size is not None and not 5 <= size <= 4096:
-            raise ScenarioError(f"preset {ref}", "size", "expected a size from 5 to 4096")
-        return paper_setup(number, size)
+    if not m:
+        return None
+    number = int(m.group(1))
+    if number != 3 and m.group(2):
+        raise ScenarioError(f"preset {ref}", "name", f"setup{number} takes no size")
+    size = int(m.group(2)) if m.group(2) else None
+    if size is not None and not 5 <= size <= 4096:
+        raise ScenarioError(f"preset {ref}", "size", "expected a size from 5 to 4096")
+    return paper_setup(number, size)
+
+
+def scenario_path(ref: str) -> Path:
+    """The file of a bundled name or a path (ScenarioError naming the choices when there is none)."""
     path = Path(ref)
     if not path.exists() and (BUNDLED_DIR / f"{ref}.toml").exists():
         path = BUNDLED_DIR / f"{ref}.toml"
@@ -49,17 +64,41 @@ def load_scenario(ref: str) -> Scenario:
             "scenario",
             f"no such file or preset; presets: {PRESET_HELP}; bundled: {', '.join(bundled_scenarios())}",
         )
-    return parse_scenario_text(path.read_text(encoding="utf-8", errors="replace"), str(path))
+    return path
+
+
+def scenario_tables(ref: str) -> tuple[dict, str, str]:
+    """(tables, text, source) of a scenario as a file would give them, so that a program can change a
+    value and parse it again (parse_scenario_data) with every check a file gets.  A preset's tables
+    are those of a file that says what the preset is (its generator, counts and seed)."""
+    preset = _preset(ref)
+    if preset is not None:
+        assert preset.generator is not None
+        data = {"name": preset.name, "seed": preset.seed, "agents": preset.agents, "controller": preset.controller,
+                "q_max": preset.q_max, "quantity": preset.quantity, "generator": asdict(preset.generator)}  # fmt: skip
+        return data, "", preset.source
+    path = scenario_path(ref)
+    text = path.read_text(encoding="utf-8", errors="replace")
+    return _toml(text, str(path)), text, str(path)
+
+
+def _toml(text: str, source: str) -> dict:
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(source, "TOML", f"not valid TOML ({exc})") from None
 
 
 def parse_scenario_text(text: str, source: str = "<string>", kind: str | None = None, name: str | None = None):
     """The scenario of the world kind the file names (`kind = ...`; the default kind's when it names
     none), or of `kind` (the file may then leave it out), named `name` (default: the file's stem)
     unless the file says.  Each kind parses its own section (world_server.WORLD_KINDS)."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(source, "TOML", f"not valid TOML ({exc})") from None
+    return parse_scenario_data(_toml(text, source), text, source, kind, name)
+
+
+def parse_scenario_data(data: dict, text: str = "", source: str = "<string>", kind: str | None = None,
+                        name: str | None = None):  # fmt: skip
+    """The scenario of a file's tables `data` (parse_scenario_text; `text` only points at map lines)."""
     try:
         spec = world_kind(kind or data.get("kind", world_kind().name))
     except UnknownPart as exc:

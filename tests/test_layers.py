@@ -7,7 +7,7 @@ Layers, bottom to top (docs/architecture.md):
     agents    agents: the controllers and the agent process; of the worlds only a kind's face and the
               world kinds' declarations (world_server.WORLD_KINDS: plain data, found by the runtimes)
     runners   engines, envs, launcher, monitor, recording, review, scenario loading
-    top       experiments, benchmarks, the command line
+    top       experiments, benchmarks, sweeps, the command line, the Python API
 
 Imports are read by grimp from the source, those inside functions included.
 """
@@ -41,6 +41,8 @@ LAYERS = {  # module prefix -> layer (the longest prefix wins)
     "swarm.cli": 4,
     "swarm.cli_arena": 4,
     "swarm.cli_reproduce": 4,
+    "swarm.cli_sweep": 4,
+    "swarm.sweeps": 4,
     "swarm.cli_grid": 4,
     "swarm.cli_check": 4,
     "swarm.api": 4,

@@ -23,3 +23,6 @@ class ScenarioError(ValueError):
     def __init__(self, source: str, where: str, problem: str):
         self.source, self.where, self.problem = source, where, problem
         super().__init__(f"{source}: {where}: {problem}")
+
+    def __reduce__(self):  # raised in a worker process, it reaches the parent whole
+        return (type(self), (self.source, self.where, self.problem))

@@ -34,11 +34,12 @@ def processes_for(jobs: int | None, work: int) -> int:
 
 def batch_run(fn: Callable[[Job], dict], work: Sequence[Job], *, jobs: int | None = None, desc: str = "runs",
               progress: bool = True, warm_up: Callable[..., None] | None = None, warm_args: tuple = (),
-              chunksize: int = 1) -> list[dict]:  # fmt: skip
+              chunksize: int = 1, on_row: Callable[[int, dict], None] | None = None) -> list[dict]:  # fmt: skip
     """`fn` over every job of `work` in `jobs` spawned processes (default: every core), rows in `work`'s order.
 
     `warm_up(*warm_args)` runs once here and once in each worker before any job, so compiling (or loading)
     kernels is never part of a run's wall time.  One process, or one job, runs here without a pool.
+    `on_row(i, row)` is told of each row as it comes in (a sweep saves it at once, so a killed one resumes).
     """
     from tqdm import tqdm
 
@@ -51,12 +52,16 @@ def batch_run(fn: Callable[[Job], dict], work: Sequence[Job], *, jobs: int | Non
         if processes == 1:
             for i, job in enumerate(work):
                 rows[i] = fn(job)
+                if on_row is not None:
+                    on_row(i, rows[i])
                 bar.update()
         else:
             init = {"initializer": warm_up, "initargs": warm_args} if warm_up is not None else {}
             with mp.get_context("spawn").Pool(processes, **init) as pool:
                 for i, row in pool.imap_unordered(partial(_numbered, fn), enumerate(work), chunksize=chunksize):
                     rows[i] = row
+                    if on_row is not None:
+                        on_row(i, row)
                     bar.update()
     finally:
         bar.close()
