@@ -13,6 +13,11 @@ from swarm.experiments import PAPERS
 from swarm.experiments.protocol import CONFIRMATION_SEEDS, NOT_REPRODUCED, REPRODUCED, REVERSED, SAME_DIRECTION
 
 VERDICTS = {REPRODUCED, SAME_DIRECTION, NOT_REPRODUCED, REVERSED, "–"}
+# Simulated time a test's quick run may cut further: girard2005's survival and mapping runs end at 10 min, not 20
+# (the same claims, each with its test and a p-value; at 5 min the maps are too short for exp. 2.1 to vary);
+# billing2015's large-maze runs at 750 steps, not 1000 (the same summary; at 500 no run reaches its goal, and
+# the path-ratio ANOVA has nothing to compare)
+SHORTER = {"girard2005": {"QUICK_SECONDS": 600.0}, "billing2015": {"QUICK_CASE2_STEPS": 750}}
 
 
 def test_every_paper_names_its_report_function_and_an_existing_page():
@@ -31,6 +36,8 @@ def test_a_quick_report_runs_on_confirmation_seeds_and_judges_every_claim(name, 
 
     mod = importlib.import_module(module)
     monkeypatch.setattr(mod, "QUICK_REPS", {k: min(n, 2) for k, n in mod.QUICK_REPS.items()})  # the fewest a test takes
+    for attr, value in SHORTER.get(name, {}).items():
+        monkeypatch.setattr(mod, attr, value)
     result = resolve(PAPERS[name].reproduce)(quick=True, jobs=2, out=tmp_path, progress=False)
     report = (tmp_path / "report.md").read_text()
     assert "Quick run" in report and result["claims"] > 0 and (tmp_path / "parameters.md").is_file()

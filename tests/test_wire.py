@@ -120,7 +120,8 @@ def test_the_batch_answer_equals_the_engine_step_agent_by_agent():
     assert answer_rows(kind, ints_ro[:-1], pf_ro, mems, slot_of, out, params, seed, 12, False) == -1
     bad = pf.copy()
     bad[3, 0] = np.nan
-    assert answer_rows(kind, ints_ro, bad.ravel(), mems, slot_of, out, params, seed, 12, False) == -1
+    bad_ro = np.frombuffer(bad.tobytes(), "<f8")  # read-only, as a message's block (one compiled signature)
+    assert answer_rows(kind, ints_ro, bad_ro, mems, slot_of, out, params, seed, 12, False) == -1
     np.testing.assert_array_equal(mems, before)
     # the null floor answers STAY for ours and leaves the memory alone
     assert answer_rows(kind, ints_ro, pf_ro, mems, slot_of, out, params, seed, 13, True) == 4
