@@ -36,10 +36,10 @@ class ArenaAgentRuntime(AgentRuntime):
         blob = msg.pop("memory", None)  # a missing agent's place, taken over where it was saved
         self.names[slot] = msg.get("controller", self.controller)
         brain = make_controller(self.names[slot])
-        brain.reset(int(msg["seed"]), agent, msg["params"])
+        self.guard.reset(brain, int(msg["seed"]), agent, msg["params"], self.names[slot])
         self.brains[slot] = brain
         heap.give_back()  # what building the controller used and freed (a DFT robot's kernels: ~5 MB)
-        if isinstance(blob, bytes):
+        if isinstance(blob, bytes) and agent not in self.guard.failed:
             memory, blob = _decoded(brain, blob), None  # the blob goes before the rollback state comes
             self.refused_memory += not restore_or_keep(brain, memory)
             memory = None
@@ -64,7 +64,8 @@ class ArenaAgentRuntime(AgentRuntime):
         agents, wheels = [], []
         mine = [(a, self.brains[self.slot_of[a]]) for a in obs.agents.tolist() if a in self.slot_of]
         if obs.shared and not self.null:  # what every robot published last tick, before this tick's step
-            self.refused_shared += deliver([b for _, b in mine], [a for a, _ in mine], list(obs.shared))
+            self.refused_shared += deliver([b for _, b in mine], [a for a, _ in mine], list(obs.shared),
+                                           self.guard.failed)  # fmt: skip
         for agent, reading in zip(obs.agents.tolist(), obs.perceptions, strict=True):
             slot = self.slot_of.get(agent)
             if slot is None:
@@ -72,13 +73,13 @@ class ArenaAgentRuntime(AgentRuntime):
             agents.append(agent)
             wheels.append(np.zeros(3) if self.null else
                           self.guard.action(self.brains[slot], reading, agent, self.names[slot], obs.tick))  # fmt: skip
-        shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine])
+        shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine], self.guard.failed)
         rab = [] if self.null else broadcasts([b for _, b in mine], [a for a, _ in mine], self.guard.failed)
         if self.kept:  # the message that carried last tick's memory (MBs for a DFT robot) and zenoh's copy
             heap.give_back()  # of it are freed by now: all of it back to the system, not kept in the heap
         self.kept = keep = obs.keep and not self.null
         # the memory's arrays are written once, straight into the message (the save-tick peak)
-        memory = [(a, memory_codec.pieces(b.snapshot())) for a, b in mine] if keep else []
+        memory = [(a, memory_codec.pieces(b.snapshot())) for a, b in mine if a not in self.guard.failed] if keep else []
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory, rab)
         self.act_publisher.put(payload)
         if not self.null:

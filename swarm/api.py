@@ -48,10 +48,10 @@ def _argv(options: dict[str, Any]) -> list[str]:
         flag = "--" + key.replace("_", "-")
         if value is True:
             argv.append(flag)
-        elif isinstance(value, list | tuple):
-            argv += [flag, ",".join(repr(float(v)) for v in value)]
+        elif isinstance(value, list | tuple):  # --flag=value: a value may start with a minus sign
+            argv.append(f"{flag}={','.join(repr(float(v)) for v in value)}")
         else:
-            argv += [flag, str(value)]
+            argv.append(f"{flag}={value}")
     return argv
 
 

@@ -36,7 +36,8 @@ def add_arena_run_args(g) -> None:
     g.add_argument("--max-ticks", type=int, metavar="T", help="stop after T control periods")
     g.add_argument("--on-controller-error", choices=ON_ERROR, metavar="{idle,stop}",
                    help="a robot whose controller raises: holds still while the others go on (idle, the default), "
-                        "or ends the run (stop)")  # fmt: skip
+                        "or ends the run (stop); for the controllers in this process (swarm run) or in the agent "
+                        "processes it starts (swarm up)")  # fmt: skip
 
 
 def arena_overrides(scenario, args, common: dict):

@@ -31,6 +31,8 @@ def add_check_parsers(sub) -> None:
         "(Even Better TOML, taplo) validates and completes a file whose first line is `#:schema PATH`.",
     )
     schema.add_argument("--out", type=Path, metavar="FILE", help="write it here instead of printing it")
+    schema.add_argument("--package-only", action="store_true", help="leave out the controllers of installed "
+                        "packages (the schema swarm carries: swarm/scenarios/scenario.schema.json)")  # fmt: skip
     schema.set_defaults(handler=cmd_schema)
 
 
@@ -51,7 +53,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_schema(args: argparse.Namespace) -> int:
-    text = json.dumps(scenario_schema(), indent=1, sort_keys=True) + "\n"
+    text = json.dumps(scenario_schema(installed=not args.package_only), indent=1, sort_keys=True) + "\n"
     if args.out is None:
         sys.stdout.write(text)
     else:

@@ -155,6 +155,8 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
             if not summary_file.exists():  # exit 1 with a summary is an unfinished run, not a failure
                 raise children.failure(world)
             summary = json.loads(summary_file.read_text())
+            for line in children.told():  # the files go with the folder: said here, once the run is over
+                print(line, file=sys.stderr)
             if rss:
                 summary["agent_process_rss_mb"] = round(max(rss.values()) / 1024, 1)
             grace = time.monotonic() + 10  # agents leave on the world's stop message; the rest are ended below
@@ -185,6 +187,15 @@ class _Children:
         self.procs.append(p)
         self.names[p.pid] = name
         return p
+
+    def told(self) -> list[str]:
+        """What the agent processes told of their controllers (a controller that raised or answered
+        NaN: agents.controllers.arena.StepGuard), to say again when the run ends."""
+        lines = []
+        for i in range(1, len(self.procs)):
+            text = (self.folder / f"child-{i}.err").read_text(errors="replace")
+            lines += [line.strip() for line in text.splitlines() if line.startswith("swarm: controller ")]
+        return lines
 
     def failed_agent(self) -> subprocess.Popen | None:
         return next((p for p in self.procs[1:] if p.poll() not in (None, 0)), None)

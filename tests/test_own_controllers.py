@@ -116,11 +116,35 @@ def test_a_controller_that_raises_stops_its_robot_and_the_run_goes_on_alike_in_b
         ArenaEngine(scenario, on_error="stop").run()
 
 
+def test_reset_that_raises_an_answer_of_text_and_a_failing_record_are_one_line_each(tmp_path, capsys):
+    from swarm.recording.arena import ArenaRecorder
+
+    out = ArenaEngine(zmaze("circlers:FailsInReset", agents=2, ticks=20)).run()
+    assert out["controller_failures"] == {"0": "KeyError: 'no such thing'"}
+    assert "robot 0 raised KeyError: 'no such thing' in reset()" in capsys.readouterr().err
+    out = ArenaEngine(zmaze("circlers:AnswersText", agents=1, ticks=20)).run()
+    assert out["rejected"]["not finite"] == 20 and "answered shape ()" in capsys.readouterr().err
+    engine = ArenaEngine(zmaze("circlers:RecordsNowAndThen", agents=2, ticks=20))
+    path = tmp_path / "sometimes.rrd"
+    recorder = ArenaRecorder(path, engine.world, engine.goals, {"run_id": "s"}, controllers=engine.controllers)
+    recorder.close(engine.run(recorder=recorder))
+    assert "leaves out robot 1's record()" in capsys.readouterr().err
+    rows = rrd_rows(path)
+    assert rows["controllers/0/series/even"] == rows["controllers/0/series/late"] == 20  # NaN where missing
+    assert not any(k.startswith("controllers/1/") for k in rows)
+
+
 def test_a_nan_answer_is_told_once_and_counted_every_tick(capsys):
     out = ArenaEngine(zmaze("circlers:AnswersNaN", agents=2, ticks=30)).run()
     told = capsys.readouterr().err.strip().splitlines()
     assert len(told) == 1 and "robot 0 answered NaN or infinite wheel speeds at tick 0" in told[0]
     assert out["rejected"]["not finite"] == 30 and "controller_failures" not in out
+    engine = ArenaEngine(zmaze("circlers:AnswersNaN", agents=2, ticks=30))
+    engine.run()
+    summary, world = run_world(engine.scenario, "own-nan", [("circlers:AnswersNaN", 1, 2)], deadline=60.0)
+    np.testing.assert_array_equal(world.pose, engine.world.pose)  # the refused robot held still in both
+    assert summary["rejected_by_reason"] == {"act: not finite": 30} and summary["agents_lost"] == 0
+    assert summary["wall_seconds"] < 30  # a refused answer is an answer: no deadline waited out
 
 
 def test_a_recording_shows_any_record_by_its_shape(tmp_path):

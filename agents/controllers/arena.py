@@ -20,7 +20,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from agents.controllers import CONTROLLERS
-from swarm.core.errors import RunError
+from swarm.core.errors import RunError, one_line
 
 MAX_SHARE_BYTES = 4 * 1024 * 1024
 
@@ -74,13 +74,19 @@ class StepGuard:
     "stop" either ends the run (ControllerFailed).  Both runtimes do the same, so lock-step runs
     stay equal to in-process ones."""
 
-    def __init__(self, on_error: str = "idle", tell=None):
+    def __init__(self, on_error: str = "idle"):
         if on_error not in ON_ERROR:
             raise ValueError(f"on_error {on_error!r}: expected one of {', '.join(ON_ERROR)}")
         self.on_error = on_error
         self.failed: dict[int, str] = {}  # agent -> what its controller raised
         self.told: set[int] = set()
-        self.tell = tell or (lambda line: print(f"swarm: {line}", file=sys.stderr, flush=True))
+
+    def reset(self, controller, seed: int, agent: int, params: dict, name: str) -> None:
+        """`controller.reset(...)`; one that raises is out of the run from its start."""
+        try:
+            controller.reset(seed, agent, params)
+        except Exception as exc:  # whatever a user's controller raises
+            self._failed(agent, exc, f"controller {name!r} of robot {agent}", "in reset()")
 
     def action(self, controller, perception, agent: int, name: str, tick: int) -> np.ndarray:
         if agent in self.failed:
@@ -88,12 +94,12 @@ class StepGuard:
         try:
             answer = controller.step(perception)
         except Exception as exc:  # whatever a user's controller raises
-            text = str(exc).strip().splitlines()
-            self.failed[agent] = f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
-            self._fault(f"controller {name!r} of robot {agent} raised {self.failed[agent]} at tick {tick}",
-                        "the robot holds still for the rest of the run")  # fmt: skip
+            self._failed(agent, exc, f"controller {name!r} of robot {agent}", f"at tick {tick}")
             return np.zeros(3)
-        action = as_action(answer)
+        try:
+            action = as_action(answer)
+        except (TypeError, ValueError):  # not numbers at all (a dict, a string): a wrong shape
+            action = np.full(3, np.nan)
         if not np.isfinite(action).all() and agent not in self.told:
             self.told.add(agent)
             what = "NaN or infinite wheel speeds" if np.size(answer) in (2, 3) else f"shape {np.shape(answer)}"
@@ -101,10 +107,14 @@ class StepGuard:
                         "the world refuses such answers and counts them (rejected actions)")  # fmt: skip
         return action
 
+    def _failed(self, agent: int, exc: Exception, who: str, when: str) -> None:
+        self.failed[agent] = one_line(exc)
+        self._fault(f"{who} raised {self.failed[agent]} {when}", "the robot holds still for the rest of the run")
+
     def _fault(self, what: str, then: str) -> None:
         if self.on_error == "stop":
             raise ControllerFailed(f"{what}; the run stops (--on-controller-error idle lets it go on)")
-        self.tell(f"{what}; {then} (--on-controller-error stop ends the run instead)")
+        print(f"swarm: {what}; {then} (--on-controller-error stop ends the run instead)", file=sys.stderr, flush=True)
 
 
 def make_controller(name: str) -> ArenaController:
@@ -112,13 +122,14 @@ def make_controller(name: str) -> ArenaController:
     return CONTROLLERS[name].make()
 
 
-def publications(controllers, agents) -> list[tuple[int, str, bytes]]:
-    """(agent, share, msgpack payload) of every controller that has something to publish, in agent order."""
+def publications(controllers, agents, failed=()) -> list[tuple[int, str, bytes]]:
+    """(agent, share, msgpack payload) of every controller that has something to publish, in agent order
+    (not those in `failed`: StepGuard.failed)."""
     from swarm.core.wire import pack
 
     out = []
     for a, c in zip(agents, controllers, strict=True):
-        share = getattr(c, "shares", None)
+        share = None if a in failed else getattr(c, "shares", None)
         if share and (data := c.publish()) is not None:
             out.append((int(a), share, pack(data)))
     return out
@@ -136,14 +147,15 @@ def broadcasts(controllers, agents, failed=()) -> list[tuple[int, bytes]]:
     return out
 
 
-def deliver(controllers, agents, shared: list[tuple[int, str, bytes]]) -> int:
-    """Hand every controller what the others of its share published (not its own), in agent order.
-    Returns the payloads refused (undecodable or malformed: counted, nothing of them merged)."""
+def deliver(controllers, agents, shared: list[tuple[int, str, bytes]], failed=()) -> int:
+    """Hand every controller what the others of its share published (not its own), in agent order
+    (not to those in `failed`).  Returns the payloads refused (undecodable or malformed: counted,
+    nothing of them merged)."""
     from swarm.core.wire import Rejected, unpack
 
     refused = 0
     for a, c in zip(agents, controllers, strict=True):
-        share = getattr(c, "shares", None)
+        share = None if a in failed else getattr(c, "shares", None)
         if not share:
             continue
         for sender, s, payload in shared:

@@ -26,3 +26,9 @@ class ScenarioError(ValueError):
 
     def __reduce__(self):  # raised in a worker process, it reaches the parent whole
         return (type(self), (self.source, self.where, self.problem))
+
+
+def one_line(exc: BaseException) -> str:
+    """An exception as one line: its type and the first line of its message (a user's code raised it)."""
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__

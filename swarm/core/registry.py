@@ -12,6 +12,7 @@ world_server.WORLD_KINDS).
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import importlib.metadata
 import pkgutil
@@ -19,6 +20,8 @@ import sys
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from typing import Any, Generic, Protocol, TypeVar
+
+from swarm.core.errors import one_line
 
 
 def resolve(reference: str) -> Any:
@@ -102,8 +105,8 @@ class ControllerSpec:
         """An installed package's entry (entry point group `swarm.controllers`): a ControllerSpec
         the package declares, or its controller class."""
         target = resolve(reference)
-        if isinstance(target, ControllerSpec):
-            return target
+        if isinstance(target, ControllerSpec):  # known by the entry point's name, whatever it declares
+            return target if target.name == name else dataclasses.replace(target, name=name)
         return cls.of_class(name, reference)
 
     def make(self) -> Any:
@@ -264,6 +267,7 @@ class Registry(Generic[E]):
         self.plugins, self.external = plugins, external
         self._entries: dict[str, E] | None = None
         self._loaded: dict[str, E] = {}  # "module:attribute" names made so far
+        self.installed: set[str] = set()  # the names installed packages' entry points gave
 
     def _found(self) -> dict[str, E]:
         if self._entries is None:
@@ -295,8 +299,9 @@ class Registry(Generic[E]):
                 continue
             try:
                 out[point.name] = self.external(point.name, point.value)
+                self.installed.add(point.name)
             except Exception as exc:  # whatever a user's package raises on import
-                print(f"swarm: {self.what} {point.name!r} ({point.value}) left out: {_one_line(exc)}", file=sys.stderr)
+                print(f"swarm: {self.what} {point.name!r} ({point.value}) left out: {one_line(exc)}", file=sys.stderr)
         return out
 
     def load(self, reference: str) -> E:
@@ -308,10 +313,10 @@ class Registry(Generic[E]):
             try:
                 self._loaded[reference] = self.external(reference, reference)
             except ModuleNotFoundError as exc:
-                raise UnknownPart(f"cannot load {self.what} {reference!r}: {_one_line(exc)}; install its package "
+                raise UnknownPart(f"cannot load {self.what} {reference!r}: {one_line(exc)}; install its package "
                                   "or put its folder on PYTHONPATH") from None  # fmt: skip
             except Exception as exc:  # whatever a user's module raises on import
-                raise UnknownPart(f"cannot load {self.what} {reference!r}: {_one_line(exc)}") from None
+                raise UnknownPart(f"cannot load {self.what} {reference!r}: {one_line(exc)}") from None
         return self._loaded[reference]
 
     def __getitem__(self, name: str) -> E:
@@ -368,8 +373,3 @@ class Selection(Mapping[str, E]):
 
     def __len__(self) -> int:
         return sum(1 for _ in self)
-
-
-def _one_line(exc: BaseException) -> str:
-    text = str(exc).strip().splitlines()
-    return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__

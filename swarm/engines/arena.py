@@ -30,7 +30,7 @@ class ArenaEngine:
         self.guard = StepGuard(on_error)
         for a, group in enumerate(g for g in scenario.groups for _ in range(g.count)):
             c = make_controller(group.controller)
-            c.reset(scenario.seed, a, controller_params(scenario, a))
+            self.guard.reset(c, scenario.seed, a, controller_params(scenario, a), group.controller)
             self.controllers.append(c)
         self.wall_seconds = 0.0
         self.actions = np.zeros((self.world.n, 3))  # wheel speeds and an act (world_server.arena.world.ACTION_WIDTH)
@@ -57,10 +57,10 @@ class ArenaEngine:
             for a, (c, p) in enumerate(zip(self.controllers, perceptions, strict=True)):
                 self.actions[a] = self.guard.action(c, p, a, self.names[a], tick)
             w.broadcast(broadcasts(self.controllers, self.agent_ids, self.guard.failed))
-            shared = publications(self.controllers, self.agent_ids)
+            shared = publications(self.controllers, self.agent_ids, self.guard.failed)
             if shared:  # what each wrote this tick, every other robot of its share reads before the next
                 self.shares.add(tick, shared)
-                self.refused_shared += deliver(self.controllers, self.agent_ids, shared)
+                self.refused_shared += deliver(self.controllers, self.agent_ids, shared, self.guard.failed)
             return self.actions
 
         def after() -> None:
@@ -93,7 +93,7 @@ class ArenaEngine:
     def summary(self) -> dict[str, Any]:
         out = self.goals.summary(self.world, self.wall_seconds, "in-process")
         for robot, c in zip(out["robots"], self.controllers, strict=True):
-            if hasattr(c, "summary"):  # what a controller learned (a map), beside what its body did
+            if hasattr(c, "summary") and robot["agent"] not in self.guard.failed:  # what it learned (a map)
                 robot.update(c.summary())
             if (shared := self.shares.of(robot["agent"])) is not None:
                 robot["shared"] = shared

@@ -30,9 +30,11 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 
 import numpy as np
 
+from swarm.core.errors import one_line
 from swarm.core.registry import resolve
 from swarm.engines.goals import ArenaGoals, optimum_planner
 from swarm.recording.grid import FORMAT_VERSION, software_versions
@@ -128,6 +130,7 @@ class ArenaRecorder:
         self._obstacles_on: tuple | None = None
         self._plans_logged: set[int] = set()
         self._logs: dict = {}  # each controller log (ControllerSpec.records) in use, by its class
+        self._quiet: set[int] = set()  # robots whose record() failed: left out of the recording
         self._published = None
         self._static_done = False
 
@@ -246,11 +249,27 @@ class ArenaRecorder:
             self._obstacles_on = on
             self._log_obstacles(tick, on)
         if self.controllers is not None:
-            records = [c.record() for c in self.controllers]  # once a tick: the logs below share them
+            records = self._records()  # once a tick: the logs below share them
             self._log_plans(tick, records)
             self._log_explanations(tick, records)
         if len(self._ticks) >= self.flush_every:
             self.flush()
+
+    def _records(self) -> list[dict]:
+        """Each controller's record(): one that raises or gives no dict is told once and shows nothing."""
+        out = []
+        for a, c in enumerate(self.controllers):
+            try:
+                record = c.record() if a not in self._quiet else {}
+            except Exception as exc:  # whatever a user's controller raises
+                record = one_line(exc)
+            if not isinstance(record, dict):
+                self._quiet.add(a)
+                print(f"swarm: the recording leaves out robot {a}'s record(): it gave {str(record)[:80]!r}, not a "
+                      "dict", file=sys.stderr)  # fmt: skip
+                record = {}
+            out.append(record)
+        return out
 
     def _log_obstacles(self, tick: int, on: tuple) -> None:
         """The boxes present now (resources among them, labelled by name)."""

@@ -53,15 +53,19 @@ class RecordLog(SeriesLog):
 
     def capture(self, tick: int, agent: int, record: dict, xy=None) -> None:
         rows = self.tick(agent, tick)
+        n = len(self._ticks[agent])  # every series holds one value per tick: NaN where a key was missing
         sparse = tick % self.every == 0
         for key, value in record.items():
             if key == "path":
                 continue
             shown = shape_of(value)
             if shown == "series":
-                rows.setdefault(str(key), []).append(float(np.asarray(value, np.float64)))
+                rows.setdefault(str(key), [np.nan] * (n - 1)).append(float(np.asarray(value, np.float64)))
             elif shown is not None and sparse:
                 self._log_array(tick, agent, str(key), shown, np.asarray(value, np.float64))
+        for column in rows.values():
+            if len(column) < n:
+                column.append(np.nan)
 
     def _log_array(self, tick: int, agent: int, key: str, shown: str, a: np.ndarray) -> None:
         rr = self.rr

@@ -62,3 +62,29 @@ class NotAController:
     """Has no step."""
 
     def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None: ...
+
+
+class RecordsNowAndThen(Circler):
+    """Its record() has a key only on even ticks, another from tick 5 on, and robot 1's record() raises."""
+
+    def record(self) -> dict[str, Any]:
+        if self.agent == 1:
+            raise RuntimeError("no record today")
+        out: dict[str, Any] = {"ticks": self.ticks}
+        if self.ticks % 2 == 0:
+            out["even"] = 1.0
+        if self.ticks >= 5:
+            out["late"] = float(self.ticks)
+        return out
+
+
+class FailsInReset(Circler):
+    def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
+        super().reset(seed, agent, params)
+        if agent == 0:
+            raise KeyError("no such thing")
+
+
+class AnswersText(Circler):
+    def step(self, perception: dict[str, np.ndarray]) -> Any:
+        return "forward"

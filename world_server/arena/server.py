@@ -212,6 +212,7 @@ class ArenaKind:
                 continue
             if (reason := self.world.judge(a, wheels)) is not None:
                 s.stats.reject(f"act: {reason}")
+                s.acted[a] = True  # an answer, refused: its robot holds still this tick, as in process
             else:
                 self.wheels[a] = 0.0
                 self.wheels[a, : len(wheels)] = wheels
@@ -222,7 +223,7 @@ class ArenaKind:
             self._take_shared(msg, group)
         self.world.broadcast([(a, data) for a, data in msg.rab if a in taken])  # heard next tick, as in-process
         for a, blob in msg.memory:
-            if s.acted[a] and s.group_of.get(a) == group and s.saves_after(msg.tick):
+            if a in taken and s.group_of.get(a) == group and s.saves_after(msg.tick):
                 self.memory[a] = blob
             else:
                 s.stats.reject("memory: not with an accepted action before a save")

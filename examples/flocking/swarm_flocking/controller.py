@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 import struct
 from dataclasses import asdict, dataclass, fields
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -60,7 +61,7 @@ class Flocking:
     """Reynolds flocking: separation, cohesion and alignment over the range-and-bearing board."""
 
     requires = ("range_and_bearing", "compass", "ir")
-    example = "examples/flocking/flock.toml"
+    example = str(Path(__file__).parents[1] / "flock.toml")  # the package's scenario, from any folder
 
     def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
         self.p = FlockingParams.from_table(params.get("table"))

@@ -46,8 +46,8 @@ class RangeAndBearing(Sensor):
         if not (self.range > 0 and math.isfinite(self.range)):
             raise ValueError(f"range: expected a positive distance in metres, got {self.range}")
         for f in ("range_noise", "bearing_noise"):
-            if not getattr(self, f) >= 0:
-                raise ValueError(f"{f}: expected a std of at least 0, got {getattr(self, f)}")
+            if not (getattr(self, f) >= 0 and math.isfinite(getattr(self, f))):
+                raise ValueError(f"{f}: expected a finite std of at least 0, got {getattr(self, f)}")
         if self.payload > MAX_PAYLOAD:
             raise ValueError(f"payload: expected at most {MAX_PAYLOAD} bytes, got {self.payload}")
 
