@@ -521,10 +521,11 @@ def test_a_saved_map_holds_no_belief_and_localization_starts_uniform():
 
 
 def test_localize_mode_needs_a_map_and_says_so():
+    from swarm.core.errors import RunError
     from swarm.engines.arena import ArenaEngine
     from swarm.experiments.tapus2006.fingerprint import tour_scenario
 
-    with pytest.raises(ValueError, match="needs a map"):
+    with pytest.raises(RunError, match="'fingerprint' of robot 0 cannot start: ValueError: .* needs a map"):
         ArenaEngine(tour_scenario("office", "mapping", "low", 0, {"mode": "localize"}))
 
 

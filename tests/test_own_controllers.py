@@ -116,12 +116,11 @@ def test_a_controller_that_raises_stops_its_robot_and_the_run_goes_on_alike_in_b
         ArenaEngine(scenario, on_error="stop").run()
 
 
-def test_reset_that_raises_an_answer_of_text_and_a_failing_record_are_one_line_each(tmp_path, capsys):
+def test_a_reset_that_raises_an_answer_of_text_and_a_failing_record_are_one_line_each(tmp_path, capsys):
     from swarm.recording.arena import ArenaRecorder
 
-    out = ArenaEngine(zmaze("circlers:FailsInReset", agents=2, ticks=20)).run()
-    assert out["controller_failures"] == {"0": "KeyError: 'no such thing'"}
-    assert "robot 0 raised KeyError: 'no such thing' in reset()" in capsys.readouterr().err
+    with pytest.raises(RunError, match=r"'circlers:FailsInReset' of robot 0 cannot start: KeyError: 'no such thing'"):
+        ArenaEngine(zmaze("circlers:FailsInReset", agents=2, ticks=20))
     out = ArenaEngine(zmaze("circlers:AnswersText", agents=1, ticks=20)).run()
     assert out["rejected"]["not finite"] == 20 and "answered shape ()" in capsys.readouterr().err
     engine = ArenaEngine(zmaze("circlers:RecordsNowAndThen", agents=2, ticks=20))

@@ -67,7 +67,7 @@ class StepGuard:
     """Steps controllers as both runtimes must, so that a user's controller that raises, answers NaN
     or the wrong shape is one line naming it, not a traceback that ends every robot's run.
 
-    A controller that raises is out of the run: from that tick on its robot holds still (wheel
+    A controller that raises in its step is out of the run: from that tick on its robot holds still (wheel
     speeds 0, a valid answer, so a lock-step world does not wait out its deadline for it) and its
     controller is not asked again (its state may be half-written).  A NaN or wrong-shaped answer
     goes to the world, which refuses and counts it; it is told once per robot.  With on_error
@@ -82,11 +82,12 @@ class StepGuard:
         self.told: set[int] = set()
 
     def reset(self, controller, seed: int, agent: int, params: dict, name: str) -> None:
-        """`controller.reset(...)`; one that raises is out of the run from its start."""
+        """`controller.reset(...)`.  One that raises cannot start (a table it refuses, a map it lacks):
+        the run ends in one line whatever `on_error` says, since no robot of it has moved yet."""
         try:
             controller.reset(seed, agent, params)
         except Exception as exc:  # whatever a user's controller raises
-            self._failed(agent, exc, f"controller {name!r} of robot {agent}", "in reset()")
+            raise ControllerFailed(f"controller {name!r} of robot {agent} cannot start: {one_line(exc)}") from None
 
     def action(self, controller, perception, agent: int, name: str, tick: int) -> np.ndarray:
         if agent in self.failed:

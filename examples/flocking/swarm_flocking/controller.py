@@ -17,40 +17,43 @@ from __future__ import annotations
 
 import math
 import struct
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from swarm.core.params import OURS, declared
+from swarm.core.tables import params_from_table
+
 HEADING_SCALE = 65536 / (2 * math.pi)  # a heading in [0, 2 pi) as a uint16
+
+
+def ours(value: float, reason: str) -> Any:
+    return declared(value, source=OURS, reason=reason)
 
 
 @dataclass(frozen=True)
 class FlockingParams:
-    """The weights of the four rules and the drive; [flocking] in a scenario sets them."""
+    """The weights of the four rules and the drive; [flocking] in a scenario sets them.  Reynolds
+    (1987) gives the rules, not numbers: every value is ours, with its reason (swarm.core.params)."""
 
-    separation: float = 0.15  # metres: neighbours nearer than this push away (four e-puck diameters)
-    w_separation: float = 1.5
-    w_cohesion: float = 1.0
-    w_alignment: float = 1.0
-    w_avoid: float = 3.0
-    cruise: float = 0.3  # a pull straight ahead, so a lone robot explores
-    speed: float = 0.8  # share of the wheel limit at full drive
-    turn_gain: float = 2.0  # wheel speed difference per radian of error, as a share of the wheel limit
+    separation: float = ours(0.15, "metres: neighbours nearer than four e-puck diameters push away")
+    w_separation: float = ours(1.5, "stronger than cohesion, so a flock does not collapse onto itself")
+    w_cohesion: float = ours(1.0, "the unit the other weights are measured against")
+    w_alignment: float = ours(1.0, "as strong as cohesion: neither heading nor gathering dominates")
+    w_avoid: float = ours(3.0, "walls outrank the flock: a robot pressed against a wall by its neighbours turns away")
+    cruise: float = ours(0.3, "a pull straight ahead, so a lone robot explores instead of spinning")
+    speed: float = ours(0.8, "share of the wheel limit at full drive, leaving room to turn")
+    turn_gain: float = ours(2.0, "wheel speed difference per pi radians of error, as a share of the wheel limit")
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None) -> FlockingParams:
-        known = {f.name for f in fields(cls)}
-        table = table or {}
-        for key, value in table.items():
-            if key not in known:
-                raise ValueError(f"unknown field {key!r}; expected one of {', '.join(sorted(known))}")
-            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-                raise ValueError(f"{key}: expected a number, got {value!r}")
-            if value < 0:
-                raise ValueError(f"{key}: expected a number >= 0, got {value!r}")
-        return cls(**{k: float(v) for k, v in table.items()})
+        """swarm's table reader: an unknown field or a value that is no number is one line."""
+        p = params_from_table(cls, table, "flocking")
+        if any(v < 0 for v in asdict(p).values()):
+            raise ValueError("[flocking]: expected numbers >= 0")
+        return p
 
 
 def unit(angles: np.ndarray) -> np.ndarray:
@@ -61,6 +64,7 @@ class Flocking:
     """Reynolds flocking: separation, cohesion and alignment over the range-and-bearing board."""
 
     requires = ("range_and_bearing", "compass", "ir")
+    parameters = ("swarm_flocking.controller:FlockingParams",)
     example = str(Path(__file__).parents[1] / "flock.toml")  # the package's scenario, from any folder
 
     def reset(self, seed: int, agent: int, params: dict[str, Any]) -> None:
