@@ -23,3 +23,7 @@ class ScenarioError(ValueError):
     def __init__(self, source: str, where: str, problem: str):
         self.source, self.where, self.problem = source, where, problem
         super().__init__(f"{source}: {where}: {problem}")
+
+    def __reduce__(self):
+        """Rebuilt from its three parts, so a worker process's error reaches the command as one line."""
+        return type(self), (self.source, self.where, self.problem)
