@@ -89,8 +89,8 @@ def run_ablations(experiment: str, reps: int | None, jobs: int | None, seed: int
     maps = reps if maps is None else maps
     if not 1 <= maps <= reps:
         raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
-    out_ = Outputs(out, experiment)
     floors = bg.check_floors("bg-ablations" if scenario else "bg-tmaze", scenario, ratios, {})
+    out_ = Outputs(out, experiment)
     made = bg.make_maps("bg-tmaze", maps, seed, floors, jobs, progress, seconds=mapping_seconds)
     survival, tests = jobs_for(reps, seed, made, max_ticks, scenario)
     rows = batch_run(run_survival, survival, jobs=jobs, desc=f"{experiment} survival", progress=progress)

@@ -46,7 +46,7 @@ OWN_FLOORS = {"table1": r"setup1", "table2": r"setup2", "congestion": r"setup1",
 
 def paper_floor(experiment: str, ref: str) -> bool:
     """`ref` is a preset of the paper's that the experiment's own numbers were measured on."""
-    return re.fullmatch(OWN_FLOORS.get(experiment, r"$^"), ref) is not None
+    return experiment in OWN_FLOORS and re.fullmatch(OWN_FLOORS[experiment], ref) is not None
 
 
 def user_floor(experiment: str, ref: str) -> Floor:
