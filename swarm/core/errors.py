@@ -24,8 +24,9 @@ class ScenarioError(ValueError):
         self.source, self.where, self.problem = source, where, problem
         super().__init__(f"{source}: {where}: {problem}")
 
-    def __reduce__(self):  # raised in a worker process, it reaches the parent whole
-        return (type(self), (self.source, self.where, self.problem))
+    def __reduce__(self):
+        """Rebuilt from its three parts, so a worker process's error reaches the command as one line."""
+        return type(self), (self.source, self.where, self.problem)
 
 
 def one_line(exc: BaseException) -> str:

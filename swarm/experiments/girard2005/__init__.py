@@ -6,6 +6,12 @@ from swarm.core.registry import ExperimentSpec, Option, PaperSpec
 _FLOOR = Option("--scenario", "the floor: a bundled name or a TOML file with the resources the experiment names "
                 "(Ep1, Ep2, DA; a T-maze's stem walls below_left, below_right) (default: the experiment's)",
                 metavar="FILE")  # fmt: skip
+_TMAZE_FLOOR = Option("--scenario", "one floor for experiments 1 and 3.2 instead of bg-exp1 and the tmaze-R floors: "
+                      "a T-maze with Ep1, Ep2, E and the stem's walls below_left, below_right (not with --ratios)",
+                      metavar="FILE")  # fmt: skip
+_COLONY_FLOOR = Option("--scenario", "the colony's floor instead of bg-colony: an ingesting (Ep) and a digesting (E) "
+                       "resource and a first [[group]] of bg animats, at its starts (drawn where it gives fewer)",
+                       metavar="FILE")  # fmt: skip
 _MAPS = Option("--maps", "mapping runs per scenario; test k loads map k mod N (default: one per test; 1: one map for "
                "every test)", type="swarm.core.tables:positive", metavar="N")  # fmt: skip
 _MAPPING = Option("--mapping", "how the mapping animat maps: hungry, planning back to what it found, or exploring "
@@ -35,11 +41,12 @@ EXPERIMENTS = (
                    smoke=(("reps", 2), ("maps", 1), ("ratios", (1.0,)), ("mapping_seconds", 120.0))),
     ExperimentSpec("bg-ablations", "girard2005", "eq. 10's cross term, the literal feedback, the wheels, dopamine, "
                    "biased odometry: what each does to experiments 1 and 3.2",
-                   "swarm.experiments.girard2005.ablations:run_ablations", options=(_MAPS, _RATIOS),
+                   "swarm.experiments.girard2005.ablations:run_ablations", options=(_TMAZE_FLOOR, _MAPS, _RATIOS),
                    smoke=(("reps", 2), ("maps", 1), ("ratios", (1.0,)), ("max_ticks", 200),
                           ("mapping_seconds", 120.0))),
     ExperimentSpec("bg-colony", "girard2005", "survival against colony size, with and without a shared map",
-                   "swarm.experiments.girard2005.colony:run_colony_experiment", options=(_SIZES,),
+                   "swarm.experiments.girard2005.colony:run_colony_experiment",
+                   options=(_COLONY_FLOOR, _SIZES),
                    smoke=(("reps", 1), ("sizes", (1, 2)), ("max_ticks", 200))),
 )  # fmt: skip
 PAPER = PaperSpec(

@@ -49,10 +49,11 @@ REPS = 10  # survival runs and T-maze tests per condition (and ratio)
 CAP = 4 * 3600.0
 
 
-def jobs_for(reps: int, seed: int, maps: dict[str, list[dict]], cap: int | None) -> tuple[list[tuple], list[tuple]]:
+def jobs_for(reps: int, seed: int, maps: dict[str, list[dict]], cap: int | None,
+             floor: str | None = None) -> tuple[list[tuple], list[tuple]]:  # fmt: skip
     """(survival jobs, T-maze test jobs), each (condition, the experiment's job): run k of every condition with
-    seed + k, test k on map k mod the maps."""
-    floor = bg.SCENARIO["bg-survival"]
+    seed + k, test k on map k mod the maps; survival on `floor` (default experiment 1's)."""
+    floor = floor or bg.SCENARIO["bg-survival"]
     survival = [(label, ("A", k, seed + k, changes, cap, floor, sensors))
                 for label, (changes, sensors) in ABLATIONS.items() for k in range(reps)]  # fmt: skip
     tests = [(label, (*job, sensors)) for label, (changes, sensors) in ABLATIONS.items()
@@ -74,36 +75,43 @@ def run_test(job: tuple) -> dict:
 
 def run_ablations(experiment: str, reps: int | None, jobs: int | None, seed: int, out: Path | None,
                   progress: bool = True, max_ticks: int | None = None, ratios: tuple[float, ...] | None = None,
-                  maps: int | None = None, mapping_seconds: float = bg.MAPPING_SECONDS) -> dict:  # fmt: skip
+                  maps: int | None = None, mapping_seconds: float = bg.MAPPING_SECONDS,
+                  scenario: str | None = None) -> dict:  # fmt: skip
     """Every condition on experiment 1 (A) and 3.2; `maps` mapping runs per T-maze (default one per test), each
-    at most `mapping_seconds`; `max_ticks` a shorter cap on survival runs (a smoke run)."""
+    at most `mapping_seconds`; `max_ticks` a shorter cap on survival runs (a smoke run).  `scenario`: one floor
+    for both, a T-maze with what bg-tmaze needs (bg.FLOOR_NEEDS), in place of bg-exp1 and the tmaze-R floors."""
+    if scenario is not None and ratios is not None:
+        raise ScenarioError("command line", "--ratios", "--ratios chooses the tmaze-R floors; --scenario gives one "
+                            "floor for both experiments: give one or the other")  # fmt: skip
     reps = REPS if reps is None else reps
     if reps < 2:
         raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
     maps = reps if maps is None else maps
     if not 1 <= maps <= reps:
         raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
+    floors = bg.check_floors("bg-ablations" if scenario else "bg-tmaze", scenario, ratios, {})
     out_ = Outputs(out, experiment)
-    floors = bg.check_floors("bg-tmaze", None, ratios, {})
     made = bg.make_maps("bg-tmaze", maps, seed, floors, jobs, progress, seconds=mapping_seconds)
-    survival, tests = jobs_for(reps, seed, made, max_ticks)
+    survival, tests = jobs_for(reps, seed, made, max_ticks, scenario)
     rows = batch_run(run_survival, survival, jobs=jobs, desc=f"{experiment} survival", progress=progress)
     rows += batch_run(run_test, tests, jobs=jobs, desc=f"{experiment} T-maze", progress=progress)
     fields = ["ablation", "experiment", "condition", "run", "seed", "map", "survival_seconds", "died", "branch",
               "chose", "seconds", "distance", "idle_acts", "wall_seconds"]  # fmt: skip
     out_.runs([{k: r.get(k, "") for k in fields} for r in rows], fields)
     cap = CAP if max_ticks is None else max_ticks * 0.25
-    summary, text = _tables(rows, cap)
+    summary, text = _tables(rows, cap, paper=scenario is None)
+    where = "" if scenario is None else (f"  Both on the user's floor {scenario} (--scenario), not the paper's: "
+                                         "the paper's numbers are not shown.")  # fmt: skip
     head = (f"# Ablations of the bg animat (experiments 1 and 3.2)\n\n{reps} runs per condition (experiment 1, "
             f"condition A, at most {cap / 3600:.3g} h) and {reps} tests per condition and ratio (experiment 3.2, "
             f"test k on map k of the declared animat); seed {seed}.  Each condition changes one thing of the "
-            "declared animat (swarm/experiments/girard2005/ablations.py says what).\n\n")  # fmt: skip
+            f"declared animat (swarm/experiments/girard2005/ablations.py says what).{where}\n\n")  # fmt: skip
     result = out_.finish(summary, head + text)
     _plot(rows, out_ / "plot.png")
     return result
 
 
-def _tables(rows: list[dict], cap: float) -> tuple[list[dict], str]:
+def _tables(rows: list[dict], cap: float, paper: bool = True) -> tuple[list[dict], str]:
     live = {a: [r for r in rows if r.get("ablation") == a and "survival_seconds" in r] for a in ABLATIONS}
     t = {a: np.array([r["survival_seconds"] for r in sel], float) for a, sel in live.items()}
     died = {a: np.array([bool(r["died"]) for r in sel]) for a, sel in live.items()}
@@ -131,13 +139,19 @@ def _tables(rows: list[dict], cap: float) -> tuple[list[dict], str]:
         lines.append(cells)
     headers = ["condition", "exp. 1 runs", "KM median survival (s)", "alive at cap", "restricted mean (s)",
                "log-rank p vs declared"]  # fmt: skip
-    headers += [f"3.2 ratio {r:g}: right first / entered (McNemar p)" for r in ratios]
+    headers += [f"3.2 {_ratio(r)}: right first / entered (McNemar p)" for r in ratios]
     right = ", ".join(f"{r} of {TMAZE_TESTS} at ratio {ratio:g}" for ratio, (_, r) in PAPER_TMAZE.items())
-    note = (f"\nThe paper: experiment 1's A lived a median of {PAPER_SURVIVAL['A'][0]:,} s (beyond its own 4 h "
-            f"cap); in experiment 3.2 the animat entered the right branch (E and Ep) first in {right}.  A p value "
-            "compares a condition with the declared animat (log-rank on survival, McNemar on the right branch test "
-            "by test); none of these is a claim of the paper.\n")  # fmt: skip
+    said = (f"The paper: experiment 1's A lived a median of {PAPER_SURVIVAL['A'][0]:,} s (beyond its own 4 h "
+            f"cap); in experiment 3.2 the animat entered the right branch (E and Ep) first in {right}.  ")  # fmt: skip
+    note = (f"\n{said if paper else ''}A p value compares a condition with the declared animat (log-rank "
+            "on survival, McNemar on the right branch test by test); none of these is a claim of the "
+            "paper.\n")  # fmt: skip
     return summary, R.markdown_table(headers, lines) + note
+
+
+def _ratio(condition: float | str) -> str:
+    """A T-maze condition's column: its branch ratio, or the user's floor by name."""
+    return f"ratio {condition:g}" if isinstance(condition, float) else str(condition)
 
 
 def _branch(rows: list[dict], ablation: str, ratio) -> np.ndarray:

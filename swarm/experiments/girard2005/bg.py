@@ -47,7 +47,7 @@ from swarm.scenario import load_scenario
 
 EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze")
 SCENARIO = {"bg-survival": "bg-exp1", "bg-choice": "bg-exp2", "bg-forget": "bg-exp2", "bg-fear": "bg-exp3",
-            "bg-tmaze": "tmaze"}  # fmt: skip
+            "bg-tmaze": "tmaze", "bg-ablations": "tmaze-1", "bg-colony": "bg-colony"}  # fmt: skip
 REPS = {"bg-survival": 10, "bg-choice": 15, "bg-forget": 15, "bg-fear": 20, "bg-tmaze": 15}
 MAPPING_SECONDS = 7200.0  # the mapping phase of experiments 2 and 3: at most two hours of the animat's life ...
 MAPPING_LEVELS = (0.5, 0.5)  # E, Ep during mapping: needs enough to seek both resources and reload there ...
@@ -74,8 +74,10 @@ MAPPING_MODES = {
 MAPPING = "explore"  # every experiment's mapping: one procedure for all
 # The resources an experiment names, by name, and the walls that mark the T-maze's junction (the stem's sides):
 # a floor given with --scenario must have them.
+# bg-ablations runs experiments 1 and 3.2 on the one floor --scenario gives (a T-maze); bg-colony experiment 1's.
 FLOOR_NEEDS = {"bg-survival": (), "bg-choice": ("Ep1", "Ep2"), "bg-forget": ("Ep1", "Ep2"),
-               "bg-fear": ("Ep1", "Ep2", "DA"), "bg-tmaze": ("Ep1", "Ep2", "below_left", "below_right")}  # fmt: skip
+               "bg-fear": ("Ep1", "Ep2", "DA"), "bg-tmaze": ("Ep1", "Ep2", "below_left", "below_right"),
+               "bg-ablations": ("Ep1", "Ep2", "below_left", "below_right"), "bg-colony": ()}  # fmt: skip
 TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep by then counts as "none"
 W_PLANS = (0.65, 0.55, 0.45)
 FEAR_EP = (0.1, 0.5)
@@ -442,7 +444,7 @@ def check_floors(experiment: str, scenario: str | None, ratios, changes: dict[st
         floors = (SCENARIO[experiment],)
     for floor in floors:
         s = load_scenario(floor)
-        if getattr(s, "kind", "arena") != "arena":
+        if getattr(s, "kind", "grid") != "arena":  # a grid scenario has no kind field
             raise ScenarioError(floor, "kind", f"{experiment} runs on an arena floor")
         names = {o.name for o in s.obstacles if o.zone is not None} | {w.name for w in s.walls}
         missing = [n for n in FLOOR_NEEDS[experiment] if n not in names]

@@ -32,13 +32,20 @@ REPS = 5
 NEST = ((5.9, 4.5), (6.5, 4.5), (5.9, 3.9), (6.5, 3.9), (5.9, 5.1), (6.5, 5.1), (5.9, 3.3), (6.5, 3.3))
 
 
-def colony_scenario(size: int, share: bool, seed: int, max_ticks: int | None = None):
-    """bg-colony with `size` animats at the nest's first places, sharing or not (and a shorter cap)."""
+def colony_scenario(size: int, share: bool, seed: int, max_ticks: int | None = None, floor: str | None = None):
+    """bg-colony with `size` animats at the nest's first places, sharing or not (and a shorter cap); or `floor`
+    (--scenario) with its first group's animats, at its first `size` starts (drawn where it gives fewer)."""
     if not 1 <= size <= len(NEST):
         raise ScenarioError("command line", "--sizes", f"colonies of 1 to {len(NEST)} animats (the nest's places)")
-    s = load_scenario("bg-colony")
-    starts = tuple((x, y, math.pi / 2) for x, y in NEST[:size])
-    group = dataclasses.replace(s.groups[0], count=size, starts=starts)
+    s = load_scenario(floor or "bg-colony")
+    g = s.groups[0]
+    if floor is None:
+        starts: tuple | None = tuple((x, y, math.pi / 2) for x, y in NEST[:size])
+    else:
+        starts = g.starts[:size] if g.starts and len(g.starts) >= size else None  # None: drawn with its clearance
+    if g.controller != "bg":
+        raise ScenarioError(s.source, "group", f"bg-colony needs a first [[group]] of bg animats, not {g.controller}")
+    group = dataclasses.replace(g, count=size, starts=starts)
     params = dict(s.controller_params)
     params["bg"] = {**params.get("bg", {}), "share": share}
     return dataclasses.replace(
@@ -51,11 +58,11 @@ def colony_scenario(size: int, share: bool, seed: int, max_ticks: int | None = N
 
 
 def run_colony(job: tuple) -> dict:
-    """One colony until every animat is dead or 4 h pass: (size, share, run, seed, max_ticks)."""
+    """One colony until every animat is dead or 4 h pass: (size, share, run, seed, max_ticks[, floor])."""
     from swarm.engines.arena import ArenaEngine
 
-    size, share, run, seed, max_ticks = job
-    engine = ArenaEngine(colony_scenario(size, share, seed, max_ticks))
+    size, share, run, seed, max_ticks, *floor = job
+    engine = ArenaEngine(colony_scenario(size, share, seed, max_ticks, *floor))
     summary = engine.run()
     robots = summary["robots"]
     lives = np.array([r["survival_seconds"] for r in robots])
@@ -71,7 +78,7 @@ def run_colony(job: tuple) -> dict:
             "rejected_shared": engine.refused_shared, "wall_seconds": summary["wall_seconds"]}  # fmt: skip
 
 
-def _summary(rows: list[dict]) -> tuple[list[dict], str]:
+def _summary(rows: list[dict], paper: bool = True) -> tuple[list[dict], str]:
     from scipy.stats import mannwhitneyu
 
     summary, lines = [], []
@@ -103,8 +110,8 @@ def _summary(rows: list[dict]) -> tuple[list[dict], str]:
           "alive at 4 h | nodes per animat | of them from others | place weights heard |\n"
           "|---|---|---|---|---|---|---|---|---|---|\n" + "\n".join(lines) + "\n\n"
           "A colony's mean survival is its animats' mean; the U test (two-sided) compares those means with and "
-          "without the shared map.  One animat alone is experiment 1's condition A (the paper: median "
-          "14431.5 s).\n")  # fmt: skip
+          "without the shared map." + ("  One animat alone is experiment 1's condition A (the paper: median "
+          "14431.5 s)." if paper else "") + "\n")  # fmt: skip
     return summary, md
 
 
@@ -128,22 +135,31 @@ def _plot(rows: list[dict], path: Path) -> None:
 
 
 def run_colony_experiment(name: str, sizes: tuple[int, ...] | None, reps: int | None, jobs: int | None, seed: int,
-                          out: Path | None, progress: bool = True, max_ticks: int | None = None) -> dict:  # fmt: skip
-    """`name`: "bg-colony", the one experiment this runs (the registry calls every experiment by name)."""
+                          out: Path | None, progress: bool = True, max_ticks: int | None = None,
+                          scenario: str | None = None) -> dict:  # fmt: skip
+    """`name`: "bg-colony", the one experiment this runs (the registry calls every experiment by name);
+    `scenario`: another floor with what experiment 1 needs (bg.check_floors) and a group of bg animats."""
+    from swarm.experiments.girard2005.bg import check_floors
+
     sizes = tuple(sorted(set(sizes or SIZES)))
     reps = REPS if reps is None else reps
+    if scenario is not None:
+        check_floors("bg-colony", scenario, None, {})
     for size in sizes:
-        colony_scenario(size, False, seed)  # one clear line for a size the nest cannot hold
+        colony_scenario(size, False, seed, None, scenario)  # one clear line for a size the nest cannot hold
     out = Outputs(out, "bg-colony")
-    work = [(n, share, k, seed + k, max_ticks) for n in sorted(sizes, reverse=True)
+    work = [(n, share, k, seed + k, max_ticks, scenario) for n in sorted(sizes, reverse=True)
             for share in ((False,) if n == 1 else (False, True)) for k in range(reps)]  # fmt: skip
     rows = batch_run(run_colony, work, jobs=jobs, desc="bg-colony", progress=progress)
     rows.sort(key=lambda r: (r["size"], r["share"], r["run"]))
     out.runs(rows, list(rows[0]))
-    summary, md = _summary(rows)
+    summary, md = _summary(rows, paper=scenario is None)
+    cap = "4 h" if scenario is None else "the floor's max_ticks"
+    where = ("bg-colony (bg-exp1's floor, a nest in the east passage)" if scenario is None else
+             f"the user's floor {scenario} (--scenario; its group's starts, drawn where it gives fewer), not the "
+             "paper's: the paper's number is not shown")  # fmt: skip
     text = (f"# A colony of BG animats: survival against colony size, with and without a shared map\n\n{reps} runs "
-            f"per size and condition, at most 4 h; seeds {seed}..{seed + reps - 1}; bg-colony (bg-exp1's floor, a "
-            f"nest in the east passage).\n\n" + md)  # fmt: skip
+            f"per size and condition, at most {cap}; seeds {seed}..{seed + reps - 1}; {where}.\n\n" + md)  # fmt: skip
     result = out.finish(summary, text)
     _plot(rows, out / "plot.png")
     return result

@@ -19,6 +19,7 @@ from swarm.core.plots import pyplot, save_figure
 from swarm.experiments.report import markdown_table
 from swarm.experiments.runner import Outputs, batch_run, cross
 from swarm.experiments.simonin2007 import paper
+from swarm.experiments.simonin2007.floors import Floor, floor_note, user_floor
 
 RUN_FIELDS = ["experiment", "scenario", "size", "agents", "controller", "physics", "seed", "iterations", "finished",
               "blocked_share", "blocked_moves", "wall_seconds"]  # fmt: skip
@@ -52,10 +53,10 @@ class Experiment:
     name: str
     title: str
     default_reps: int
-    configs: Callable[[], list[Config]]
+    configs: Callable[..., list[Config]]  # (floor: Floor | None) -> its conditions, on the paper's floor for None
     max_iterations: int
-    report: Callable[[list[dict]], tuple[list[dict], str]]
-    plot: Callable[[list[dict], Path], None]
+    report: Callable[..., tuple[list[dict], str]]  # (rows, floor: Floor | None)
+    plot: Callable[..., None]  # (rows, path, floor: Floor | None)
 
 
 def run_one(spec: RunSpec) -> dict:
@@ -95,36 +96,50 @@ def _fmt(x: float, digits: int = 1) -> str:
     return "n/a" if x != x else f"{x:,.{digits}f}"
 
 
-def _table1_configs():
-    return [Config("setup1", 40, n) for n in paper.TABLE1]
+def _shown(floor: Floor | None) -> bool:
+    """The paper's numbers apply: the experiment runs on the paper's own floor."""
+    return floor is None or floor.paper
 
 
-def _table1_report(rows):
-    summary, lines, prev = [], [], None
+def _on(floor: Floor | None, ref: str, size: int) -> tuple[str, int]:
+    """The floor's reference and side: the user's floor, else the paper's (`ref`, `size`)."""
+    return (ref, size) if floor is None else (floor.ref, floor.size)
+
+
+def _table1_configs(floor: Floor | None = None):
+    ref, size = _on(floor, "setup1", 40)
+    return [Config(ref, size, n) for n in paper.TABLE1]
+
+
+def _table1_report(rows, floor: Floor | None = None):
+    shown, summary, lines, prev = _shown(floor), [], [], None
     for n, (p_mean, p_std) in paper.TABLE1.items():
         mean, std, count, unfinished = _stats(rows, agents=n)
         halving = mean / prev if prev else float("nan")
         prev = mean
-        summary.append({"agents": n, "runs": count, "unfinished": unfinished, "mean": round(mean, 1),
-                        "std": round(std, 1), "paper_mean": p_mean, "paper_std": p_std,
-                        "ratio_to_paper": round(mean / p_mean, 3), "ratio_to_previous": round(halving, 3)})  # fmt: skip
-        lines.append([str(n), _fmt(mean), _fmt(std), str(p_mean), str(p_std), f"{mean / p_mean:.2f}",
-                      _fmt(halving, 2), f"{unfinished}/{count}"])  # fmt: skip
-    md = markdown_table(["agents", "ours: mean", "ours: std", "paper: mean", "paper: std", "ours/paper",
-              "ours: T(n)/T(n/2)", "unfinished"], lines)  # fmt: skip
+        row = {"agents": n, "runs": count, "unfinished": unfinished, "mean": round(mean, 1), "std": round(std, 1)}
+        line = [str(n), _fmt(mean), _fmt(std)]
+        if shown:
+            row |= {"paper_mean": p_mean, "paper_std": p_std, "ratio_to_paper": round(mean / p_mean, 3)}
+            line += [str(p_mean), str(p_std), f"{mean / p_mean:.2f}"]
+        summary.append(row | {"ratio_to_previous": round(halving, 3)})
+        lines.append([*line, _fmt(halving, 2), f"{unfinished}/{count}"])
+    papers = ["paper: mean", "paper: std", "ours/paper"] if shown else []
+    md = markdown_table(["agents", "ours: mean", "ours: std", *papers, "ours: T(n)/T(n/2)", "unfinished"], lines)
     return summary, md
 
 
-def _table1_plot(rows, path):
+def _table1_plot(rows, path, floor: Floor | None = None):
     plt = pyplot()
     ns = list(paper.TABLE1)
     ours = [_stats(rows, agents=n) for n in ns]
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.errorbar(ns, [o[0] for o in ours], yerr=[o[1] for o in ours], marker="o", capsize=3, label="swarm")
-    ax.errorbar(ns, [paper.TABLE1[n][0] for n in ns], yerr=[paper.TABLE1[n][1] for n in ns],
-                marker="s", capsize=3, label="paper (Table 1)")  # fmt: skip
-    ax.set(xscale="log", yscale="log", xlabel="agents", ylabel="iterations to forage",
-           title="Setup 1: 40x40, 30% obstacles, 20 resources")  # fmt: skip
+    if _shown(floor):
+        ax.errorbar(ns, [paper.TABLE1[n][0] for n in ns], yerr=[paper.TABLE1[n][1] for n in ns],
+                    marker="s", capsize=3, label="paper (Table 1)")  # fmt: skip
+    title = "Setup 1: 40x40, 30% obstacles, 20 resources" if floor is None else floor.label
+    ax.set(xscale="log", yscale="log", xlabel="agents", ylabel="iterations to forage", title=title)
     ax.legend()
     save_figure(fig, path)
 
@@ -132,40 +147,45 @@ def _table1_plot(rows, path):
 # --------------------------------------------------------------------- table 2
 
 
-def _table2_configs():
-    return [Config("setup2", 20, n) for n in paper.TABLE2]
+def _table2_configs(floor: Floor | None = None):
+    ref, size = _on(floor, "setup2", 20)
+    return [Config(ref, size, n) for n in paper.TABLE2]
 
 
-def _table2_report(rows):
+def _table2_report(rows, floor: Floor | None = None):
     v_ref = _stats(rows, agents=1)[0]
     p_ref = paper.TABLE2[1]
-    summary, lines = [], []
+    shown, summary, lines = _shown(floor), [], []
     for n, p_exp in paper.TABLE2.items():
         mean, std, count, unfinished = _stats(rows, agents=n)
         proj, p_proj = v_ref / n, p_ref / n
         sem = std / np.sqrt(count) if count else float("nan")
-        summary.append({"agents": n, "runs": count, "unfinished": unfinished, "mean": round(mean, 1),
-                        "sem": round(sem, 1), "projected": round(proj, 1),
-                        "difference": round(proj - mean, 1), "paper_mean": p_exp,
-                        "paper_projected": round(p_proj, 1), "paper_difference": round(p_proj - p_exp, 1),
-                        "ratio_to_paper": round(mean / p_exp, 3)})  # fmt: skip
-        lines.append([str(n), f"{_fmt(mean)} ± {_fmt(sem)}", _fmt(proj), _fmt(proj - mean),
-                      _fmt(p_exp), _fmt(p_proj), _fmt(p_proj - p_exp), f"{mean / p_exp:.2f}"])  # fmt: skip
-    md = markdown_table(["agents", "ours: mean ± s.e.", "ours: projected", "ours: proj-exp", "paper: mean",
-              "paper: projected", "paper: proj-exp", "ours/paper"], lines)  # fmt: skip
+        row = {"agents": n, "runs": count, "unfinished": unfinished, "mean": round(mean, 1), "sem": round(sem, 1),
+               "projected": round(proj, 1), "difference": round(proj - mean, 1)}  # fmt: skip
+        line = [str(n), f"{_fmt(mean)} ± {_fmt(sem)}", _fmt(proj), _fmt(proj - mean)]
+        if shown:
+            row |= {"paper_mean": p_exp, "paper_projected": round(p_proj, 1),
+                    "paper_difference": round(p_proj - p_exp, 1), "ratio_to_paper": round(mean / p_exp, 3)}  # fmt: skip
+            line += [_fmt(p_exp), _fmt(p_proj), _fmt(p_proj - p_exp), f"{mean / p_exp:.2f}"]
+        summary.append(row)
+        lines.append(line)
+    papers = ["paper: mean", "paper: projected", "paper: proj-exp", "ours/paper"] if shown else []
+    md = markdown_table(["agents", "ours: mean ± s.e.", "ours: projected", "ours: proj-exp", *papers], lines)
     return summary, md
 
 
-def _table2_plot(rows, path):
+def _table2_plot(rows, path, floor: Floor | None = None):
     plt = pyplot()
     ns = list(paper.TABLE2)
     ours = [_stats(rows, agents=n)[0] for n in ns]
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(ns, ours, "o-", label="swarm: experimental")
     ax.plot(ns, [ours[0] / n for n in ns], "--", label="swarm: projected V_ref/n")
-    ax.plot(ns, [paper.TABLE2[n] for n in ns], "s-", label="paper: experimental")
-    ax.plot(ns, [paper.TABLE2[1] / n for n in ns], ":", label="paper: projected")
-    ax.set(xlabel="agents", ylabel="iterations to forage", title="Setup 2: 20x20, 5%, 2 resources")
+    if _shown(floor):
+        ax.plot(ns, [paper.TABLE2[n] for n in ns], "s-", label="paper: experimental")
+        ax.plot(ns, [paper.TABLE2[1] / n for n in ns], ":", label="paper: projected")
+    title = "Setup 2: 20x20, 5%, 2 resources" if floor is None else floor.label
+    ax.set(xlabel="agents", ylabel="iterations to forage", title=title)
     ax.legend()
     save_figure(fig, path)
 
@@ -175,11 +195,12 @@ def _table2_plot(rows, path):
 SETUP3_SIZES = tuple(paper.TABLE3)
 
 
-def _table3_configs():
+def _table3_configs(floor: Floor | None = None):
+    """Setup 3's sizes: one floor cannot give them (floors.ONE_FLOOR_REFUSED)."""
     return [Config(f"setup3-{s}", s, 50) for s in SETUP3_SIZES]
 
 
-def _table3_report(rows):
+def _table3_report(rows, floor: Floor | None = None):
     summary, lines, prev, p_prev = [], [], None, None
     for size, p_mean in paper.TABLE3.items():
         mean, std, count, unfinished = _stats(rows, size=size)
@@ -196,7 +217,7 @@ def _table3_report(rows):
     return summary, md
 
 
-def _table3_plot(rows, path):
+def _table3_plot(rows, path, floor: Floor | None = None):
     plt = pyplot()
     sizes = list(paper.TABLE3)
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -213,35 +234,43 @@ def _table3_plot(rows, path):
 ANT_SIZES = (12, 25, 50, 100)
 
 
-def _ants_configs():
-    return [Config(f"setup3-{s}", s, 50, c) for s in ANT_SIZES for c in ("cmarking", "ant")]
+def _ants_configs(floor: Floor | None = None):
+    floors = [(f"setup3-{s}", s) for s in ANT_SIZES] if floor is None else [(floor.ref, floor.size)]
+    return [Config(ref, s, 50, c) for ref, s in floors for c in ("cmarking", "ant")]
 
 
-def _ants_report(rows):
+def _size_label(size: int, floor: Floor | None) -> str:
+    return f"{size}x{size}" if floor is None or floor.paper else floor.label
+
+
+def _ants_report(rows, floor: Floor | None = None):
     summary, lines = [], []
-    for size in ANT_SIZES:
+    for size in sorted({r["size"] for r in rows}):
         cm, _, cm_n, cm_unf = _stats(rows, size=size, controller="cmarking")
         ant, _, ant_n, ant_unf = _stats(rows, size=size, controller="ant")
         gap = 100 * (1 - cm / ant)
         summary.append({"size": size, "cmarking_mean": round(cm, 1), "ant_mean": round(ant, 1),
                         "gap_percent": round(gap, 1), "cmarking_unfinished": cm_unf,
                         "ant_unfinished": ant_unf, "runs": cm_n, "cmarking_wins": bool(cm < ant)})  # fmt: skip
-        lines.append([f"{size}x{size}", _fmt(cm), _fmt(ant), f"{gap:.0f}%", "yes" if cm < ant else "NO",
+        lines.append([_size_label(size, floor), _fmt(cm), _fmt(ant), f"{gap:.0f}%", "yes" if cm < ant else "NO",
                       f"{cm_unf}+{ant_unf}/{cm_n + ant_n}"])  # fmt: skip
     md = markdown_table(["size", "c-marking: mean", "ant: mean", "gap 1-cm/ant", "c-marking faster",
               "unfinished"], lines)  # fmt: skip
-    md += (f"\n\nPaper (section 5.5, Figure 9): the gap shrinks "
-           f"{' -> '.join(f'{g}%' for g in paper.ANT_GAP_PERCENT)} as the environment grows.")  # fmt: skip
+    if _shown(floor):
+        md += (f"\n\nPaper (section 5.5, Figure 9): the gap shrinks "
+               f"{' -> '.join(f'{g}%' for g in paper.ANT_GAP_PERCENT)} as the environment grows.")  # fmt: skip
     return summary, md
 
 
-def _ants_plot(rows, path):
+def _ants_plot(rows, path, floor: Floor | None = None):
     plt = pyplot()
+    sizes = sorted({r["size"] for r in rows}) or list(ANT_SIZES)
     fig, ax = plt.subplots(figsize=(6, 4))
     for c in ("cmarking", "ant"):
-        ax.plot(ANT_SIZES, [_stats(rows, size=s, controller=c)[0] for s in ANT_SIZES], "o-", label=c)
+        ax.plot(sizes, [_stats(rows, size=s, controller=c)[0] for s in sizes], "o-", label=c)
+    where = "setup 3" if floor is None else floor.label
     ax.set(xscale="log", yscale="log", xlabel="side of the square environment",
-           ylabel="iterations to forage", title="c-marking vs ants (setup 3, 50 agents)")  # fmt: skip
+           ylabel="iterations to forage", title=f"c-marking vs ants ({where}, 50 agents)")  # fmt: skip
     ax.legend()
     save_figure(fig, path)
 
@@ -252,12 +281,13 @@ CONGESTION_AGENTS = (10, 20, 40, 80, 160)
 CONGESTION_CAP = 50_000  # a run that jams is cut here (counted unfinished); the same cap for both kinds
 
 
-def _congestion_configs():
-    return [Config("setup1", 40, n, physics=p) for n in CONGESTION_AGENTS for p in ("ideal", "physical")]
+def _congestion_configs(floor: Floor | None = None):
+    ref, size = _on(floor, "setup1", 40)
+    return [Config(ref, size, n, physics=p) for n in CONGESTION_AGENTS for p in ("ideal", "physical")]
 
 
-def _congestion_report(rows):
-    summary, lines = [], []
+def _congestion_report(rows, floor: Floor | None = None):
+    shown, summary, lines = _shown(floor), [], []
     for n in CONGESTION_AGENTS:
         ideal, _, runs, ideal_unf = _stats(rows, agents=n, physics="ideal")
         phys, phys_std, _, phys_unf = _stats(rows, agents=n, physics="physical")
@@ -270,27 +300,33 @@ def _congestion_report(rows):
                         "physical_mean": round(phys, 1), "physical_std": round(phys_std, 1),
                         "physical_unfinished": phys_unf, "physical_over_ideal": round(phys / ideal, 3),
                         "blocked_share": round(share, 4), "blocked_moves": round(moves, 1),
-                        "physical_ticks_per_second": round(rate), "paper_mean": paper.TABLE1[n][0]})  # fmt: skip
-        lines.append([str(n), str(paper.TABLE1[n][0]), _fmt(ideal, 0), _fmt(phys, 0), _fmt(phys / ideal, 2),
-                      _fmt(share, 3), _fmt(moves, 0), _fmt(rate, 0), f"{phys_unf}/{len(bodies)}"])  # fmt: skip
-    md = markdown_table(["agents", "paper (Table 1): mean", "ideal: mean", "physical: mean", "physical / ideal",
-              "blocked share", "blocked moves per run", "physical ticks/s", "physical unfinished"], lines)  # fmt: skip
+                        "physical_ticks_per_second": round(rate)})  # fmt: skip
+        if shown:
+            summary[-1]["paper_mean"] = paper.TABLE1[n][0]
+        lines.append([str(n), *([str(paper.TABLE1[n][0])] if shown else []), _fmt(ideal, 0), _fmt(phys, 0),
+                      _fmt(phys / ideal, 2), _fmt(share, 3), _fmt(moves, 0), _fmt(rate, 0),
+                      f"{phys_unf}/{len(bodies)}"])  # fmt: skip
+    md = markdown_table(["agents", *(["paper (Table 1): mean"] if shown else []), "ideal: mean", "physical: mean",
+                         "physical / ideal", "blocked share", "blocked moves per run", "physical ticks/s",
+                         "physical unfinished"], lines)  # fmt: skip
     md += (f"\n\nPhysical: pymunk discs (the scenario's bodies: diameter 0.4 cells by default). A run still "
            f"foraging after {CONGESTION_CAP:,} ticks is cut there, counted as unfinished, and enters the mean at "
            "the cap. Ticks/s: one run per core while the others run.")  # fmt: skip
     return summary, md
 
 
-def _congestion_plot(rows, path):
+def _congestion_plot(rows, path, floor: Floor | None = None):
     plt = pyplot()
     ns = list(CONGESTION_AGENTS)
     fig, ax = plt.subplots(figsize=(6, 4))
     for physics, marker in (("ideal", "o-"), ("physical", "^-")):
         ax.plot(ns, [_stats(rows, agents=n, physics=physics)[0] for n in ns], marker, label=f"swarm: {physics}")
-    ax.plot(ns, [paper.TABLE1[n][0] for n in ns], "s:", label="paper (Table 1, grid)")
+    if _shown(floor):
+        ax.plot(ns, [paper.TABLE1[n][0] for n in ns], "s:", label="paper (Table 1, grid)")
     ax.axhline(CONGESTION_CAP, color="grey", lw=0.8, ls="--", label="cap")
+    where = "Setup 1" if floor is None else floor.label
     ax.set(xscale="log", yscale="log", xlabel="agents", ylabel="iterations to forage",
-           title="Setup 1: what robot bodies cost")  # fmt: skip
+           title=f"{where}: what robot bodies cost")  # fmt: skip
     ax.legend()
     save_figure(fig, path)
 
@@ -312,11 +348,12 @@ EXPERIMENTS: dict[str, Experiment] = {
 }  # fmt: skip
 
 
-def plan(name: str, reps: int, seed: int) -> list[RunSpec]:
+def plan(name: str, reps: int, seed: int, floor: Floor | None = None) -> list[RunSpec]:
+    """Every run of an experiment: its conditions on its floor (the paper's, or `floor`) × the seeds."""
     exp = EXPERIMENTS[name]
     specs = [
         RunSpec(name, c.scenario, c.size, c.agents, c.controller, c.physics, seed + rep, exp.max_iterations)
-        for c, rep in cross(exp.configs(), range(reps))
+        for c, rep in cross(exp.configs(floor), range(reps))
     ]
     return sorted(specs, key=expected_work, reverse=True)
 
@@ -331,27 +368,32 @@ def expected_work(spec: RunSpec) -> float:
 
 def run_experiment(
     name: str, reps: int | None = None, jobs: int | None = None, seed: int = 0,
-    out: Path | None = None, progress: bool = True,
+    out: Path | None = None, progress: bool = True, scenario: str | None = None,
 ) -> dict:  # fmt: skip
+    """Run one experiment's conditions on the paper's floors, or on `scenario` (a grid floor with a base and
+    resources: floors.user_floor), the paper's numbers beside ours only on the paper's own floor."""
     if name not in EXPERIMENTS:
         raise ValueError(f"unknown experiment {name!r}: choose one of {', '.join(EXPERIMENTS)}")
     exp = EXPERIMENTS[name]
+    floor = None if scenario is None else user_floor(name, scenario)
     reps = exp.default_reps if reps is None else reps
     if reps < 1:
         raise ValueError("--reps must be at least 1")
     jobs = jobs or os.cpu_count() or 1
     out = Outputs(out, name)
-    specs = plan(name, reps, seed)
+    specs = plan(name, reps, seed, floor)
     physics = sorted({s.physics for s in specs})
     # many short runs go in chunks (less messaging); a few long ones one by one (a live progress bar)
     rows = batch_run(run_one, specs, jobs=jobs, desc=exp.title.split(":")[0], progress=progress, warm_up=warm_up,
                      warm_args=(physics,), chunksize=max(1, min(16, len(specs) // (jobs * 100))))  # fmt: skip
     rows.sort(key=lambda r: (r["size"], r["agents"], r["controller"], r["physics"], r["seed"]))
     out.runs(rows, RUN_FIELDS)
-    summary, md = exp.report(rows)
-    text = f"# {exp.title}\n\n{reps} runs per configuration, seeds {seed}..{seed + reps - 1}.\n\n{md}\n"
+    summary, md = exp.report(rows, floor)
+    title = exp.title if floor is None else f"{exp.title.split(':')[0]}'s design on {floor.label}"
+    text = (f"# {title}\n\n{reps} runs per configuration, seeds {seed}..{seed + reps - 1}.\n\n"
+            f"{floor_note(floor)}{md}\n")  # fmt: skip
     result = out.finish(summary, text)
-    exp.plot(rows, out / "plot.png")
+    exp.plot(rows, out / "plot.png", floor)
     return result
 
 

@@ -26,6 +26,7 @@ from swarm.core.errors import ScenarioError
 from swarm.core.plots import pyplot, save_figure
 from swarm.experiments.protocol import CONFIRMATION_SEEDS
 from swarm.experiments.runner import Outputs, batch_run
+from swarm.experiments.simonin2007.floors import Floor, floor_note, user_floor
 
 SIZES = (25, 50, 100)
 SEEDS = 10
@@ -54,8 +55,8 @@ def run_setting(job: tuple) -> dict:
     from swarm.engines.grid import Engine
     from swarm.scenario import load_scenario
 
-    controller, params, size, seed = job
-    s = load_scenario(f"setup3-{size}").with_overrides(agents=50, controller=controller, seed=seed)
+    controller, params, size, seed, floor = job
+    s = load_scenario(floor).with_overrides(agents=50, controller=controller, seed=seed)
     if controller == "ant":
         s = replace(s, ant=replace(s.ant, **params))
     else:
@@ -86,34 +87,43 @@ def sizes_option(text: str) -> tuple[int, ...]:
 
 
 def run_tuning(name: str, reps: int | None, jobs: int | None, seed: int, out: Path | None,
-               progress: bool = True, tuning_sizes: tuple[int, ...] | None = None) -> dict:  # fmt: skip
-    """`name`: "tuning" (the registry calls every experiment by name)."""
+               progress: bool = True, tuning_sizes: tuple[int, ...] | None = None,
+               scenario: str | None = None) -> dict:  # fmt: skip
+    """`name`: "tuning" (the registry calls every experiment by name).  Tunes on setup 3's `tuning_sizes`, or
+    on the one grid floor `scenario` names (floors.user_floor)."""
     reps = SEEDS if reps is None else reps
-    sizes = SIZES if tuning_sizes is None else tuning_sizes
+    if scenario is not None and tuning_sizes is not None:
+        raise ScenarioError("command line", "--tuning-sizes", "--scenario gives the one floor to tune on; "
+                            "--tuning-sizes chooses setup 3's sizes: give one or the other")  # fmt: skip
+    floor = None if scenario is None else user_floor(name, scenario)
+    sizes = (floor.size,) if floor else SIZES if tuning_sizes is None else tuning_sizes
+    refs = {s: floor.ref if floor else f"setup3-{s}" for s in sizes}
     if seed + reps > CONFIRMATION_SEEDS.start:
         last = seed + reps - 1
         raise ScenarioError("command line", "--seed", f"tuning uses development seeds only (below "
                             f"{CONFIRMATION_SEEDS.start}); seeds {seed}..{last} reach past them")  # fmt: skip
     out_ = Outputs(out, name)
-    work = [(c, p, size, seed + k) for c, p in settings() for size in sizes for k in range(reps)]
+    work = [(c, p, size, seed + k, refs[size]) for c, p in settings() for size in sizes for k in range(reps)]
     work.sort(key=lambda j: j[2] ** 2 * (3 if j[0] == "ant" else 1), reverse=True)  # the longest first
     rows = batch_run(run_setting, work, jobs=jobs, desc=name, progress=progress)
     order = [label(c, p) for c, p in settings()]
     rows.sort(key=lambda r: (order.index(r["setting"]), r["size"], r["seed"]))
     out_.runs(rows, FIELDS)
-    summary, md = _table(rows, reps, seed, sizes)
+    summary, md = _table(rows, reps, seed, sizes, floor)
     result = out_.finish(summary, md)
     _plot(rows, out_ / "plot.png", sizes)
     return result
 
 
-def _table(rows: list[dict], reps: int, seed: int, sizes: tuple[int, ...]) -> tuple[list[dict], str]:
+def _table(rows: list[dict], reps: int, seed: int, sizes: tuple[int, ...],
+           floor: Floor | None = None) -> tuple[list[dict], str]:  # fmt: skip
     scores = score(rows, sizes)
     summary, parts = [], []
     for controller in ("ant", "cmarking"):
         mine = [s for s in scores if any(r["setting"] == s and r["controller"] == controller for r in rows)]
         best = min(mine, key=scores.__getitem__)
-        lines = [f"\n### {controller}\n", "| setting | " + " | ".join(f"{s}x{s}" for s in sizes)
+        columns = [f"{s}x{s}" if floor is None or floor.paper else floor.label for s in sizes]
+        lines = [f"\n### {controller}\n", "| setting | " + " | ".join(columns)
                  + " | geometric mean | unfinished |", "|---|" + "---|" * (len(sizes) + 2)]  # fmt: skip
         for setting in mine:
             sel = [r for r in rows if r["setting"] == setting]
@@ -127,9 +137,11 @@ def _table(rows: list[dict], reps: int, seed: int, sizes: tuple[int, ...]) -> tu
                             "unfinished": unfinished, "best": setting == best})  # fmt: skip
         parts.append("\n".join(lines))
     head = (f"# Tuning both foraging models with the same budget (development seeds {seed}..{seed + reps - 1})\n\n"
-            f"25 settings per model × sizes {', '.join(map(str, sizes))} (setup 3, 50 agents) × {reps} seeds; "
-            "score: the geometric mean over the sizes of the mean foraging time (lower is better). The ants' "
-            f"pheromone window is [threshold, {WINDOW:g} × threshold), NetLogo's [0.05, 2) scaled.\n")  # fmt: skip
+            + (f"25 settings per model × sizes {', '.join(map(str, sizes))} (setup 3, 50 agents)" if floor is None
+               else f"{floor_note(floor, numbers=False)}25 settings per model on {floor.label} (50 agents)")
+            + f" × {reps} seeds; score: the geometric mean over the sizes of the mean foraging time (lower is "
+            f"better). The ants' pheromone window is [threshold, {WINDOW:g} × threshold), NetLogo's [0.05, 2) "
+            "scaled.\n")  # fmt: skip
     return summary, head + "\n".join(parts) + "\n"
 
 

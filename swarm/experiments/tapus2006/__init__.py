@@ -5,6 +5,9 @@ from swarm.core.registry import ExperimentSpec, Option, PaperSpec
 
 _FLOOR = Option("--scenario", "a floor with 'mapping', 'localize' and 'localize-off-map' routes and place zones "
                 "(default office)")  # fmt: skip
+_TEAM_FLOOR = Option("--scenario", "a floor with a 'mapping' route (robot k of N drives its k-th stretch) and place "
+                     "zones (default office: robot k surveys the k-th stretch of the corridor and its rooms)",
+                     metavar="FILE")  # fmt: skip
 _RUN = "swarm.experiments.tapus2006.fingerprint:run_fingerprint_experiment"
 EXPERIMENTS = (
     ExperimentSpec("fingerprint-calibrate", "tapus2006", "fit the alignment's defaults on the mapping tour", _RUN,
@@ -14,7 +17,8 @@ EXPERIMENTS = (
     ExperimentSpec("fingerprint-localize", "tapus2006", "map on one tour, localize on another", _RUN,
                    options=(_FLOOR,), writes="runs.csv, table.md, summary.csv, plot.png"),
     ExperimentSpec("fingerprint-together", "tapus2006", "surveyors of office sharing one map",
-                   "swarm.experiments.tapus2006.team:run_team_experiment", writes="runs.csv, table.md, plot.png",
+                   "swarm.experiments.tapus2006.team:run_team_experiment", options=(_TEAM_FLOOR,),
+                   writes="runs.csv, table.md, plot.png",
                    smoke=(("reps", 1), ("teams", (1, 2)))),
 )  # fmt: skip
 PAPER = PaperSpec(

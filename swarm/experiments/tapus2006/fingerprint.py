@@ -119,6 +119,8 @@ def tour_scenario(name: str, route: str, noise: str, seed: int, table: dict | No
     from swarm.scenario import load_scenario
 
     s = load_scenario(name)
+    if getattr(s, "kind", "grid") != "arena":  # a grid scenario has no kind field
+        raise ScenarioError(name, "kind", "the fingerprint experiments map an arena floor")
     if route not in s.routes:
         raise ScenarioError(name, "routes", f"no route {route!r}; the fingerprint experiments need "
                             "'mapping', 'localize' and 'localize-off-map' routes")  # fmt: skip
@@ -449,6 +451,7 @@ def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | Non
                                out: Path | None, progress: bool = True) -> dict:  # fmt: skip
     name = scenario or "office"
     reps = reps or 3
+    tour_scenario(name, "mapping", "low", seed)  # a floor it cannot map is refused here, in one line
     out = Outputs(out, which)
     if which == "fingerprint-calibrate":
         return _calibrate(name, seed, out)

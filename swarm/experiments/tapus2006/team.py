@@ -8,6 +8,8 @@ changes each tick and merges the others' (agents.controllers.navigation.mapshare
 Robot 0's merged map covers the floor when each of the floor's 20 places has
 a node in it, a node's place being where most of the fingerprints behind it
 were taken (by whichever robot made it; ground truth, for judging only).
+On another floor (--scenario) robot k of N drives the k-th of N stretches of
+the floor's `mapping` route, and the floor's place zones judge the map.
 Reported per N: ticks (and simulated seconds) until robot 0's map covers the
 floor, the mean distance each robot had driven by then, robot 0's node count
 at the end against a lone robot's, how many of its nodes came from others
@@ -17,12 +19,15 @@ places it knows but never visited.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
+from swarm.core.errors import ScenarioError
 from swarm.experiments.runner import Outputs, batch_run
 from swarm.experiments.tapus2006.fingerprint import place_of, places
 
@@ -59,18 +64,71 @@ def team_toml(robots: int, base: str = "office") -> str:
     return text.rstrip("\n") + "\n\n" + "\n".join(groups)
 
 
-def team_scenario(robots: int, noise: str, seed: int):
+def team_scenario(robots: int, noise: str, seed: int, floor: str | None = None):
+    """The office with `robots` surveyors, or `floor` with robot k driving the k-th stretch of its mapping route."""
     from swarm.scenario import parse_arena_text
 
+    if floor is not None:
+        return floor_team(floor, robots).with_overrides(noise=noise, seed=seed)
     s = parse_arena_text(team_toml(robots), f"office, {robots} surveyors", "office-team")
     return s.with_overrides(noise=noise, seed=seed)
+
+
+def stretches(route: tuple, robots: int) -> list[list[tuple[float, float]]]:
+    """A route cut into `robots` consecutive stretches of equal length (any team fits any route), each
+    stretch from its cut to the next through the route's waypoints between them."""
+    pts = np.asarray(route, float)
+    legs = np.maximum(np.hypot(*np.diff(pts, axis=0).T), 1e-9)
+    along = np.concatenate([[0.0], np.cumsum(legs)])
+
+    def at(d: float) -> tuple[float, float]:
+        i = int(np.clip(np.searchsorted(along, d, side="right") - 1, 0, len(legs) - 1))
+        x, y = pts[i] + (d - along[i]) / legs[i] * (pts[i + 1] - pts[i])
+        return float(x), float(y)
+
+    cuts = [along[-1] * k / robots for k in range(robots + 1)]
+    return [[at(a), *(tuple(map(float, p)) for p, d in zip(pts, along, strict=True) if a < d < b), at(b)]
+            for a, b in itertools.pairwise(cuts)]  # fmt: skip
+
+
+def check_team_floor(floor: str, teams: tuple[int, ...]):
+    """The floor --scenario names, checked for what the team needs: an arena floor with place zones (to judge
+    the map by) and a 'mapping' route to share among the robots."""
+    from swarm.scenario import load_scenario
+
+    s = load_scenario(floor)
+    if getattr(s, "kind", "grid") != "arena":  # a grid scenario has no kind field
+        raise ScenarioError(floor, "kind", "fingerprint-together maps an arena floor")
+    if not places(s):
+        raise ScenarioError(floor, "zones", "fingerprint-together needs place zones ([[zone]] kind = \"place\", "
+                            "rect = [...]) to judge the map by")  # fmt: skip
+    if "mapping" not in s.routes:
+        raise ScenarioError(floor, "routes", "fingerprint-together needs a 'mapping' route, split among the robots")
+    route = np.asarray(s.routes["mapping"], float)
+    if len(route) < 2 or not np.hypot(*np.diff(route, axis=0).T).sum() > 0:
+        raise ScenarioError(floor, "routes.mapping", "fingerprint-together needs a mapping route of some length")
+    return s
+
+
+def floor_team(floor: str, robots: int):
+    """`floor` with `robots` fingerprint robots (its first group's), robot k on the k-th stretch of its mapping
+    route, facing along it."""
+    s = check_team_floor(floor, (robots,))
+    routes, groups = dict(s.routes), []
+    for k, stretch in enumerate(stretches(s.routes["mapping"], robots)):
+        (x0, y0), (x1, y1) = stretch[0], stretch[1]
+        routes[f"survey_{k}"] = tuple(stretch)
+        groups.append(replace(s.groups[0], count=1, controller="fingerprint", route=f"survey_{k}",
+                              starts=((x0, y0, math.atan2(y1 - y0, x1 - x0)),), goals=None,
+                              draw_goals=False))  # fmt: skip
+    return replace(s, groups=tuple(groups), routes=routes)
 
 
 def team_job(job: tuple) -> dict:
     from swarm.engines.arena import ArenaEngine
 
-    robots, noise, seed = job
-    s = team_scenario(robots, noise, seed)
+    robots, noise, seed, *floor = job
+    s = team_scenario(robots, noise, seed, *floor)
     zones = places(s)
     engine = ArenaEngine(s)
     cs = engine.controllers
@@ -126,15 +184,19 @@ def known_places(lead, counts: list[dict]) -> set[int]:
 
 
 def run_team_experiment(name: str, reps: int | None, jobs: int | None, seed: int, out: Path | None,
-                        progress: bool = True, teams: tuple[int, ...] = TEAMS) -> dict:  # fmt: skip
-    """`name`: "fingerprint-together", the one experiment this runs (the registry calls every experiment by name)."""
+                        progress: bool = True, teams: tuple[int, ...] = TEAMS,
+                        scenario: str | None = None) -> dict:  # fmt: skip
+    """`name`: "fingerprint-together", the one experiment this runs (the registry calls every experiment by name);
+    `scenario`: another floor, robot k of N on the k-th stretch of its mapping route (check_team_floor)."""
     reps = reps or 1
+    if scenario is not None:
+        check_team_floor(scenario, teams)
     out = Outputs(out, "fingerprint-together")
-    work = [(n, "low", seed + r) for n in sorted(teams, reverse=True) for r in range(reps)]
+    work = [(n, "low", seed + r, scenario) for n in sorted(teams, reverse=True) for r in range(reps)]
     rows = batch_run(team_job, work, jobs=jobs, desc="fingerprint-together", progress=progress)
     rows.sort(key=lambda r: (r["robots"], r["seed"]))
     out.runs(rows)
-    result = out.finish(None, _table(rows, reps, seed))
+    result = out.finish(None, _table(rows, reps, seed, scenario))
     plot(rows, out / "plot.png")
     return result
 
@@ -144,11 +206,14 @@ def _mean(sel: list[dict], key: str) -> float:
     return float(np.mean(values)) if values else math.nan
 
 
-def _table(rows: list[dict], reps: int, seed: int) -> str:
+def _table(rows: list[dict], reps: int, seed: int, floor: str | None = None) -> str:
     lone = _mean([r for r in rows if r["robots"] == 1], "nodes")
-    lines = ["# Mapping together (fingerprints of places, `office`, noise low)\n",
-             f"{reps} run(s) per team size (seeds {seed}..{seed + reps - 1}); robot k surveys the k-th stretch of the "
-             "corridor and its rooms; robot 0's merged map is judged.\n",
+    design = ("robot k surveys the k-th stretch of the corridor and its rooms" if floor is None else
+              "robot k of N drives the k-th of N stretches of the floor's mapping route (the user's "
+              "floor)")  # fmt: skip
+    lines = [f"# Mapping together (fingerprints of places, `{floor or 'office'}`, noise low)\n",
+             f"{reps} run(s) per team size (seeds {seed}..{seed + reps - 1}); {design}; robot 0's merged map is "
+             "judged.\n",
              "| robots | covered after (ticks) | (s simulated) | distance per robot (m) | places known | "
              "known, never visited | nodes | a lone robot's | from others | merged into ours |",
              "|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
