@@ -525,7 +525,7 @@ def test_localize_mode_needs_a_map_and_says_so():
     from swarm.engines.arena import ArenaEngine
     from swarm.experiments.tapus2006.fingerprint import tour_scenario
 
-    with pytest.raises(RunError, match="'fingerprint' of robot 0 cannot start: ValueError: .* needs a map"):
+    with pytest.raises(RunError, match=r"'fingerprint' of robot 0 cannot start: ValueError: .* needs a map"):
         ArenaEngine(tour_scenario("office", "mapping", "low", 0, {"mode": "localize"}))
 
 
