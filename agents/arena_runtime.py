@@ -62,10 +62,9 @@ class ArenaAgentRuntime(AgentRuntime):
 
     def _answer(self, obs: arena_proto.ArenaObs) -> int:
         agents, wheels = [], []
-        mine = [(a, self.brains[self.slot_of[a]]) for a in obs.agents.tolist() if a in self.slot_of]
+        mine = [(self.brains[self.slot_of[a]], a) for a in obs.agents.tolist() if a in self.slot_of]
         if obs.shared and not self.null:  # what every robot published last tick, before this tick's step
-            self.refused_shared += deliver([b for _, b in mine], [a for a, _ in mine], list(obs.shared),
-                                           self.guard.failed)  # fmt: skip
+            self.refused_shared += deliver(*self.guard.working(mine), list(obs.shared))
         for agent, reading in zip(obs.agents.tolist(), obs.perceptions, strict=True):
             slot = self.slot_of.get(agent)
             if slot is None:
@@ -73,13 +72,14 @@ class ArenaAgentRuntime(AgentRuntime):
             agents.append(agent)
             wheels.append(np.zeros(3) if self.null else
                           self.guard.action(self.brains[slot], reading, agent, self.names[slot], obs.tick))  # fmt: skip
-        shared = [] if self.null else publications([b for _, b in mine], [a for a, _ in mine], self.guard.failed)
-        rab = [] if self.null else broadcasts([b for _, b in mine], [a for a, _ in mine], self.guard.failed)
+        brains, ids = self.guard.working(mine)  # those still in the run (after this tick's steps)
+        shared = [] if self.null else publications(brains, ids)
+        rab = [] if self.null else broadcasts(brains, ids)
         if self.kept:  # the message that carried last tick's memory (MBs for a DFT robot) and zenoh's copy
             heap.give_back()  # of it are freed by now: all of it back to the system, not kept in the heap
         self.kept = keep = obs.keep and not self.null
         # the memory's arrays are written once, straight into the message (the save-tick peak)
-        memory = [(a, memory_codec.pieces(b.snapshot())) for a, b in mine if a not in self.guard.failed] if keep else []
+        memory = [(a, memory_codec.pieces(b.snapshot())) for b, a in zip(brains, ids, strict=True)] if keep else []
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory, rab)
         self.act_publisher.put(payload)
         if not self.null:

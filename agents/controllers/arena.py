@@ -108,6 +108,12 @@ class StepGuard:
                         "the world refuses such answers and counts them (rejected actions)")  # fmt: skip
         return action
 
+    def working(self, pairs) -> tuple[list, list]:
+        """The (controller, agent) pairs still in the run, as (controllers, agents): only they publish,
+        receive, broadcast and save."""
+        kept = [(c, a) for c, a in pairs if a not in self.failed]
+        return [c for c, _ in kept], [a for _, a in kept]
+
     def _failed(self, agent: int, exc: Exception, who: str, when: str) -> None:
         self.failed[agent] = one_line(exc)
         self._fault(f"{who} raised {self.failed[agent]} {when}", "the robot holds still for the rest of the run")
@@ -123,40 +129,37 @@ def make_controller(name: str) -> ArenaController:
     return CONTROLLERS[name].make()
 
 
-def publications(controllers, agents, failed=()) -> list[tuple[int, str, bytes]]:
-    """(agent, share, msgpack payload) of every controller that has something to publish, in agent order
-    (not those in `failed`: StepGuard.failed)."""
+def publications(controllers, agents) -> list[tuple[int, str, bytes]]:
+    """(agent, share, msgpack payload) of every controller that has something to publish, in agent order."""
     from swarm.core.wire import pack
 
     out = []
     for a, c in zip(agents, controllers, strict=True):
-        share = None if a in failed else getattr(c, "shares", None)
+        share = getattr(c, "shares", None)
         if share and (data := c.publish()) is not None:
             out.append((int(a), share, pack(data)))
     return out
 
 
-def broadcasts(controllers, agents, failed=()) -> list[tuple[int, bytes]]:
+def broadcasts(controllers, agents) -> list[tuple[int, bytes]]:
     """(agent, bytes) of every controller that broadcasts this tick (its optional `broadcast()`), in
-    agent order: the world hands them to its range-and-bearing neighbours at the next tick.  The
-    robots in `failed` (StepGuard.failed: their controllers raised) send nothing."""
+    agent order: the world hands them to its range-and-bearing neighbours at the next tick."""
     out = []
     for a, c in zip(agents, controllers, strict=True):
-        send = None if a in failed else getattr(c, "broadcast", None)
+        send = getattr(c, "broadcast", None)
         if send is not None and (data := send()) is not None:
             out.append((int(a), bytes(data)))
     return out
 
 
-def deliver(controllers, agents, shared: list[tuple[int, str, bytes]], failed=()) -> int:
-    """Hand every controller what the others of its share published (not its own), in agent order
-    (not to those in `failed`).  Returns the payloads refused (undecodable or malformed: counted,
-    nothing of them merged)."""
+def deliver(controllers, agents, shared: list[tuple[int, str, bytes]]) -> int:
+    """Hand every controller what the others of its share published (not its own), in agent order.
+    Returns the payloads refused (undecodable or malformed: counted, nothing of them merged)."""
     from swarm.core.wire import Rejected, unpack
 
     refused = 0
     for a, c in zip(agents, controllers, strict=True):
-        share = None if a in failed else getattr(c, "shares", None)
+        share = getattr(c, "shares", None)
         if not share:
             continue
         for sender, s, payload in shared:

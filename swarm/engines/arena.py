@@ -56,11 +56,12 @@ class ArenaEngine:
         def decide(perceptions, tick: int) -> np.ndarray:
             for a, (c, p) in enumerate(zip(self.controllers, perceptions, strict=True)):
                 self.actions[a] = self.guard.action(c, p, a, self.names[a], tick)
-            w.broadcast(broadcasts(self.controllers, self.agent_ids, self.guard.failed))
-            shared = publications(self.controllers, self.agent_ids, self.guard.failed)
+            working = self.guard.working(zip(self.controllers, self.agent_ids, strict=True))
+            w.broadcast(broadcasts(*working))
+            shared = publications(*working)
             if shared:  # what each wrote this tick, every other robot of its share reads before the next
                 self.shares.add(tick, shared)
-                self.refused_shared += deliver(self.controllers, self.agent_ids, shared, self.guard.failed)
+                self.refused_shared += deliver(*working, shared)
             return self.actions
 
         def after() -> None:

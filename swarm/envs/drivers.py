@@ -21,7 +21,7 @@ class Drivers:
         self.controllers = []
         for a, name in zip(self.robots, self.names, strict=True):
             c = make_controller(name)
-            c.reset(s.seed, a, controller_params(s, a))
+            self.guard.reset(c, s.seed, a, controller_params(s, a), name)
             self.controllers.append(c)
 
     def act(self, run: ArenaRun) -> None:
@@ -29,7 +29,8 @@ class Drivers:
         tick = run.world.tick
         for a, name, c in zip(self.robots, self.names, self.controllers, strict=True):
             run.actions[a] = self.guard.action(c, run.perception[a], a, name, tick)
-        run.world.broadcast(broadcasts(self.controllers, self.robots, self.guard.failed))
-        shared = publications(self.controllers, self.robots)
+        working = self.guard.working(zip(self.controllers, self.robots, strict=True))
+        run.world.broadcast(broadcasts(*working))
+        shared = publications(*working)
         if shared:
-            deliver(self.controllers, self.robots, shared)
+            deliver(*working, shared)

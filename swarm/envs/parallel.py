@@ -8,7 +8,7 @@ from typing import Any, ClassVar
 import numpy as np
 from pettingzoo.utils.env import ParallelEnv
 
-from swarm.envs.render import TopDown
+from swarm.envs.render import Canvas
 from swarm.envs.run import ArenaRun, agent_boxes, rows
 from swarm.envs.source import arena_scenario
 from world_server.arena.scenario import ArenaScenario
@@ -55,7 +55,7 @@ class ArenaParallelEnv(ParallelEnv):
         self.agents: list[str] = []
         self.live_index: dict[str, int] = {}
         self.run: ArenaRun | None = None
-        self.canvas: TopDown | None = None
+        self.canvas = Canvas()
 
     def observation_space(self, agent: str):
         return self.observation_spaces[agent]
@@ -115,9 +115,7 @@ class ArenaParallelEnv(ParallelEnv):
         """A top-down picture of the arena (walls and robots) as an (h, w, 3) uint8 array."""
         if self.render_mode != "rgb_array" or self.run is None:
             return None
-        if self.canvas is None or self.canvas.world is not self.run.world:
-            self.canvas = TopDown(self.run.world)
-        return self.canvas.frame()
+        return self.canvas.frame(self.run.world)
 
     def close(self) -> None:
         self.run = None

@@ -58,3 +58,15 @@ class TopDown:
         length2 = dx * dx + dy * dy
         t = 0.0 if length2 == 0 else np.clip(((xs - x0) * dx + (ys - y0) * dy) / length2, 0.0, 1.0)
         img[box][(xs - x0 - t * dx) ** 2 + (ys - y0 - t * dy) ** 2 <= width * width] = rgb
+
+
+class Canvas:
+    """The frames of whichever world an env holds now: a new TopDown when reset made a new world."""
+
+    def __init__(self) -> None:
+        self.top: TopDown | None = None
+
+    def frame(self, world: ArenaWorld) -> np.ndarray:
+        if self.top is None or self.top.world is not world:
+            self.top = TopDown(world)
+        return self.top.frame()

@@ -10,7 +10,7 @@ import numpy as np
 
 from swarm.envs.drivers import Drivers
 from swarm.envs.parallel import Reward, Terminated, no_reward
-from swarm.envs.render import TopDown
+from swarm.envs.render import Canvas
 from swarm.envs.run import ArenaRun, agent_boxes
 from swarm.envs.source import arena_scenario
 from world_server.arena.scenario import ArenaScenario
@@ -40,7 +40,7 @@ class ArenaGymEnv(gym.Env):
         self.observation_space, self.action_space = obs[agent], act[agent]
         self.first_seed: int | None = scenario.seed if seed is None else seed
         self.run: ArenaRun | None = None
-        self.canvas: TopDown | None = None
+        self.canvas = Canvas()
         self.drivers: Drivers | None = None
 
     def reset(self, *, seed: int | None = None, options: dict | None = None) -> tuple[dict, dict]:
@@ -75,9 +75,7 @@ class ArenaGymEnv(gym.Env):
         """A top-down picture of the arena as an (h, w, 3) uint8 array."""
         if self.render_mode != "rgb_array" or self.run is None:
             return None
-        if self.canvas is None or self.canvas.world is not self.run.world:
-            self.canvas = TopDown(self.run.world)
-        return self.canvas.frame()
+        return self.canvas.frame(self.run.world)
 
 
 def make(scenario: str | ArenaScenario, *, agent: int = 0, reward: Reward | None = None,

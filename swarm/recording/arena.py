@@ -259,15 +259,17 @@ class ArenaRecorder:
         """Each controller's record(): one that raises or gives no dict is told once and shows nothing."""
         out = []
         for a, c in enumerate(self.controllers):
-            try:
-                record = c.record() if a not in self._quiet else {}
-            except Exception as exc:  # whatever a user's controller raises
-                record = one_line(exc)
-            if not isinstance(record, dict):
-                self._quiet.add(a)
-                print(f"swarm: the recording leaves out robot {a}'s record(): it gave {str(record)[:80]!r}, not a "
-                      "dict", file=sys.stderr)  # fmt: skip
-                record = {}
+            record: object = {}
+            if a not in self._quiet:
+                try:
+                    record = c.record()
+                    why = None if isinstance(record, dict) else f"it gave {str(record)[:80]!r}, not a dict"
+                except Exception as exc:  # whatever a user's controller raises
+                    why = f"it raised {one_line(exc)}"
+                if why is not None:
+                    self._quiet.add(a)
+                    print(f"swarm: the recording leaves out robot {a}'s record(): {why}", file=sys.stderr)
+                    record = {}
             out.append(record)
         return out
 

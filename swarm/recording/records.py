@@ -23,25 +23,22 @@ def flip(xy: np.ndarray) -> np.ndarray:
     return out
 
 
-def shape_of(value) -> str | None:
-    """ "series", "bars", "images", "path" or None (not recorded): how a record's value is shown."""
-    if isinstance(value, bool | int | float | np.number | np.bool_):
-        return "series"
-    if not isinstance(value, np.ndarray | list | tuple):
-        return None
+def shape_of(value) -> tuple[str | None, np.ndarray | None]:
+    """How a record's value is shown ("series", "bars", "images", "path", or None: not recorded), and
+    the value as an array."""
+    if not isinstance(value, bool | int | float | np.number | np.bool_ | np.ndarray | list | tuple):
+        return None, None
     try:
         a = np.asarray(value, np.float64)
     except (TypeError, ValueError):
-        return None
+        return None, None
     if a.ndim == 0:
-        return "series"
+        return "series", a
     if a.ndim == 1 and a.size:
-        return "bars"
+        return "bars", a
     if a.ndim == 2 and a.shape[1] == 2:
-        return "path"
-    if a.ndim == 2 and a.size:
-        return "images"
-    return None
+        return "path", a
+    return ("images", a) if a.ndim == 2 and a.size else (None, None)
 
 
 class RecordLog(SeriesLog):
@@ -58,11 +55,11 @@ class RecordLog(SeriesLog):
         for key, value in record.items():
             if key == "path":
                 continue
-            shown = shape_of(value)
+            shown, a = shape_of(value)
             if shown == "series":
-                rows.setdefault(str(key), [np.nan] * (n - 1)).append(float(np.asarray(value, np.float64)))
+                rows.setdefault(str(key), [np.nan] * (n - 1)).append(float(a))
             elif shown is not None and sparse:
-                self._log_array(tick, agent, str(key), shown, np.asarray(value, np.float64))
+                self._log_array(tick, agent, str(key), shown, a)
         for column in rows.values():
             if len(column) < n:
                 column.append(np.nan)

@@ -93,9 +93,6 @@ class Obstacle:
         return ((self.rect[0] + self.rect[2]) / 2, (self.rect[1] + self.rect[3]) / 2)
 
 
-RESOURCE_GREY, RESOURCE_SIZE, RESOURCE_REACH = fields.RESOURCE_GREY, fields.RESOURCE_SIZE, fields.RESOURCE_REACH
-
-
 @dataclass(frozen=True)
 class Group:
     count: int
@@ -512,18 +509,20 @@ def _resource(r, source: str, where: str) -> Obstacle:
         raise ScenarioError(source, where, "expected a [[resource]] table")
     no_unknown(r, set(fields.RESOURCE), source, f"[[resource]] ({where})")
     kind = _get(r, "kind", str, source, None, f"{where}.kind")
-    if kind not in RESOURCE_GREY:
-        raise ScenarioError(source, f"{where}.kind", f"unknown {kind!r}; expected one of {', '.join(RESOURCE_GREY)}")
+    if kind not in fields.RESOURCE_GREY:
+        raise ScenarioError(
+            source, f"{where}.kind", f"unknown {kind!r}; expected one of {', '.join(fields.RESOURCE_GREY)}"
+        )
     cx, cy = _numbers(r, "centre", source, f"{where}.centre", 2)
-    size = float(_get(r, "size", (int, float), source, RESOURCE_SIZE, f"{where}.size"))
-    reach = float(_get(r, "reach", (int, float), source, RESOURCE_REACH, f"{where}.reach"))
+    size = float(_get(r, "size", (int, float), source, fields.RESOURCE_SIZE, f"{where}.size"))
+    reach = float(_get(r, "reach", (int, float), source, fields.RESOURCE_REACH, f"{where}.reach"))
     if not (0 < size <= 10 and 0 < reach <= 100):
         raise ScenarioError(source, where, f"expected a size of 0-10 m and a reach of 0-100 m, got {size}, {reach}")
     appear = _get(r, "appear", int, source, 0, f"{where}.appear")
     vanish = _get(r, "vanish", int, source, None, f"{where}.vanish")
     if appear < 0 or (vanish is not None and vanish <= appear):
         raise ScenarioError(source, where, f"expected 0 <= appear < vanish (ticks), got {appear}, {vanish}")
-    colour = _colour(r.get("colour", RESOURCE_GREY[kind]), source, f"{where}.colour")
+    colour = _colour(r.get("colour", fields.RESOURCE_GREY[kind]), source, f"{where}.colour")
     half = size / 2
     return Obstacle((cx - half, cy - half, cx + half, cy + half), appear, vanish, colour,
                     _get(r, "name", str, source, kind, f"{where}.name"), solid=kind != "dangerous", zone=kind,

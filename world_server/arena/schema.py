@@ -79,29 +79,19 @@ def table(fields: dict[str, Any], required: tuple[str, ...] = ()) -> dict[str, A
     return out
 
 
+JSON_TYPES = {bool: "boolean", int: "integer", float: "number", str: "string", tuple: "array", list: "array"}
+
+
 def of_dataclass(cls) -> dict[str, Any]:
-    """A parameter class's table: each field typed by its default (a list: numbers)."""
+    """A parameter class's table: each field typed by its default, or by its annotation without one."""
     props = {}
     for f in dataclasses.fields(cls):
-        default = f.default if f.default is not dataclasses.MISSING else None
-        if default is None and f.type in ("int", "float", "str", "bool", int, float, str, bool):  # no default
-            default = {"int": 0, "float": 0.0, "str": "", "bool": False}.get(str(f.type), f.type)
-            default = default() if isinstance(default, type) else default
-        if isinstance(default, bool):
-            props[f.name] = {"type": "boolean"}
-        elif isinstance(default, int):
-            props[f.name] = INTEGER
-        elif isinstance(default, float):
-            props[f.name] = NUMBER
-        elif isinstance(default, str):
-            props[f.name] = STRING
-        elif isinstance(default, tuple | list):
-            props[f.name] = {"type": "array"}
-        else:
-            props[f.name] = {}
+        default = None if f.default is dataclasses.MISSING else f.default
+        kind = type(default) if default is not None else {t.__name__: t for t in JSON_TYPES}.get(str(f.type))
+        props[f.name] = {"type": JSON_TYPES[kind]} if kind in JSON_TYPES else {}
         why = next(iter(f.metadata.values()), None)  # swarm.core.params.declared: its provenance
         if why is not None and (text := getattr(why, "reason", "") or getattr(why, "where", "")):
-            props[f.name] = {**props[f.name], "description": f"{text} (default {default!r})"}
+            props[f.name]["description"] = f"{text} (default {default!r})"
     return table(props)
 
 

@@ -264,20 +264,12 @@ def revisits_recalled(run: dict, zones: list, least: int = 3) -> tuple[int, int]
     place = np.array([place_of(p, zones) for p in run["truth"][:, :2]], np.int64)
     rooms = np.array([name.startswith("room") for name, _ in zones], np.bool_)
     first = first_use(nodes)
-    seen, revisits, recalled, i = set(), 0, 0, 0
-    while i < len(place):
-        j = i
-        while j < len(place) and place[j] == place[i]:
-            j += 1
-        if j - i >= least and rooms[place[i]]:
-            if place[i] in seen:
-                revisits += 1
-                before = set(nodes[:i][place[:i] == place[i]].tolist())
-                right = [first[k] < i and int(nodes[k]) in before for k in range(i, j)]
-                recalled += int(np.mean(right) >= 0.5)
-            seen.add(int(place[i]))
-        i = j
-    return revisits, recalled
+    recalled = 0
+    spans = revisit_spans(place, rooms, least)
+    for i, j in spans:
+        before = set(nodes[:i][place[:i] == place[i]].tolist())
+        recalled += int(np.mean([first[k] < i and int(nodes[k]) in before for k in range(i, j)]) >= 0.5)
+    return len(spans), recalled
 
 
 def first_use(believed: np.ndarray) -> np.ndarray:
@@ -290,18 +282,24 @@ def room_revisits(place: np.ndarray, first: np.ndarray, rooms: np.ndarray, least
     """Loops closed where the paper counts them, in rooms: (visits to a room seen on an earlier visit,
     those whose fingerprints mostly joined nodes made before the visit began; `first`: first_use).
     A visit is a run of at least `least` fingerprints in one place."""
-    seen, revisits, closed, i = set(), 0, 0, 0
+    spans = revisit_spans(place, rooms, least)
+    return len(spans), sum(int(np.mean(first[i:j] < i) >= 0.5) for i, j in spans)
+
+
+def revisit_spans(place: np.ndarray, rooms: np.ndarray, least: int) -> list[tuple[int, int]]:
+    """[i, j) of every visit to a room seen on an earlier visit, a visit being a run of at least `least`
+    fingerprints in one place."""
+    seen, spans, i = set(), [], 0
     while i < len(place):
         j = i
         while j < len(place) and place[j] == place[i]:
             j += 1
         if j - i >= least and rooms[place[i]]:
             if place[i] in seen:
-                revisits += 1
-                closed += int(np.mean(first[i:j] < i) >= 0.5)
+                spans.append((i, j))
             seen.add(int(place[i]))
         i = j
-    return revisits, closed
+    return spans
 
 
 def ground_seen_again(xy: np.ndarray, first: np.ndarray, place: np.ndarray, where: np.ndarray, near: float = 0.3,
