@@ -114,7 +114,7 @@ def search_dir(pi, pf, mem, params, seed, agent, tick):
     return d
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def ant_step(pi, pf, mem, act, params, seed, agent, tick):
     reset_action(act)
     read_load_outcome(pi, mem)

@@ -200,7 +200,7 @@ def search_step(pi, mem, act, params, seed, agent, tick):
     mem[M_PREV] = opposite(d) if d < N_DIRS else -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def cmarking_step(pi, pf, mem, act, params, seed, agent, tick):
     reset_action(act)
     act[A_MARK] = update_value(pi)

@@ -10,7 +10,7 @@ from world_server.grid.face.layout import A_MARK, A_MOVE, M_MODE, M_PREV, RETURN
 from world_server.grid.face.marks import update_value
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def marking_step(pi, pf, mem, act, params, seed, agent, tick):
     reset_action(act)
     act[A_MARK] = update_value(pi)
