@@ -19,6 +19,8 @@ from swarm.recording.grid import Recorder, run_meta
 from swarm.scenario import load_scenario
 from world_server.server import new_run_id
 
+QUICK_TICKS = 150  # a quick distributed run: enough ticks to time, few enough to take seconds
+
 
 def _recorder(engine: Engine, path: Path, runtime: str = "in-process") -> Recorder:
     return Recorder(path, engine.world, run_meta(engine.scenario, engine.world, path.stem, "foraged", runtime))
@@ -85,7 +87,7 @@ def _close_floor(agents: int, seeds: range, tmp: Path) -> float:
     return round(total * 1000 / len(seeds), 1)
 
 
-def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int) -> dict:
+def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int, max_ticks: int) -> dict:
     """`pairs` runs each way, alternated (plain, recorded, plain, ...), same seed:
     the median ticks/s of each, since one lock-step run over zenoh moves by a
     few percent on its own."""
@@ -96,7 +98,8 @@ def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int
             run_id = f"benchrec{new_run_id()}"
             path = tmp / f"{run_id}.rrd"
             s = swarm_up("setup1", agents, "cmarking", 1, run_id, f"tcp/127.0.0.1:{port + record}", deadline=10.0,
-                         progress=False, per_process=per_process, record=str(path) if record else None)  # fmt: skip
+                         max_iterations=max_ticks, progress=False, per_process=per_process,
+                         record=str(path) if record else None)  # fmt: skip
             rates[record].append(s["ticks_per_second"])
             if record:
                 size, ticks = path.stat().st_size, s["iterations"]
@@ -108,18 +111,22 @@ def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int
 
 
 def bench_recording(quick: bool = False, port: int = 7650) -> dict:
-    seeds = range(1, 3 if quick else 6)
+    """`quick` checks every part in seconds rather than measuring: one seed in process, and
+    distributed runs of few agent processes that stop at QUICK_TICKS."""
+    seeds = range(1, 2 if quick else 6)
+    pairs, max_ticks = (1, QUICK_TICKS) if quick else (3, 1_000_000)
     with tempfile.TemporaryDirectory(prefix="swarm-bench-rec-") as tmp:
         _warm_up(Path(tmp))
         rows = [_in_process(n, seeds, Path(tmp)) for n in (20, 160)]
-        pairs = 1 if quick else 3
-        rows += [_distributed(20, 1, Path(tmp), port, pairs), _distributed(160, 10, Path(tmp), port + 2, pairs)]
-    return {"benchmark": "recording", "scenario": "setup1", "runs": rows}
+        for i, (agents, per_process) in enumerate(((20, 10), (160, 40)) if quick else ((20, 1), (160, 10))):
+            rows.append(_distributed(agents, per_process, Path(tmp), port + 2 * i, pairs, max_ticks))
+    return {"benchmark": "recording", "scenario": "setup1", "quick": quick, "runs": rows}
 
 
 def format_recording_bench(result: dict) -> str:
     header = f"{'runtime':>12}{'agents':>7}{'ticks/s':>10}{'recorded':>10}{'cost':>7}{'B/tick':>8}{'MB/run':>8}"
-    lines = ["Recording cost, setup1 to completion (cost = share of ticks/s lost to recording)", "", header]
+    extent = f"--quick: distributed runs stop at {QUICK_TICKS} ticks" if result.get("quick") else "to completion"
+    lines = [f"Recording cost, setup1 {extent} (cost = share of ticks/s lost to recording)", "", header]
     for r in result["runs"]:
         lines.append(f"{r['runtime']:>12}{r['agents']:>7}{r['ticks_per_second']:>10}"
                      f"{r['recorded_ticks_per_second']:>10}{r['cost']:>7.0%}{r['bytes_per_tick']:>8}"
