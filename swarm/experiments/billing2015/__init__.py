@@ -7,6 +7,7 @@ _MAZE = Option("--scenario", "zmaze or large-maze (default both)")
 _NOISE = Option("--noise", "only the conditions at this noise level", choices=("none", "low", "high"))
 _STEPS = Option("--max-steps", "run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)",
                 dest="max_ticks", type="swarm.core.tables:positive", metavar="T")  # fmt: skip
+_FIGURES_MAZE = Option("--scenario", "none: the figures are drawn in the paper's zmaze and large-maze")
 _DFT = "swarm.experiments.billing2015.dft:run_dft_experiment"
 _WRITES = "runs.csv, summary.csv, table.md, plot.png"
 EXPERIMENTS = (
@@ -21,6 +22,12 @@ EXPERIMENTS = (
                    options=(_MAZE, _NOISE, _STEPS), writes=f"{_WRITES}, paths.png, paths.npz"),
     ExperimentSpec("dft-together", "billing2015", "a scout shares the obstacle it meets over the context key space",
                    _DFT, options=(_MAZE, _NOISE, _STEPS)),
+    ExperimentSpec("dft-figures", "billing2015", "the paper's figures from dft runs: motivation fields, activity at "
+                   "four places, planning time against path length, a replanning velocity profile, case-2 paths",
+                   "swarm.experiments.billing2015.figures:run_dft_figures", options=(_FIGURES_MAZE, _STEPS),
+                   writes="runs.csv, planning.csv, summary.csv, table.md, motivation.png, activity.png, "
+                          "planning.png, velocity.png, paths.png",
+                   smoke=(("reps", 2), ("max_ticks", 150))),
 )  # fmt: skip
 PAPER = PaperSpec(
     "billing2015",
