@@ -20,6 +20,11 @@ EXPERIMENTS = (
                    "swarm.experiments.tapus2006.team:run_team_experiment", options=(_TEAM_FLOOR,),
                    writes="runs.csv, table.md, plot.png",
                    smoke=(("reps", 1), ("teams", (1, 2)))),
+    ExperimentSpec("fingerprint-robustness", "tapus2006", "localization under camera noise, biased odometry and "
+                   "compass, a kidnapping, and against delta-d and theta",
+                   "swarm.experiments.tapus2006.robustness:run_robustness_experiment", options=(_FLOOR,),
+                   writes="runs.csv, summary.csv, table.md, plot.png",
+                   smoke=(("reps", 1), ("waypoints", 8), ("conditions", ("camera", "kidnap")))),
 )  # fmt: skip
 PAPER = PaperSpec(
     "tapus2006",

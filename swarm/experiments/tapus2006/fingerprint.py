@@ -34,6 +34,7 @@ mapping fingerprint (off the mapped floor) are left out of the shares
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -115,29 +116,47 @@ def link_topology(run: dict, zones: list, graph: set[frozenset[int]]) -> dict[st
     return {"links_same_place": same, "links_adjacent": adjacent, "links_not_adjacent": apart}
 
 
-def tour_scenario(name: str, route: str, noise: str, seed: int, table: dict | None = None):
+def tour_scenario(name: str, route: str, noise: str, seed: int, table: dict | None = None,
+                  sensors: dict[str, dict] | None = None, routes: dict | None = None):  # fmt: skip
+    """Floor `name` with one fingerprint robot driving `route`: `table` over its [fingerprint] table,
+    `sensors` over its sensors' tables ({"camera": {"noise": 10.0}}, as a scenario's [robot.<name>]
+    tables), `routes` over the floor's routes."""
     from swarm.scenario import load_scenario
 
     s = load_scenario(name)
     if getattr(s, "kind", "grid") != "arena":  # a grid scenario has no kind field
         raise ScenarioError(name, "kind", "the fingerprint experiments map an arena floor")
+    s = replace(s, routes={**s.routes, **(routes or {})})
     if route not in s.routes:
         raise ScenarioError(name, "routes", f"no route {route!r}; the fingerprint experiments need "
                             "'mapping', 'localize' and 'localize-off-map' routes")  # fmt: skip
-    first = s.routes[route][0]
-    nxt = s.routes[route][1] if len(s.routes[route]) > 1 else (first[0] + 1, first[1])
-    heading = math.atan2(nxt[1] - first[1], nxt[0] - first[0])
-    g = replace(s.groups[0], count=1, controller="fingerprint", route=route, starts=((*first, heading),),
-                goals=None, draw_goals=False)  # fmt: skip
+    robot = s.groups[0].robot
+    for sensor, changes in (sensors or {}).items():
+        spec = getattr(robot.sensors, sensor)
+        if spec is None:
+            raise ScenarioError(name, f"robot.{sensor}", f"the robot {robot.name!r} has no {sensor}")
+        robot = replace(robot, sensors=robot.sensors.changed(**{sensor: type(spec).from_table(changes, spec)}))
+    g = replace(s.groups[0], count=1, controller="fingerprint", robot=robot, goals=None, draw_goals=False)
     tables = dict(s.controller_params)
     tables["fingerprint"] = {**tables.get("fingerprint", {}), **(table or {})}
     s = replace(s, groups=(g,), controller_params=tables)
-    return s.with_overrides(noise=noise, seed=seed)
+    return along(s, route).with_overrides(noise=noise, seed=seed)
 
 
-def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000) -> dict[str, Any]:
+def along(s, route: str):
+    """Scenario `s` with its one robot driving `route` from its first waypoint, facing the second."""
+    first = s.routes[route][0]
+    nxt = s.routes[route][1] if len(s.routes[route]) > 1 else (first[0] + 1, first[1])
+    heading = math.atan2(nxt[1] - first[1], nxt[0] - first[0])
+    return replace(s, groups=(replace(s.groups[0], route=route, starts=((*first, heading),)),))
+
+
+def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000, resume: dict | None = None) -> dict[str, Any]:
     """Run one fingerprint robot along its route; per fingerprint the true pose,
-    the node it joined or believed, the node matched best, and the likelihoods."""
+    the node it joined or believed, the node matched best, and the likelihoods.
+    With `resume` (a localizing controller's snapshot, the result's "controller"),
+    the robot goes on with that controller's map, belief and odometric position
+    wherever the route starts: its odometry does not know it was moved."""
     from swarm.engines.arena import ArenaEngine
     from world_server.arena.scenario import controller_params
 
@@ -148,6 +167,8 @@ def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000) -> dict[
         params["fingerprint"] = {**params.get("fingerprint", {}), "mode": "localize"}
         params["topomap"] = topomap
         c.reset(s.seed, 0, params)
+        if resume is not None:  # its own driver along its own route, a log of this tour only
+            c.restore({**resume, "driver": c.snapshot()["driver"], "log": []})
     truth, likelihoods, prints = [], [], []
     while not c.finished and engine.tick < max_ticks:
         before = engine.world.pose[0].copy()
@@ -165,7 +186,7 @@ def drive_tour(s, topomap: dict | None = None, max_ticks: int = 40_000) -> dict[
             "joined": log[:, 1], "nodes_after": log[:, 3],
             "map": c.map_data(),
             "closures": c.map.closures, "fingerprints": prints, "finished": c.finished,
-            "wall_seconds": engine.wall_seconds}  # fmt: skip
+            "wall_seconds": engine.wall_seconds, "controller": c}  # fmt: skip
 
 
 def node_places(run: dict, zones: list) -> np.ndarray:
@@ -345,13 +366,21 @@ def right_nodes(mapped: dict, xy: np.ndarray, aliased: dict[int, int] | None = N
     return right
 
 
-def localize_run(name: str, noise: str, seed: int, route: str) -> tuple[dict, dict]:
+def localize_run(name: str, noise: str, seed: int, route: str, table: dict | None = None,
+                 sensors: dict[str, dict] | None = None, routes: dict | None = None,
+                 second: Callable[..., dict] | None = None, per_print: bool = False) -> tuple[dict, dict]:  # fmt: skip
     """The map of the mapping tour (odometry and sensor noise drawn from `seed`), then the `route` tour
-    localizing on it (drawn from seed + 1000): (the mapping run, localization_counts)."""
-    s = tour_scenario(name, "mapping", noise, seed)
+    localizing on it (drawn from seed + 1000): (the mapping run, localization_counts).  `table`,
+    `sensors` and `routes` change both tours (tour_scenario); `second(scenario, topomap)` drives the
+    second tour (default drive_tour); with `per_print` the counts keep their per-fingerprint `right`."""
+    s = tour_scenario(name, "mapping", noise, seed, table, sensors, routes)
     mapped = drive_tour(s)
-    loc = drive_tour(tour_scenario(name, route, noise, seed + 1000), topomap=mapped["map"])
-    return mapped, {**localization_counts(mapped, loc, places(s)), "ticks": loc["ticks"],
+    tour = tour_scenario(name, route, noise, seed + 1000, table, sensors, routes)
+    loc = (second or drive_tour)(tour, mapped["map"])
+    counts = localization_counts(mapped, loc, places(s))
+    if not per_print:
+        del counts["right"]
+    return mapped, {**counts, "ticks": loc["ticks"],
                     "finished": loc["finished"],
                     "wall_seconds": round(mapped["wall_seconds"] + loc["wall_seconds"], 2)}  # fmt: skip
 
@@ -361,12 +390,15 @@ def localization_counts(mapped: dict, loc: dict, zones: list) -> dict:
     alone, the grid filter and the links-only filter put at a right node (right_nodes: an aliased node
     counts right only at its own place), the same by the loose rule (`*_right_loose`: an aliased node
     right at both ends), the mean chance of a node drawn at random being right, and where the right node
-    ranked among the matches when matching missed."""
+    ranked among the matches when matching missed; `right`, per fingerprint of the second tour, whether
+    matching alone, the grid filter and the links-only filter were right (1) or not (0), -1 off the map."""
     k = mapped["size"]
     aliased = aliased_nodes(mapped, zones)
     by_match, by_markov, by_links, loose, ranks, chance, off = [], [], [], [], [], [], 0
-    for xy, matched, believed, linked, like in zip(loc["truth"][:, :2], loc["matched"], loc["believed"],
-                                                   loc["believed_links"], loc["likelihoods"], strict=True):  # fmt: skip
+    track = np.full((len(loc["matched"]), 3), -1, np.int8)
+    for i, (xy, matched, believed, linked, like) in enumerate(zip(loc["truth"][:, :2], loc["matched"],
+                                                                  loc["believed"], loc["believed_links"],
+                                                                  loc["likelihoods"], strict=True)):  # fmt: skip
         right = right_nodes(mapped, xy, aliased, zones)
         if right is None:
             off += 1
@@ -376,6 +408,7 @@ def localization_counts(mapped: dict, loc: dict, zones: list) -> dict:
         by_match.append(int(matched) in right)
         by_markov.append(int(believed) in right)
         by_links.append(int(linked) in right)
+        track[i] = by_match[-1], by_markov[-1], by_links[-1]
         chance.append(len(right) / k)
         if not by_match[-1] and right:  # where the right node comes among the matches
             order = np.argsort(-like, kind="stable")
@@ -388,7 +421,7 @@ def localization_counts(mapped: dict, loc: dict, zones: list) -> dict:
             "markov_right_loose": int(loose_sums[1]), "links_right_loose": int(loose_sums[2]),
             "chance": round(float(np.mean(chance)), 4),
             "missed_rank2": int((ranks == 2).sum()), "missed_rank3": int((ranks == 3).sum()),
-            "missed_rank_over3": int((ranks > 3).sum())}  # fmt: skip
+            "missed_rank_over3": int((ranks > 3).sum()), "right": track}  # fmt: skip
 
 
 def localize_job(job: tuple) -> dict:

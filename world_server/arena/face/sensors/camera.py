@@ -9,6 +9,8 @@ import numpy as np
 
 from world_server.arena.face.sensors.base import Rays, Reading, Sensor
 
+COLOUR, RANGE = 10, 11  # noise streams: each sector's colour error, its range error
+
 
 def grey(rgb: np.ndarray) -> np.ndarray:
     """Luminance (ITU-R 601) of uint8 colours, as uint8."""
@@ -19,14 +21,21 @@ def grey(rgb: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class Camera(Sensor):
     """Panoramic linear camera: per sector the colour, grey level and distance
-    of the nearest wall or robot among `rays_per_sector` rays spread over it."""
+    of the nearest wall or robot among `rays_per_sector` rays spread over it,
+    each colour channel off by a normal error of std `noise` (colour levels,
+    0-255, rounded and clipped) and each distance by one of std `range_noise`
+    (metres), both drawn afresh every tick and sector.  Both are 0 unless a
+    scenario sets them: the camera then reads exactly what its rays hit."""
 
     name = "camera"
     rank = 0
+    streams = (COLOUR, RANGE)
 
     sectors: int = 36
     rays_per_sector: int = 5
     range: float = 30.0
+    noise: float = 0.0  # std of each colour channel, levels
+    range_noise: float = 0.0  # std of each sector's distance, metres
 
     def rays(self, model) -> Rays:
         width = 2 * math.pi / self.sectors
@@ -40,8 +49,14 @@ class Camera(Sensor):
         ranges = r.ranges.reshape(n, *k)
         near = np.argmin(ranges, axis=2)
         pick = (np.arange(n)[:, None], np.arange(self.sectors)[None, :], near)
-        rgb = r.rgb.reshape(n, *k, 3)[pick]
-        return {"camera_range": ranges[pick], "camera_rgb": rgb, "camera_grey": grey(rgb),
+        rgb, seen = r.rgb.reshape(n, *k, 3)[pick], ranges[pick]
+        factor = r.noise.factor(self.name)
+        if self.noise and factor:
+            noisy = rgb + r.normal(COLOUR, self.sectors * 3).reshape(n, self.sectors, 3) * self.noise * factor
+            rgb = np.clip(np.rint(noisy), 0, 255).astype(np.uint8)
+        if self.range_noise and factor:
+            seen = np.clip(seen + r.normal(RANGE, self.sectors) * self.range_noise * factor, 0.0, self.range)
+        return {"camera_range": seen, "camera_rgb": rgb, "camera_grey": grey(rgb),
                 "camera_what": r.what.reshape(n, *k)[pick]}  # fmt: skip
 
     def readings(self) -> dict[str, tuple[tuple[int, ...], str]]:
