@@ -364,6 +364,16 @@ def run_dft_figures(name: str, reps: int | None, jobs: int | None, seed: int, ou
     plot_paths(paths, f"development seeds {seed + 1}-{seed + min(reps, CASE2_PAIRS)} (seed + pair)",
                out / "paths.png")  # fmt: skip
 
+    summary, md = _report(planning, ok, replan, paths, rho, p, seed, reps, max_ticks)
+    result = out.finish(summary, md)
+    result["runs"] = len(rows)
+    return result
+
+
+def _report(planning: list[dict], ok: list[dict], replan: dict, paths: list[dict], rho: float, p: float,
+            seed: int, reps: int, max_ticks: int | None) -> tuple[list[dict], str]:  # fmt: skip
+    """summary.csv's rows and table.md's text."""
+    first, last = seed + 1, seed + reps
     ticks = np.array([r["planning_ticks"] for r in ok], float)
     summary = [{"figure": "planning", "pairs": len(planning), "planned": len(ok),
                 "planning_ticks_median": float(np.median(ticks)) if len(ok) else None,
@@ -385,6 +395,4 @@ def run_dft_figures(name: str, reps: int | None, jobs: int | None, seed: int, ou
           f"{REPLAN_DURATION} steps; planning complete at t = {replan['planning_ticks']}; route {replan['route']}; "
           f"reached: {replan['reached']} (tick {replan['ticks_to_goal']}).\n\n"
           f"## Case 2 (paths.png)\n\n{summary[2]['reached']} of {len(paths)} runs reached their goal.\n")  # fmt: skip
-    result = out.finish(summary, md)
-    result["runs"] = len(rows)
-    return result
+    return summary, md
