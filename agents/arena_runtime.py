@@ -41,7 +41,8 @@ class ArenaAgentRuntime(AgentRuntime):
         heap.give_back()  # what building the controller used and freed (a DFT robot's kernels: ~5 MB)
         if isinstance(blob, bytes) and agent not in self.guard.failed:
             memory, blob = _decoded(brain, blob), None  # the blob goes before the rollback state comes
-            self.refused_memory += not restore_or_keep(brain, memory)
+            if not self.guard.resumed_failed(memory, agent, self.names[slot]):
+                self.refused_memory += not restore_or_keep(brain, memory)
             memory = None
             heap.give_back()
 
@@ -51,9 +52,10 @@ class ArenaAgentRuntime(AgentRuntime):
         handed = msg.memory
         while handed:
             agent, blob = handed.pop()
-            if (slot := self.slot_of.get(agent)) is not None:
+            if (slot := self.slot_of.get(agent)) is not None and agent not in self.guard.failed:
                 memory, blob = _decoded(self.brains[slot], blob), None
-                self.refused_memory += not restore_or_keep(self.brains[slot], memory)
+                if not self.guard.resumed_failed(memory, agent, self.names[slot]):
+                    self.refused_memory += not restore_or_keep(self.brains[slot], memory)
                 memory = None
         heap.give_back()
 
@@ -79,7 +81,7 @@ class ArenaAgentRuntime(AgentRuntime):
             heap.give_back()  # of it are freed by now: all of it back to the system, not kept in the heap
         self.kept = keep = obs.keep and not self.null
         # the memory's arrays are written once, straight into the message (the save-tick peak)
-        memory = [(a, memory_codec.pieces(b.snapshot())) for b, a in zip(brains, ids, strict=True)] if keep else []
+        memory = [(a, memory_codec.pieces(self.guard.memory(b, a))) for b, a in mine] if keep else []
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory, rab)
         self.act_publisher.put(payload)
         if not self.null:

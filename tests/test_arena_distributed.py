@@ -216,20 +216,23 @@ def test_swarm_status_answers_for_an_arena_world():
         world.close()
 
 
-RESUMES = [  # scenario, agents, seed, max ticks, the saved tick to kill after, kill the agents too
-    ("large-maze", 3, 4, 3000, 100, False),
-    ("large-maze", 3, 4, 3000, 300, True),
-    ("bg-colony", 4, 0, 700, 250, False),  # animats that share their maps: publications in flight at the save
+RESUMES = [  # scenario, agents, seed, max ticks, the saved tick to kill after, kill the agents too, controller
+    ("large-maze", 3, 4, 3000, 100, False, None),
+    ("large-maze", 3, 4, 3000, 300, True, None),
+    ("bg-colony", 4, 0, 700, 250, False, None),  # animats that share their maps: publications in flight at the save
+    ("zmaze", 3, 0, 300, 100, True, "circlers:FailsAtTick"),  # robot 1's controller raised at tick 4: it stays out
 ]
 
 
-@pytest.mark.parametrize(("ref", "agents", "seed", "max_ticks", "kill_at", "agents_too"), RESUMES)
+@pytest.mark.parametrize(("ref", "agents", "seed", "max_ticks", "kill_at", "agents_too", "own"), RESUMES)
 def test_kill_9_the_arena_world_then_a_restart_ends_exactly_as_swarm_run(ref, agents, seed, max_ticks, kill_at,
-                                                                        agents_too, tmp_path):  # fmt: skip
+                                                                        agents_too, own, tmp_path,
+                                                                        monkeypatch):  # fmt: skip
     """kill -9 of the world (and of every agent process, whose places newcomers
     take over) a few ticks after a save; the restarted world resumes from disk
     and the run ends with the in-process run's poses, paths, collisions,
-    publications and metabolism, robot for robot."""
+    publications and metabolism, robot for robot.  A controller that failed
+    before the save stays failed after it (`own`: a user's, from tests/outside)."""
     import json
     import os
     import re
@@ -237,6 +240,7 @@ def test_kill_9_the_arena_world_then_a_restart_ends_exactly_as_swarm_run(ref, ag
     import subprocess
     import sys
     import time
+    from pathlib import Path
 
     from swarm.scenario import BUNDLED_DIR
     from world_server import persist
@@ -245,7 +249,11 @@ def test_kill_9_the_arena_world_then_a_restart_ends_exactly_as_swarm_run(ref, ag
     text = (BUNDLED_DIR / f"{ref}.toml").read_text()
     (scenario_file := tmp_path / f"{ref}.toml").write_text(re.sub(r"(?m)^max_ticks = .*$", f"max_ticks = {max_ticks}",
                                                                   text))  # fmt: skip
-    scenario = load_scenario(str(scenario_file)).with_overrides(agents=agents, seed=seed)
+    if own:
+        outside = str(Path(__file__).parent / "outside")
+        monkeypatch.syspath_prepend(outside)
+        monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [outside, os.environ.get("PYTHONPATH")])))
+    scenario = load_scenario(str(scenario_file)).with_overrides(agents=agents, seed=seed, controller=own)
     engine = ArenaEngine(scenario)
     expected = engine.run()
     controller = scenario.groups[0].controller
@@ -254,7 +262,8 @@ def test_kill_9_the_arena_world_then_a_restart_ends_exactly_as_swarm_run(ref, ag
     summary_file = tmp_path / "summary.json"
     world_cmd = [sys.executable, "-m", "swarm", "world", str(scenario_file), "--agents", str(agents), "--seed",
                  str(seed), "--run-id", "aresume", "--listen", endpoint, "--state-dir", str(tmp_path),
-                 "--persist-every", "50", "--deadline", "10", "--summary-file", str(summary_file)]  # fmt: skip
+                 "--persist-every", "50", "--deadline", "10", "--summary-file", str(summary_file),
+                 *(["--controller", own] if own else [])]  # fmt: skip
     world = subprocess.Popen(world_cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     agent_procs = start_agents(endpoint, "aresume", controller, agents)
     procs = [world, *agent_procs]
@@ -277,7 +286,8 @@ def test_kill_9_the_arena_world_then_a_restart_ends_exactly_as_swarm_run(ref, ag
         assert int(before["tick"]) % 50 == 0 and (before["memory_at"][:, 1] > 0).all()  # every controller's memory
         world = subprocess.Popen(world_cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         procs.append(world)
-        assert world.wait(timeout=300) == 0, world.stderr.read().decode()[-3000:]
+        stopped = 1 if own else 0  # circlers reach no goal: the run stops at its last tick, exit 1
+        assert world.wait(timeout=300) == stopped, world.stderr.read().decode()[-3000:]
         summary = json.loads(summary_file.read_text())
         assert summary["ticks"] == expected["ticks"]
         for got, want in zip(summary["robots"], expected["robots"], strict=True):  # the world's view of each robot

@@ -63,6 +63,9 @@ class ControllerFailed(RunError):
     """A controller raised (or answered NaN or the wrong shape) and the run was told to stop on it."""
 
 
+FAILED = "swarm_controller_failed"  # the only key of a saved memory whose controller had failed
+
+
 class StepGuard:
     """Steps controllers as both runtimes must, so that a user's controller that raises, answers NaN
     or the wrong shape is one line naming it, not a traceback that ends every robot's run.
@@ -107,6 +110,20 @@ class StepGuard:
             self._fault(f"controller {name!r} of robot {agent} answered {what} at tick {tick}",
                         "the world refuses such answers and counts them (rejected actions)")  # fmt: skip
         return action
+
+    def memory(self, controller, agent: int):
+        """What a save keeps of a robot's controller: its snapshot, or, once it has failed, why, so that a
+        resumed run keeps it out as the uninterrupted run does."""
+        return {FAILED: self.failed[agent]} if agent in self.failed else controller.snapshot()
+
+    def resumed_failed(self, memory, agent: int, name: str) -> bool:
+        """Whether a saved `memory` says the robot's controller had failed: then it stays out (told once)."""
+        if not (isinstance(memory, dict) and set(memory) == {FAILED}):
+            return False
+        self.failed[agent] = str(memory[FAILED])
+        print(f"swarm: controller {name!r} of robot {agent} had raised {self.failed[agent]} before the run was saved;"
+              f" the robot holds still for the rest of the run", file=sys.stderr, flush=True)  # fmt: skip
+        return True
 
     def working(self, pairs) -> tuple[list, list]:
         """The (controller, agent) pairs still in the run, as (controllers, agents): only they publish,
