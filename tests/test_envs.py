@@ -152,3 +152,59 @@ def test_observations_are_the_worlds_readings():
         for key, value in readings[a].items():
             np.testing.assert_array_equal(obs[name][key], value)
     assert env.render().shape == (400, 400, 3)
+
+
+ANIMAT_AT_FOOD = """[metabolism]
+[[resource]]
+name = "food"
+kind = "ingesting"
+centre = [0.6, 0.5]
+[[group]]
+count = 1
+controller = "bg"
+robot = "animat"
+start = [1.2, 0.5, 0.0]
+"""
+
+TALKERS = """[[group]]
+count = 2
+controller = "wander"
+starts = [[0.4, 0.5, 0.0], [0.6, 0.5, 3.14159]]
+robot = { model = "epuck", sensors = ["range_and_bearing"] }
+"""
+
+
+def test_a_learner_chooses_the_metabolisms_act():
+    from swarm.envs.spaces import ACTS
+
+    env = parallel_env(parse_arena_text(box(ANIMAT_AT_FOOD, w=3.0, h=2.0, robot="animat"), "food.toml"))
+    space = env.action_space("robot_0")
+    assert set(space.spaces) == {"wheels", "act"} and space["act"].n == len(ACTS)
+    env.reset(seed=0)
+    still = np.zeros(2, np.float32)
+    env.step({"robot_0": {"wheels": still, "act": 0}})
+    assert env.run.world.metabolism.acts[0].sum() == 0
+    for _ in range(3):
+        env.step({"robot_0": {"wheels": still, "act": ACTS.index("ReloadEp")}})  # in the food's zone: it eats
+    assert env.run.world.metabolism.acts[0, ACTS.index("ReloadEp")] == 3
+    with pytest.raises(ValueError, match=r"^robot_0: act must be a whole number from 0 to 2 .*got 7$"):
+        env.step({"robot_0": {"wheels": still, "act": 7}})
+    with pytest.raises(ValueError, match=r"^robot_0: its robot has no range_and_bearing sensor to broadcast with$"):
+        env.step({"robot_0": {"wheels": still, "broadcast": b"hi"}})
+    with pytest.raises(ValueError, match=r"^robot_0: unknown action keys \['speed'\]"):
+        env.step({"robot_0": {"wheels": still, "speed": 1}})
+
+
+def test_a_learner_broadcasts_and_its_neighbour_hears_it_next_tick():
+    from pettingzoo.test import parallel_api_test
+
+    env = parallel_env(parse_arena_text(box(TALKERS), "talk.toml"))
+    assert env.action_space("robot_0")["broadcast"].shape == (4,)
+    parallel_api_test(env, num_cycles=20)  # sampled dict actions, broadcasts included
+    env.reset(seed=0)
+    still = np.zeros(2, np.float32)
+    env.step({"robot_0": {"wheels": still, "broadcast": np.array([1, 2, 3, 4], np.uint8)}, "robot_1": still})
+    heard = env.step({"robot_0": still, "robot_1": still})[0]["robot_1"]
+    assert heard["rab_count"] == 1 and heard["rab_data"][0].tolist() == [1, 2, 3, 4]
+    with pytest.raises(ValueError, match=r"^robot_1: broadcast must be bytes or a 1-D array of 0-255"):
+        env.step({"robot_1": {"wheels": still, "broadcast": np.array([300, 1])}})

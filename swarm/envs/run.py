@@ -13,6 +13,7 @@ import numpy as np
 from gymnasium import spaces
 
 from swarm.engines.goals import ArenaGoals
+from world_server.arena.metabolism import ACTS
 from world_server.arena.scenario import ArenaScenario
 from world_server.arena.wheels import ACTION_WIDTH
 from world_server.arena.world import ArenaWorld
@@ -44,12 +45,16 @@ class ArenaRun:
         return out
 
     def set_actions(self, robots: list[int], actions: list, names: list[str]) -> None:
-        """These robots' wheel speeds for this tick (one array op for all of them).  NaN or inf is
-        refused (ValueError, one line naming the agent): a learner that answers it has diverged,
-        and holding the robot still would hide that; finite speeds beyond the model's limit are
-        clipped to it (a Box policy's samples may overshoot its bounds)."""
+        """These robots' actions for this tick: wheel speeds (one array op for all of them), or a dict
+        of the action space's `wheels`, `act` and `broadcast`.  NaN or inf is refused (ValueError, one
+        line naming the agent): a learner that answers it has diverged, and holding the robot still
+        would hide that; finite speeds beyond the model's limit are clipped to it (a Box policy's
+        samples may overshoot its bounds).  An act the world does not know, or a broadcast from a
+        robot without a range-and-bearing sensor, is refused likewise."""
         if not robots:
             return
+        parts = [self._parts(a, action, name) for a, action, name in zip(robots, actions, names, strict=True)]
+        actions = [wheels for wheels, _, _ in parts]
         try:
             wheels = np.asarray(actions, np.float64).reshape(len(robots), 2)
         except ValueError:
@@ -61,6 +66,36 @@ class ArenaRun:
             raise ValueError(f"{names[k]}: wheel speeds must be finite, got {wheels[k].tolist()}")
         limit = self.world.max_wheel[robots][:, None]
         self.actions[robots, :2] = np.clip(wheels, -limit, limit)
+        self.actions[robots, 2] = [act for _, act, _ in parts]
+        self.world.broadcast([(a, sent) for a, (_, _, sent) in zip(robots, parts, strict=True) if sent is not None])
+
+    def _parts(self, robot: int, action, name: str) -> tuple[object, int, bytes | None]:
+        """(wheels, act, broadcast bytes or None) of one robot's action."""
+        if not isinstance(action, Mapping):
+            return action, 0, None
+        if unknown := set(action) - {"wheels", "act", "broadcast"}:
+            raise ValueError(f"{name}: unknown action keys {sorted(unknown)}; expected wheels, act, broadcast")
+        if "wheels" not in action:
+            raise ValueError(f"{name}: an action dict needs its 'wheels'")
+        act, sent = action.get("act", 0), action.get("broadcast")
+        acts = len(ACTS) if self.world.metabolism is not None else 1
+        try:
+            whole = np.ndim(act) == 0 and float(act).is_integer()
+        except (TypeError, ValueError):  # not a number at all
+            whole = False
+        if not (whole and 0 <= int(act) < acts):
+            raise ValueError(f"{name}: act must be a whole number from 0 to {acts - 1} "
+                             f"({', '.join(ACTS[:acts])}), got {act!r}")  # fmt: skip
+        if sent is not None:
+            if self.world.rab_size[robot] == 0:
+                raise ValueError(f"{name}: its robot has no range_and_bearing sensor to broadcast with")
+            data = np.asarray(bytearray(sent) if isinstance(sent, bytes | bytearray) else sent)
+            bytes_like = data.ndim == 1 and data.dtype.kind in "ui"
+            if not (bytes_like and (data.size == 0 or 0 <= data.min() <= data.max() <= 255)):
+                raise ValueError(f"{name}: broadcast must be bytes or a 1-D array of 0-255, got {data.dtype} "
+                                 f"{data.shape}")  # fmt: skip
+            sent = data.astype(np.uint8).tobytes()
+        return action["wheels"], int(act), sent
 
     def advance(self) -> None:
         """One tick from the actions set (held robots' rows zeroed), goals tracked after it."""
@@ -78,13 +113,14 @@ class ArenaRun:
         return self.world.tick >= max_ticks or self.world.done()
 
 
-def agent_boxes(scenario: ArenaScenario) -> tuple[list[spaces.Dict], list[spaces.Box]]:
+def agent_boxes(scenario: ArenaScenario) -> tuple[list[spaces.Dict], list[spaces.Space]]:
     """Every robot's observation and action space, one pair per group shared by its robots."""
     from swarm.envs.spaces import action_space, observation_space
 
     obs, act = [], []
     for g in scenario.groups:
-        o, a = observation_space(g.robot, scenario.metabolism is not None), action_space(g.robot)
+        metabolism = scenario.metabolism is not None
+        o, a = observation_space(g.robot, metabolism), action_space(g.robot, metabolism)
         obs += [o] * g.count
         act += [a] * g.count
     return obs, act

@@ -1,5 +1,6 @@
 """The Gymnasium spaces of an arena robot, from its model: one Box per reading its sensors declare
-(`Sensor.readings()`: shape and dtype), bounded where the sensor bounds it, and its wheel speeds."""
+(`Sensor.readings()`: shape and dtype), bounded where the sensor bounds it, and its actions: wheel
+speeds, and the act and broadcast of a robot that has them."""
 
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ from gymnasium import spaces
 
 from world_server.arena.face.robots import RobotModel
 from world_server.arena.face.sensors.base import Sensor
+from world_server.arena.face.sensors.range_bearing import RangeAndBearing
 from world_server.arena.face.sensors.zones import ZONE_KINDS
+from world_server.arena.metabolism import ACTS
 
 
 def reading_bounds(sensor: Sensor, key: str, dtype: np.dtype) -> tuple[float, float]:
@@ -50,7 +53,17 @@ def observation_space(model: RobotModel, metabolism: bool = False) -> spaces.Dic
     return spaces.Dict(boxes)
 
 
-def action_space(model: RobotModel) -> spaces.Box:
-    """Left and right wheel speeds (m/s), each within the model's limit."""
+def action_space(model: RobotModel, metabolism: bool = False) -> spaces.Box | spaces.Dict:
+    """Left and right wheel speeds (m/s), each within the model's limit.  A robot that can do more
+    than drive gets a Dict of them under `wheels`, with `act` (the consummatory act it asks for,
+    world_server.arena.metabolism.ACTS) where the scenario has a metabolism, and `broadcast` (the
+    bytes its range-and-bearing sensor sends this tick) where it carries one."""
     w = float(model.max_wheel_speed)
-    return spaces.Box(-w, w, (2,), np.float32)
+    wheels = spaces.Box(-w, w, (2,), np.float32)
+    more: dict[str, spaces.Space] = {}
+    if metabolism:
+        more["act"] = spaces.Discrete(len(ACTS))
+    rab = next((s for s in model.sensors.specs if s.name == RangeAndBearing.name), None)
+    if rab is not None:
+        more["broadcast"] = spaces.Box(0, 255, (rab.payload,), np.uint8)
+    return spaces.Dict({"wheels": wheels, **more}) if more else wheels
