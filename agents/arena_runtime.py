@@ -11,11 +11,15 @@ resumed run goes on exactly as if nothing had happened.
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
+from agents.controllers import CONTROLLERS
 from agents.controllers.arena import StepGuard, broadcasts, deliver, make_controller, publications
 from agents.runtime import AgentRuntime
 from swarm.core import heap, kernels, memory_codec, wire
+from swarm.core.errors import one_line
 from world_server.arena.face import wire as arena_proto
 
 
@@ -31,11 +35,15 @@ class ArenaAgentRuntime(AgentRuntime):
         self.refused_shared = 0  # other robots' publications this process's controllers refused
         self.refused_memory = 0  # memories handed back that could not be decoded
         self.kept = False  # the last answer carried the controllers' memory
+        self.recorded: set[int] = set()  # agents whose record() goes to the world's recording
+        self.quiet: set[int] = set()  # agents whose record() failed or grew too big: told once, no longer sent
 
     def _welcomed(self, slot: int, agent: int, msg: dict) -> None:
         blob = msg.pop("memory", None)  # a missing agent's place, taken over where it was saved
         self.names[slot] = msg.get("controller", self.controller)
         brain = make_controller(self.names[slot])
+        if msg.get("recorded") and not CONTROLLERS[self.names[slot]].records:  # no log of its own: its record()
+            self.recorded.add(agent)
         self.guard.reset(brain, int(msg["seed"]), agent, msg["params"], self.names[slot])
         self.brains[slot] = brain
         heap.give_back()  # what building the controller used and freed (a DFT robot's kernels: ~5 MB)
@@ -83,10 +91,33 @@ class ArenaAgentRuntime(AgentRuntime):
         # the memory's arrays are written once, straight into the message (the save-tick peak)
         memory = [(a, memory_codec.pieces(self.guard.memory(b, a))) for b, a in mine] if keep else []
         payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory, rab)
+        if self.recorded and not self.null:  # before the action: the world has them when it ends the tick
+            self._send_records(obs.tick, brains, ids)
         self.act_publisher.put(payload)
         if not self.null:
             self._send_plans(obs.tick, agents)
         return len(agents)
+
+    def _send_records(self, tick: int, brains: list, ids: list[int]) -> None:
+        """The record() of each controller the world records by shape (swarm.recording.records)."""
+        for brain, agent in zip(brains, ids, strict=True):
+            if agent not in self.recorded or agent in self.quiet:
+                continue
+            try:
+                record = brain.record()
+                why = None if isinstance(record, dict) else f"it gave {str(record)[:80]!r}, not a dict"
+                values = {} if why else arena_proto.record_values(record, tick)
+                if not values and not why:
+                    continue  # nothing to show this tick
+                message = None if why else arena_proto.record_message(tick, agent, values)
+            except Exception as exc:  # whatever a user's controller raises
+                why, message = f"it raised {one_line(exc)}", None
+            if message is None:
+                self.quiet.add(agent)
+                why = why or f"it passed {arena_proto.MAX_RECORD_BYTES} bytes"
+                print(f"swarm: the recording leaves out robot {agent}'s record(): {why}", file=sys.stderr, flush=True)
+                continue
+            self.session.put(self.keys.record(self.group), message)
 
     def _send_plans(self, tick: int, agents: list[int]) -> None:
         """A controller's new plan goes to the world once, for the recording."""

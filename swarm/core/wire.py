@@ -9,6 +9,7 @@ Key expressions, all under one prefix per run, `swarm/<run>/`:
     marks/<group>     agent process -> world: their mark writes (merged by min);
                       `get swarm/<run>/marks/**` returns the marking environment
     plans/<group>     agent process -> world (arena): a path a controller planned, for the recording
+    records/<group>   agent process -> world (arena): a controller's record(), for the recording
     alive/<id>        liveliness token of an agent
     state             world -> anyone: per-tick summary
 
@@ -57,6 +58,7 @@ class Keys:
         self.acts = f"{self.prefix}/act/*"
         self.marks = f"{self.prefix}/marks/**"
         self.plans = f"{self.prefix}/plans/*"
+        self.records = f"{self.prefix}/records/*"
         self.alive_all = f"{self.prefix}/alive/*"
 
     def obs(self, group: str) -> str:
@@ -70,6 +72,9 @@ class Keys:
 
     def plan(self, group: str) -> str:
         return f"{self.prefix}/plans/{group}"
+
+    def record(self, group: str) -> str:
+        return f"{self.prefix}/records/{group}"
 
     def alive(self, agent: int) -> str:
         return f"{self.prefix}/alive/{agent}"

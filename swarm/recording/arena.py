@@ -17,7 +17,8 @@ Layout (timeline `tick`; the record at tick t shows the world after tick t):
     …/<agent>/…           what explains a controller's choices, by the logs its registry entry names
                           (ControllerSpec.records: its map, its fields, its channels; in process, and a
                           map from its publications when distributed): each log's module lists its paths;
-                          a controller whose entry names none: its record() by shape (swarm/recording/records.py)
+                          a controller whose entry names none: its record() by shape (swarm/recording/records.py;
+                          distributed, sent by its agent process on swarm/<run>/records/<group>)
     metrics/<name>        reached, collisions, distance, agents_alive, tick_ms, rejected_messages
                           (in-process: the actions the world refused)
     metrics/robots/<name> per robot, one scalar each: path_length, collisions, in_goal, finished (dwelt)
@@ -71,13 +72,12 @@ def arena_meta(scenario, world, goals: ArenaGoals, run_id: str, runtime: str) ->
             "optimal_lengths": [v if v is not None and math.isfinite(v) else None for v in goals.optimum]}  # fmt: skip
 
 
-def records_of(scenario, any_record: bool = True) -> list[tuple[str, ...]]:
-    """Each robot's logs ("module:Class"): those its controller's registry entry names, or (with
-    `any_record`: in process, where the recorder holds the controllers) the log that shows any
-    record() by its shape (swarm.recording.records) for one that names none."""
+def records_of(scenario) -> list[tuple[str, ...]]:
+    """Each robot's logs ("module:Class"): those its controller's registry entry names, or the log that
+    shows any record() by its shape (swarm.recording.records) for one that names none (in process from
+    the controller, distributed from what its agent process sends on records/<group>)."""
     specs = scenario.known_controllers
-    fallback = (RECORD_LOG,) if any_record else ()
-    return [(specs[g.controller].records if g.controller in specs else ()) or fallback
+    return [(specs[g.controller].records if g.controller in specs else ()) or (RECORD_LOG,)
             for g in scenario.groups for _ in range(g.count)]  # fmt: skip
 
 
@@ -115,7 +115,7 @@ class ArenaRecorder:
         sinks = [rr.FileSink(str(self.path))]
         if viewer:
             sinks.append(rr.GrpcSink(viewer))
-        self._records_of = records_of(world.scenario, any_record=controllers is not None)
+        self._records_of = records_of(world.scenario)
         self.rec.set_sinks(*sinks, default_blueprint=blueprint(rrb, world.scenario, self._records_of))
         self._meta_given = meta
         self.meta: dict = {}
@@ -312,6 +312,12 @@ class ArenaRecorder:
         record = self._published.update(agent, data)
         if record is not None:
             self._log(MapLog).capture(tick, agent, record, self.world.pose[agent, :2])
+
+    def log_record(self, tick: int, agent: int, values: dict) -> None:
+        """Distributed: a robot's record() as its agent process sent it (the record log of a controller
+        whose entry names no log of its own)."""
+        if 0 <= agent < self.world.n and self._records_of[agent] == (RECORD_LOG,):
+            self._log(resolve(RECORD_LOG)).capture(tick, agent, values)
 
     def log_plan(self, tick: int, agent: int, path: np.ndarray) -> None:
         """A controller's planned path, at the tick it was planned."""

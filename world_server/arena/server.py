@@ -93,10 +93,13 @@ class ArenaKind:
         persist.save_arrays(self.state_file, arrays, meta)
 
     def declare(self, put) -> list:
-        """Action messages, the plans agents send for the recording, and the controllers' shared key spaces."""
+        """Action messages, the plans and records agents send for the recording, and the controllers'
+        shared key spaces."""
         session, k = self.server.session, self.server.keys
         out = [session.declare_subscriber(k.acts, lambda s: put(("act", s))),
                session.declare_subscriber(k.plans, lambda s: put(("plan", s)))]  # fmt: skip
+        if self.server.recorder is not None:
+            out.append(session.declare_subscriber(k.records, lambda s: put(("record", s))))
         shares = {self.scenario.share_of(c) for c in set(self.controllers.tolist())} - {None}
         for share in sorted(shares):
             out.append(session.declare_queryable(f"{k.prefix}/{share}/**",
@@ -110,6 +113,8 @@ class ArenaKind:
             self._on_shared_query(*item)
         elif event == "plan":
             self._on_plan(item)
+        elif event == "record":
+            self._on_record(item)
 
     def _on_plan(self, sample) -> None:
         s = self.server
@@ -121,6 +126,17 @@ class ArenaKind:
             s.stats.reject("plan: names an agent of another process")
         elif s.recorder is not None:
             s.recorder.log_plan(plan.tick, plan.agent, plan.path)
+
+    def _on_record(self, sample) -> None:
+        s = self.server
+        received = s.receive(sample, arena_proto.parse_record, "record")
+        if received is None:
+            return
+        record, group = received
+        if not (0 <= record.agent < len(s.slots)) or s.group_of.get(record.agent) != group:
+            s.stats.reject("record: names an agent of another process")
+        elif s.recorder is not None:
+            s.recorder.log_record(record.tick, record.agent, record.values)
 
     # ------------------------------------------------------------------ joins
 
@@ -141,7 +157,8 @@ class ArenaKind:
             self.world.present[agent] = True
             self.memory[agent] = None
         welcome = {"family": self.family, "controller": str(self.controllers[agent]),
-                   "params": controller_params(self.scenario, agent)}  # fmt: skip
+                   "params": controller_params(self.scenario, agent),
+                   "recorded": self.server.recorder is not None}  # fmt: skip
         if self.memory[agent] is not None:
             welcome["memory"] = self.memory[agent]
         return welcome

@@ -17,6 +17,10 @@
                   newcomer's welcome, when a restarted world resumes the run
     plans/<group> agent process -> world: one agent's planned path (P x 2 float64, m), once
                   per new plan, at most MAX_PLAN_POINTS points (the recording's, not the controller's)
+    records/<group> agent process -> world, only while the world records: one agent's
+                  `record()` (swarm.core.memory_codec bytes of its numbers and numeric arrays;
+                  the arrays every ARRAYS_EVERY ticks, as the recording shows them), for a
+                  controller whose registry entry names no log of its own (a user's)
 
 Decoding never raises on bad input: it returns a `Rejected` reason.  Wheel
 speeds are not judged here: the world checks every agent's pair (finite,
@@ -31,6 +35,7 @@ from dataclasses import dataclass
 import msgpack
 import numpy as np
 
+from swarm.core import memory_codec
 from swarm.core.wire import (
     FAMILY_ARENA,
     HEADERS,
@@ -54,6 +59,8 @@ DTYPES = {"<f8": np.float64, "<i8": np.int64, "|u1": np.uint8, "|b1": np.bool_}
 ITEMSIZE = {kind: np.dtype(kind).itemsize for kind in DTYPES}
 MAX_SENSORS, MAX_DIMS = 32, 4
 MAX_PLAN_POINTS = 2000  # 32 KB: a plan message stays under the world's message limit
+MAX_RECORD_BYTES = 1024 * 1024  # one record() message: a user's numbers and a few small arrays
+ARRAYS_EVERY = 10  # ticks between the arrays of a record() sent (swarm.recording.records shows them as often)
 
 
 MAX_SHARED = 4 * 1024 * 1024  # bytes of shared payloads in one message
@@ -309,3 +316,62 @@ def parse_plan(data: bytes) -> Plan | Rejected:
     if not np.isfinite(path).all():
         return Rejected("path: not finite")
     return Plan(tick, agent, path)
+
+
+@dataclass(frozen=True)
+class Record:
+    tick: int
+    agent: int
+    values: dict  # key -> a float or a numeric array (swarm.recording.records shows each by its shape)
+
+
+def record_values(record: dict, tick: int) -> dict:
+    """What of a controller's record() travels: numbers every tick, numeric arrays of at most 2
+    dimensions every ARRAYS_EVERY ticks; text, None and the like stay home, and so does `path` (the
+    plan, sent on plans/<group> when it changes)."""
+    out: dict = {}
+    for key, value in record.items():
+        if key == "path":
+            continue
+        if isinstance(value, bool | int | float | np.number | np.bool_):
+            out[str(key)] = float(value)
+        elif tick % ARRAYS_EVERY == 0 and isinstance(value, np.ndarray | list | tuple):
+            try:
+                a = np.asarray(value, np.float64)
+            except (TypeError, ValueError):
+                continue
+            if a.ndim == 0:
+                out[str(key)] = float(a)
+            elif a.ndim <= 2 and a.size:
+                out[str(key)] = a
+    return out
+
+
+def record_message(tick: int, agent: int, values: dict) -> bytes | None:
+    """A record() message (values from `record_values`), or None when it would pass MAX_RECORD_BYTES."""
+    blob = memory_codec.encode(values)
+    if len(blob) > MAX_RECORD_BYTES - 256:
+        return None
+    return pack({"type": "record", "family": FAMILY_ARENA, "tick": int(tick), "agent": int(agent), "record": blob})
+
+
+def parse_record(data: bytes) -> Record | Rejected:
+    header = family_header(data, "record", FAMILY_ARENA, "a record", limit=MAX_RECORD_BYTES)
+    if isinstance(header, Rejected):
+        return header
+    m, tick = header
+    agent = int_field(m, "agent")
+    if isinstance(agent, Rejected):
+        return agent
+    if not isinstance(m.get("record"), bytes):
+        return Rejected("record: expected the bytes of a record")
+    values = memory_codec.decode(m["record"])
+    if isinstance(values, Rejected):
+        return values
+    if not isinstance(values, dict) or not all(isinstance(k, str) for k in values):
+        return Rejected("record: expected a map of names to numbers and arrays")
+    for key, value in values.items():
+        if not (isinstance(value, float) or (isinstance(value, np.ndarray) and value.dtype == np.float64
+                and 1 <= value.ndim <= 2)):  # fmt: skip
+            return Rejected(f"record: {key!r} is not a number or a numeric array of 1 or 2 dimensions")
+    return Record(tick, agent, values)
