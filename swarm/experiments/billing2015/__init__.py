@@ -8,6 +8,9 @@ _NOISE = Option("--noise", "only the conditions at this noise level", choices=("
 _STEPS = Option("--max-steps", "run length limit in steps of 64 ms (default 3000, the paper's; the code used 2000)",
                 dest="max_ticks", type="swarm.core.tables:positive", metavar="T")  # fmt: skip
 _FIGURES_MAZE = Option("--scenario", "none: the figures are drawn in the paper's zmaze and large-maze")
+_CASE2 = Option("--scenario", "large-maze, the default and the only one (the paper's case 2)")
+_PARAMETER = Option("--parameter", "only this parameter's levels (prox_gain, prox_width, c_prox, ir_width, map_noise)",
+                    metavar="NAME")  # fmt: skip
 _DFT = "swarm.experiments.billing2015.dft:run_dft_experiment"
 _WRITES = "runs.csv, summary.csv, table.md, plot.png"
 EXPERIMENTS = (
@@ -22,6 +25,10 @@ EXPERIMENTS = (
                    options=(_MAZE, _NOISE, _STEPS), writes=f"{_WRITES}, paths.png, paths.npz"),
     ExperimentSpec("dft-together", "billing2015", "a scout shares the obstacle it meets over the context key space",
                    _DFT, options=(_MAZE, _NOISE, _STEPS)),
+    ExperimentSpec("dft-sensitivity", "billing2015", "case 2's SPA success against the proximity and IR "
+                   "parameters and the map noise, one declared parameter at a time",
+                   "swarm.experiments.billing2015.sensitivity:run_sensitivity", options=(_CASE2, _PARAMETER, _STEPS),
+                   smoke=(("reps", 1), ("max_ticks", 60))),
     ExperimentSpec("dft-figures", "billing2015", "the paper's figures from dft runs: motivation fields, activity at "
                    "four places, planning time against path length, a replanning velocity profile, case-2 paths",
                    "swarm.experiments.billing2015.figures:run_dft_figures", options=(_FIGURES_MAZE, _STEPS),
