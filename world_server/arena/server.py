@@ -112,31 +112,23 @@ class ArenaKind:
         elif event == "shared?":
             self._on_shared_query(*item)
         elif event == "plan":
-            self._on_plan(item)
+            self._on_recorded(item, arena_proto.parse_plan, "plan", lambda r, m: r.log_plan(m.tick, m.agent, m.path))
         elif event == "record":
-            self._on_record(item)
+            self._on_recorded(item, arena_proto.parse_record, "record",
+                              lambda r, m: r.log_record(m.tick, m.agent, m.values))  # fmt: skip
 
-    def _on_plan(self, sample) -> None:
+    def _on_recorded(self, sample, parse, what: str, log) -> None:
+        """A plan or a record() an agent process sends for the recording, logged when it names one of the
+        process's own agents."""
         s = self.server
-        received = s.receive(sample, arena_proto.parse_plan, "plan")
+        received = s.receive(sample, parse, what)
         if received is None:
             return
-        plan, group = received
-        if not (0 <= plan.agent < len(s.slots)) or s.group_of.get(plan.agent) != group:
-            s.stats.reject("plan: names an agent of another process")
+        message, group = received
+        if not (0 <= message.agent < len(s.slots)) or s.group_of.get(message.agent) != group:
+            s.stats.reject(f"{what}: names an agent of another process")
         elif s.recorder is not None:
-            s.recorder.log_plan(plan.tick, plan.agent, plan.path)
-
-    def _on_record(self, sample) -> None:
-        s = self.server
-        received = s.receive(sample, arena_proto.parse_record, "record")
-        if received is None:
-            return
-        record, group = received
-        if not (0 <= record.agent < len(s.slots)) or s.group_of.get(record.agent) != group:
-            s.stats.reject("record: names an agent of another process")
-        elif s.recorder is not None:
-            s.recorder.log_record(record.tick, record.agent, record.values)
+            log(s.recorder, message)
 
     # ------------------------------------------------------------------ joins
 

@@ -39,6 +39,7 @@ from swarm.core import memory_codec
 from swarm.core.wire import (
     FAMILY_ARENA,
     HEADERS,
+    MAX_MESSAGE_BYTES,
     HandBack,
     Rejected,
     bin_header,
@@ -301,14 +302,21 @@ def plan_message(tick: int, agent: int, path: np.ndarray) -> bytes:
                  "path": path.astype("<f8").tobytes()})  # fmt: skip
 
 
-def parse_plan(data: bytes) -> Plan | Rejected:
-    header = family_header(data, "plan", FAMILY_ARENA, "a plan")
+def agent_header(data: bytes, kind: str, what: str, limit: int) -> tuple[dict, int, int] | Rejected:
+    """(message, tick, agent) of a message about one agent (a plan, a record), checked."""
+    header = family_header(data, kind, FAMILY_ARENA, what, limit)
     if isinstance(header, Rejected):
         return header
     m, tick = header
     agent = int_field(m, "agent")
-    if isinstance(agent, Rejected):
-        return agent
+    return agent if isinstance(agent, Rejected) else (m, tick, agent)
+
+
+def parse_plan(data: bytes) -> Plan | Rejected:
+    header = agent_header(data, "plan", "a plan", MAX_MESSAGE_BYTES)
+    if isinstance(header, Rejected):
+        return header
+    m, tick, agent = header
     raw = m.get("path")
     if not isinstance(raw, bytes) or len(raw) % 16 or not 0 < len(raw) // 16 <= MAX_PLAN_POINTS:
         return Rejected(f"path: expected 1 to {MAX_PLAN_POINTS} points of 2 float64")
@@ -356,13 +364,10 @@ def record_message(tick: int, agent: int, values: dict) -> bytes | None:
 
 
 def parse_record(data: bytes) -> Record | Rejected:
-    header = family_header(data, "record", FAMILY_ARENA, "a record", limit=MAX_RECORD_BYTES)
+    header = agent_header(data, "record", "a record", MAX_RECORD_BYTES)
     if isinstance(header, Rejected):
         return header
-    m, tick = header
-    agent = int_field(m, "agent")
-    if isinstance(agent, Rejected):
-        return agent
+    m, tick, agent = header
     if not isinstance(m.get("record"), bytes):
         return Rejected("record: expected the bytes of a record")
     values = memory_codec.decode(m["record"])
