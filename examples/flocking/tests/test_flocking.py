@@ -107,8 +107,6 @@ def sensor_installed(tmp_path, monkeypatch):
     this process and of the processes it starts), read afresh by the sensors' registry."""
     import importlib
 
-    import swarm_flocking
-
     from world_server.arena.face.sensors import SENSORS
 
     site = tmp_path / "site"
@@ -122,7 +120,8 @@ def sensor_installed(tmp_path, monkeypatch):
     monkeypatch.setenv(
         "PYTHONPATH", os.pathsep.join(filter(None, [str(PACKAGE), str(site), os.environ.get("PYTHONPATH")]))
     )
-    monkeypatch.setattr(swarm_flocking, "__path__", [str(PACKAGE / "swarm_flocking"), *swarm_flocking.__path__])
+    for name in [m for m in sys.modules if m.split(".")[0] == "swarm_flocking"]:  # imported again, from here
+        monkeypatch.delitem(sys.modules, name)
     importlib.invalidate_caches()
     monkeypatch.setattr(SENSORS, "_points", None)
     monkeypatch.setattr(SENSORS, "_made", {})
