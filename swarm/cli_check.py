@@ -31,8 +31,9 @@ def add_check_parsers(sub) -> None:
         "(Even Better TOML, taplo) validates and completes a file whose first line is `#:schema PATH`.",
     )
     schema.add_argument("--out", type=Path, metavar="FILE", help="write it here instead of printing it")
-    schema.add_argument("--package-only", action="store_true", help="leave out the controllers of installed "
-                        "packages (the schema swarm carries: swarm/scenarios/scenario.schema.json)")  # fmt: skip
+    schema.add_argument("--package-only", action="store_true", help="leave out the controllers and sensors "
+                        "of installed packages (the schema swarm carries: "
+                        "swarm/scenarios/scenario.schema.json)")  # fmt: skip
     schema.set_defaults(handler=cmd_schema)
 
 

@@ -114,14 +114,16 @@ def parse_arena_text(text: str, source: str = "<string>", default_name: str = "a
 
 def scenario_schema(installed: bool = True) -> dict:
     """The JSON Schema of a scenario file: one of the world kinds' schemas (each kind's `schema`,
-    given that kind's controllers from the registry; with `installed` False, only the package's own,
-    not those of installed packages' entry points: the schema the package carries)."""
+    given that kind's controllers from the registry; with `installed` False, only the package's own
+    controllers and sensors, not those of installed packages' entry points: the schema the package
+    carries)."""
     from world_server import WORLD_KINDS
 
     def mine(c) -> bool:
         return installed or c.name not in CONTROLLERS.installed
 
-    kinds = [resolve(k.schema)({c.name: c for c in CONTROLLERS if c.world == k.name and mine(c)})
+    every = CONTROLLERS if installed else CONTROLLERS.including(())  # installed ones: not even imported
+    kinds = [resolve(k.schema)({c.name: c for c in every if c.world == k.name and mine(c)}, installed)
              for k in WORLD_KINDS if k.schema is not None]  # fmt: skip
     return {"$schema": "https://json-schema.org/draft/2020-12/schema", "title": "swarm scenario file",
             "description": "A scenario of any world kind (`kind`; a file that names none is the default kind's).",

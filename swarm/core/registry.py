@@ -37,6 +37,11 @@ class UnknownPart(ValueError):
     """A name no entry of the registry has; the message lists the ones it has."""
 
 
+class Refused(ValueError):
+    """An installed package's entry the registry will not take: the message says why and what to do
+    (told as it is, without the exception's name)."""
+
+
 @dataclass(frozen=True)
 class ControllerSpec:
     """Everything the project needs to know of one controller, in its own folder.
@@ -237,7 +242,9 @@ class WorldKindSpec:
     options_title: str | None = None  # its options' own section of --help (None: among the command's own)
     check: str | None = None
     commands: tuple[str, ...] = ()
-    schema: str | None = None  # "module:function": schema(controllers) -> the JSON Schema of its scenario files
+    # "module:function": schema(controllers, installed) -> the JSON Schema of its scenario files (with
+    # `installed` False, without the parts of installed packages)
+    schema: str | None = None
 
 
 class Entry(Protocol):
@@ -257,17 +264,21 @@ class Registry(Generic[E]):
     Parts from outside the package: with `plugins` (an entry point group), every installed
     package's entry point of that group is an entry, made by `external(name, "module:attribute")`;
     with `external`, a name that is itself a "module:attribute" reference is one too (made when
-    first asked for, then kept)."""
+    first asked for, then kept).  An entry point's module is imported only when its entry is asked
+    for (by name, or by going through every entry): its name alone (`names()`, the command line's
+    help) is read from the installed packages' metadata."""
 
     def __init__(self, what: str, package: str, attribute: str, *, modules: bool = False,
                  key: Callable[[E], Any] | None = None, plugins: str | None = None,
-                 external: Callable[[str, str], E] | None = None):  # fmt: skip
+                 external: Callable[[str, str], E] | None = None, references: bool = True):  # fmt: skip
         self.what, self.package, self.attribute = what, package, attribute
         self.modules, self.key = modules, key
         self.plugins, self.external = plugins, external
-        self._entries: dict[str, E] | None = None
+        self.references = references and external is not None  # a "module:attribute" name is an entry
+        self._entries: dict[str, E] | None = None  # the package's own
+        self._points: dict[str, str] | None = None  # the installed packages' entry points: name -> "module:attribute"
+        self._made: dict[str, E | None] = {}  # the entry points made so far (None: left out)
         self._loaded: dict[str, E] = {}  # "module:attribute" names made so far
-        self.installed: set[str] = set()  # the names installed packages' entry points gave
 
     def _found(self) -> dict[str, E]:
         if self._entries is None:
@@ -283,33 +294,72 @@ class Registry(Generic[E]):
                     found[entry.name] = entry
             if self.key is not None:
                 found = {e.name: e for e in sorted(found.values(), key=self.key)}
-            self._entries = found | self._installed(found)
+            self._entries = found
         return self._entries
 
-    def _installed(self, found: dict[str, E]) -> dict[str, E]:
-        """The entries installed packages declare.  One that cannot be loaded is left out with one
-        line on stderr (a broken plugin must not stop every command)."""
-        if self.plugins is None or self.external is None:
-            return {}
-        out: dict[str, E] = {}
-        for point in importlib.metadata.entry_points(group=self.plugins):
-            if point.name in found or point.name in out:
-                print(f"swarm: {self.what} {point.name!r} of {point.value} left out: the name is taken",
-                      file=sys.stderr)  # fmt: skip
-                continue
+    def _installed(self) -> dict[str, str]:
+        """The entry points installed packages declare, by name, read from their metadata (nothing
+        imported).  One whose name is taken is left out with one line on stderr."""
+        if self._points is None:
+            self._points = {}
+            if self.plugins is not None and self.external is not None:
+                found = self._found()
+                for point in importlib.metadata.entry_points(group=self.plugins):
+                    if point.name in found or point.name in self._points:
+                        print(f"swarm: {self.what} {point.name!r} of {point.value} left out: the name is taken; "
+                              "give the entry point another name", file=sys.stderr)  # fmt: skip
+                        continue
+                    self._points[point.name] = point.value
+        return self._points
+
+    @property
+    def installed(self) -> set[str]:
+        """The names installed packages' entry points give (whether or not they load)."""
+        return set(self._installed())
+
+    def _made_of(self, name: str) -> E | None:
+        """The entry of installed entry point `name`, made once.  One that cannot be made is left out
+        with one line on stderr (a broken plugin must not stop every command): None."""
+        if name not in self._made:
+            reference = self._installed()[name]
             try:
-                out[point.name] = self.external(point.name, point.value)
-                self.installed.add(point.name)
+                self._made[name] = self.external(name, reference)  # type: ignore[misc]
+            except Refused as exc:
+                self._made[name] = None
+                print(f"swarm: {self.what} {name!r} ({reference}) refused: {exc}", file=sys.stderr)
             except Exception as exc:  # whatever a user's package raises on import
-                print(f"swarm: {self.what} {point.name!r} ({point.value}) left out: {one_line(exc)}", file=sys.stderr)
-        return out
+                self._made[name] = None
+                print(f"swarm: {self.what} {name!r} ({reference}) left out: {one_line(exc)}", file=sys.stderr)
+        return self._made[name]
+
+    def _ordered(self, names: Iterator[str] | tuple[str, ...] | list[str] | set[str]) -> dict[str, E]:
+        """The package's entries and the installed ones among `names` (made now), in the registry's order."""
+        found = dict(self._found())
+        points = self._installed()
+        for name in [n for n in points if n in set(names)]:
+            if (entry := self._made_of(name)) is not None:
+                found[name] = entry
+        if self.key is not None and len(found) > len(self._found()):
+            found = {e.name: e for e in sorted(found.values(), key=self.key)}
+        return found
+
+    def _all(self) -> dict[str, E]:
+        return self._ordered(tuple(self._installed()))
+
+    def known(self) -> dict[str, E]:
+        """The package's entries and the installed ones made so far (nothing imported)."""
+        return self._ordered([n for n, e in self._made.items() if e is not None])
+
+    def including(self, names: Any) -> tuple[E, ...]:
+        """The package's entries and the installed ones among `names` (imported now), in order."""
+        return tuple(self._ordered([n for n in names if isinstance(n, str)]).values())
 
     def load(self, reference: str) -> E:
         """The entry of a "module:attribute" name (`external`), made once; UnknownPart in one line
         saying why it cannot be."""
         if reference not in self._loaded:
-            if self.external is None or ":" not in reference:
-                raise UnknownPart(f"unknown {self.what} {reference!r}; expected one of {', '.join(self._found())}")
+            if not self.references or ":" not in reference:
+                raise UnknownPart(f"unknown {self.what} {reference!r}; expected one of {', '.join(self.names())}")
             try:
                 self._loaded[reference] = self.external(reference, reference)
             except ModuleNotFoundError as exc:
@@ -323,23 +373,32 @@ class Registry(Generic[E]):
         entries = self._found()
         if isinstance(name, str) and name in entries:
             return entries[name]
-        if isinstance(name, str) and ":" in name and self.external is not None:
+        if isinstance(name, str) and name in self._installed() and (entry := self._made_of(name)) is not None:
+            return entry
+        if isinstance(name, str) and ":" in name and self.references:
             return self.load(name)
-        raise UnknownPart(f"unknown {self.what} {name!r}; expected one of {', '.join(entries)}"
-                          + (" or module:Class" if self.external is not None else ""))  # fmt: skip
+        raise UnknownPart(f"unknown {self.what} {name!r}; expected one of {', '.join(self.names())}"
+                          + (" or module:Class" if self.references else ""))  # fmt: skip
 
     def __contains__(self, name: object) -> bool:
         if name in self._found():
             return True
+        if isinstance(name, str) and name in self._installed():
+            return self._made_of(name) is not None
         try:
-            return isinstance(name, str) and ":" in name and self.external is not None and bool(self.load(name))
+            return isinstance(name, str) and ":" in name and self.references and bool(self.load(name))
         except UnknownPart:
             return False
 
     def __iter__(self) -> Iterator[E]:
-        return iter(self._found().values())
+        return iter(self._all().values())
 
-    def names(self, where: Callable[[E], bool] = lambda _: True) -> tuple[str, ...]:
+    def names(self, where: Callable[[E], bool] | None = None) -> tuple[str, ...]:
+        """The entries' names.  Without `where`, the installed ones are named from their metadata,
+        unimported (one that then fails to load is left out from then on)."""
+        if where is None:
+            made = self._made
+            return (*self._found(), *(n for n in self._installed() if made.get(n, True) is not None))
         return tuple(e.name for e in self if where(e))
 
     def where(self, field: str, value: Any) -> Selection[E]:

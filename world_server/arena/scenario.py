@@ -23,7 +23,7 @@ Errors name the file and the field and say what is expected.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -328,9 +328,10 @@ def clearance_at(xy: np.ndarray, rects: np.ndarray, segs: np.ndarray) -> np.ndar
 _TOP = set(fields.TOP)  # the tables' keys are the schema's (world_server/arena/schema.py)
 
 
-def _tabled() -> tuple[str, ...]:
-    """The sensors a scenario's [robot.<name>] and [noise] tables may name: those with fields."""
-    return SENSORS.names(lambda cls: bool(cls.field_names()))
+def _tabled(keys: Iterable[str] = ()) -> tuple[str, ...]:
+    """The sensors a scenario's [robot.<name>] and [noise] tables may name: those with fields (of the
+    installed ones, those among `keys`, imported now)."""
+    return tuple(cls.name for cls in SENSORS.including(keys) if cls.field_names())
 
 
 def parse_section(data: dict, text: str, source: str, name: str,
@@ -342,7 +343,7 @@ def parse_section(data: dict, text: str, source: str, name: str,
 def parse_arena(data: dict, source: str, default_name: str, controllers: Mapping[str, ControllerSpec]) -> ArenaScenario:
     """The ArenaScenario of a scenario file's tables.  `controllers`: the arena controllers a group
     may name (each may have its own [name] table)."""
-    tables = [c for c in controllers if c in data] + [k for k in data if ":" in k and k in controllers]
+    tables = [k for k in data if k in controllers]  # imports only the installed controllers it names
     no_unknown(data, _TOP | set(tables), source, "top level")
     size = _numbers(data, "size", source, "size", 2)
     if not all(0 < v <= 10_000 for v in size):
@@ -395,7 +396,7 @@ def _robot(value, source: str, where: str) -> RobotModel:
         return MODELS[value]
     if not isinstance(value, dict):
         raise ScenarioError(source, where, "expected a model name or a [robot] table")
-    allowed = {*fields.ROBOT, *_tabled()}
+    allowed = {*fields.ROBOT, *_tabled(value)}
     no_unknown(value, allowed, source, f"[{where}]")
     model = _robot(value.get("model", "epuck"), source, f"{where}.model")
     changes: dict[str, Any] = {"name": _get(value, "name", str, source, model.name, f"{where}.name")}
@@ -420,10 +421,11 @@ def _sensors(value: dict, sensors: Sensors, source: str, where: str) -> Sensors:
     others left out), then each [robot.<name>] table over that sensor's spec (adding it)."""
     if "sensors" in value:
         names, kinds = value["sensors"], SENSORS.names()
-        if not isinstance(names, list) or not all(isinstance(n, str) and n in kinds for n in names):
+        if not isinstance(names, list) or not all(isinstance(n, str) and n in SENSORS for n in names):
+            kinds = SENSORS.names()  # less an installed one that could not be loaded
             raise ScenarioError(source, f"{where}.sensors", f"expected a list of {', '.join(sorted(kinds))}")
         sensors = Sensors(**{k: (getattr(sensors, k) or True) if k in names else None for k in kinds})
-    for key in _tabled():
+    for key in _tabled(value):
         if key in value:
             table = _table(value, key, source, f"{where}.{key}")
             cls = SENSORS[key]
@@ -449,7 +451,7 @@ def _noise(value, source: str) -> Noise:
     for k in value:
         if k == "level":
             continue
-        if k not in {*_tabled(), "map"}:
+        if k not in {*_tabled(value), "map"}:
             raise ScenarioError(source, f"noise.{k}", f"unknown sensor; expected level or one of "
                                 f"{', '.join(sorted(_tabled()))}")  # fmt: skip
         scales.append((k, float(_get(value, k, (int, float), source, where=f"noise.{k}"))))
@@ -728,7 +730,11 @@ def controller_params(s: ArenaScenario, agent: int) -> dict[str, Any]:
             "max_wheel_speed": m.max_wheel_speed,
             "max_speed": m.max_speed,
             "max_turn_rate": m.max_turn_rate,
-            **{k: v for cls in SENSORS for k, v in cls.tells(getattr(m.sensors, cls.name), m).items()},
+            **{
+                k: v
+                for cls in SENSORS.including(m.sensors.names())
+                for k, v in cls.tells(getattr(m.sensors, cls.name), m).items()
+            },
         },
         "control_period": s.control_period,
         "noise": s.noise.level,

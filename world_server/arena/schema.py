@@ -95,9 +95,10 @@ def of_dataclass(cls) -> dict[str, Any]:
     return table(props)
 
 
-def schema(controllers: dict[str, Any]) -> dict[str, Any]:
+def schema(controllers: dict[str, Any], installed: bool = True) -> dict[str, Any]:
     """The arena scenario file's schema; `controllers`: the arena controllers' entries by name (each
-    may have its own [name] table, typed by its parameter classes)."""
+    may have its own [name] table, typed by its parameter classes); with `installed` False, only the
+    package's own sensors, not those of installed packages' entry points."""
     from swarm.core.registry import resolve
     from world_server.arena.face.robots import MODELS
     from world_server.arena.face.sensors import SENSORS
@@ -105,10 +106,12 @@ def schema(controllers: dict[str, Any]) -> dict[str, Any]:
     from world_server.arena.metabolism import MetabolismParams
     from world_server.arena.sensors import NOISE_LEVELS
 
-    tabled = [cls for cls in SENSORS if cls.field_names()]
+    classes = SENSORS.including(SENSORS.installed if installed else ())
+    tabled = [cls for cls in classes if cls.field_names()]
     sensors = {cls.name: of_dataclass(cls) for cls in tabled}
+    names = [cls.name for cls in classes]
     robot_table = table({**ROBOT, "model": {"enum": list(MODELS)},
-                         "sensors": {"type": "array", "items": {"enum": SENSORS.names()}}, **sensors})  # fmt: skip
+                         "sensors": {"type": "array", "items": {"enum": names}}, **sensors})  # fmt: skip
     robot = {"oneOf": [{"enum": list(MODELS)}, robot_table], "description": "a model name or a [robot] table"}
     noise = {"oneOf": [{"enum": list(NOISE_LEVELS)},
                        table({"level": {"enum": list(NOISE_LEVELS)}, "map": NUMBER,

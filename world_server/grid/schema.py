@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any
 
 
-def schema(controllers: dict[str, Any]) -> dict[str, Any]:
+def schema(controllers: dict[str, Any], installed: bool = True) -> dict[str, Any]:
     from world_server.arena.schema import INTEGER, STRING, of_dataclass, table
     from world_server.grid.params import AntParams, CMarkingParams, PhysicsParams
     from world_server.grid.scenario import _TOP_KEYS, GENERATOR_KEYS, Generator

@@ -9,7 +9,8 @@ Each robot steers by the sum of four unit-free vectors in its own frame (x ahead
 - avoidance: away from what its IR sensors see, and a constant pull ahead (`cruise`).
 
 It sees no positions and no identities: distances and bearings of the neighbours in range and in
-sight, their broadcast headings, its own compass and IR.  It drives at `speed` of its wheel limit,
+sight, their broadcast headings, its own compass and IR.  A robot that also carries this package's
+`neighbour_count` sensor (swarm_flocking.sensor) records how crowded it is.  It drives at `speed` of its wheel limit,
 slower the further the wanted direction is from its heading, and turns in proportion to that angle.
 """
 
@@ -74,6 +75,8 @@ class Flocking:
         self.ir_bearings = np.asarray(robot.get("ir_bearings") or (), np.float64)
         self.heading = 0.0
         self.neighbours = 0
+        self.counts = robot.get("neighbour_radius") is not None  # it carries neighbour_count
+        self.crowd = 0
         self.wanted = 0.0
         self.ticks = 0
 
@@ -101,6 +104,8 @@ class Flocking:
     def step(self, perception: dict[str, np.ndarray]) -> np.ndarray:
         self.ticks += 1
         self.heading = float(perception["compass"]) % (2 * math.pi)
+        if self.counts:
+            self.crowd = int(perception["neighbour_count"])
         want = self._rules(perception)
         self.wanted = math.atan2(want[1], want[0])
         v = self.p.speed * self.max_wheel * max(0.0, math.cos(self.wanted))
@@ -120,6 +125,7 @@ class Flocking:
         self.heading, self.ticks = float(state["heading"]), int(state["ticks"])
 
     def record(self) -> dict[str, Any]:
-        return {"neighbours": self.neighbours, "wanted_turn": self.wanted, "heading": self.heading}
+        out = {"neighbours": self.neighbours, "wanted_turn": self.wanted, "heading": self.heading}
+        return out | ({"crowd": self.crowd} if self.counts else {})
 
     check_table = staticmethod(FlockingParams.from_table)

@@ -4,11 +4,14 @@ process and as agent processes (lock-step equal), and recorded."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
+import pytest
 from swarm_flocking.metrics import polarization
 
 FLOCK = str(Path(__file__).parents[1] / "flock.toml")
@@ -91,3 +94,71 @@ def test_the_example_sweep_runs_and_alignment_orders_the_flock(tmp_path):
     assert len(rows) == 4 and (tmp_path / "swarm_flocking.metrics_polarization.png").exists()
     order = {(r["flocking.w_alignment"], r["seed"]): r["swarm_flocking.metrics:polarization"] for r in rows}
     assert all(order[1.0, seed] > order[0.0, seed] for seed in (1, 2)), order
+
+
+# ------------------------------------------------------------------ the package's sensor
+
+PACKAGE = Path(__file__).parents[1]
+
+
+@pytest.fixture
+def sensor_installed(tmp_path, monkeypatch):
+    """The package's `swarm.sensors` entry point as pip would install it (a dist-info on the path of
+    this process and of the processes it starts), read afresh by the sensors' registry."""
+    import importlib
+
+    from world_server.arena.face.sensors import SENSORS
+
+    site = tmp_path / "site"
+    dist = site / "swarm_flocking_sensor-0.1.0.dist-info"
+    dist.mkdir(parents=True)
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: swarm-flocking-sensor\nVersion: 0.1.0\n")
+    entry = tomllib.loads((PACKAGE / "pyproject.toml").read_text())["project"]["entry-points"]["swarm.sensors"]
+    (dist / "entry_points.txt").write_text("[swarm.sensors]\n" + "".join(f"{k} = {v}\n" for k, v in entry.items()))
+    for folder in (PACKAGE, site):  # this checkout's package first, whatever an editable install points to
+        monkeypatch.syspath_prepend(str(folder))
+    monkeypatch.setenv(
+        "PYTHONPATH", os.pathsep.join(filter(None, [str(PACKAGE), str(site), os.environ.get("PYTHONPATH")]))
+    )
+    for name in [m for m in sys.modules if m.split(".")[0] == "swarm_flocking"]:  # imported again, from here
+        monkeypatch.delitem(sys.modules, name)
+    importlib.invalidate_caches()
+    monkeypatch.setattr(SENSORS, "_points", None)
+    monkeypatch.setattr(SENSORS, "_made", {})
+    return tmp_path
+
+
+def crowded(tmp_path: Path, radius: float = 0.4) -> Path:
+    """The package's scenario with four robots that carry neighbour_count too, without noise."""
+    text = Path(FLOCK).read_text().replace("count = 12", "count = 4").replace('noise = "low"', 'noise = "none"')
+    text = text.replace(
+        '"range_and_bearing"] }',
+        f'"range_and_bearing", "neighbour_count"], neighbour_count = {{ radius = {radius} }} }}',
+    )
+    path = tmp_path / "crowded.toml"
+    path.write_text(text)
+    return path
+
+
+def test_a_scenario_carries_the_packages_sensor_and_its_reading_reaches_the_controller(sensor_installed):
+    from swarm.engines.arena import ArenaEngine
+    from swarm.scenario import load_scenario
+
+    scenario = load_scenario(str(crowded(sensor_installed))).with_overrides(max_ticks=1)
+    robot = scenario.groups[0].robot
+    assert robot.sensors.names()[-1] == "neighbour_count" and robot.sensors.neighbour_count.radius == 0.4
+    engine = ArenaEngine(scenario)
+    xy = engine.world.pose[:, :2].copy()
+    engine.run()
+    apart = np.hypot(*(xy[None] - xy[:, None]).transpose(2, 0, 1))
+    expected = ((apart <= 0.4).sum(axis=1) - 1).tolist()  # the others within the radius, at the first step
+    assert [c.crowd for c in engine.controllers] == expected and all(c.counts for c in engine.controllers)
+    assert engine.controllers[0].record()["crowd"] == expected[0]
+
+
+def test_agent_processes_read_the_packages_sensor_as_the_in_process_run(sensor_installed):
+    args = (str(crowded(sensor_installed)), "--agents", "4", "--max-ticks", "60", "--seed", "2")
+    alone, distributed = summary_of("run", *args), summary_of("up", *args, "--no-record")
+    assert [r["pose"] for r in distributed["robots"]] == [r["pose"] for r in alone["robots"]]
+    bad = swarm("run", str(crowded(sensor_installed, radius=-1.0)))
+    assert bad.returncode == 2 and "neighbour_count.radius" in bad.stderr and "Traceback" not in bad.stderr
