@@ -417,6 +417,7 @@ def test_a_dft_memory_handed_back_is_read_where_it_lies_in_the_message():
     """A resume's peak: the memory message is parsed with its blob as a view, the blob decoded
     with its fields as views, and the controller copies them into its own arrays: no MB-sized copy on the way."""
     from agents.arena_runtime import ArenaAgentRuntime
+    from agents.controllers.arena import StepGuard
 
     scenario = load_scenario("large-maze").with_overrides(controller="dft", max_ticks=50)
     engine = ArenaEngine(scenario)
@@ -425,6 +426,7 @@ def test_a_dft_memory_handed_back_is_read_where_it_lies_in_the_message():
     message = arena_proto.memory_message([(0, blob)])
     runtime = ArenaAgentRuntime.__new__(ArenaAgentRuntime)  # its restore path alone, without a session
     runtime.brains, runtime.slot_of, runtime.refused_memory = [make_controller("dft")], {0: 0}, 0
+    runtime.guard, runtime.names = StepGuard(), ["dft"]
     runtime.brains[0].reset(scenario.seed, 0, controller_params(scenario, 0))
     tracemalloc.start()
     handed = arena_proto.parse_obs(message)
