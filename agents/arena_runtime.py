@@ -16,10 +16,9 @@ import sys
 import numpy as np
 
 from agents.controllers import CONTROLLERS
-from agents.controllers.arena import StepGuard, broadcasts, deliver, make_controller, publications
+from agents.controllers.arena import StepGuard, broadcasts, deliver, make_controller, publications, record_of
 from agents.runtime import AgentRuntime
 from swarm.core import heap, kernels, memory_codec, wire
-from swarm.core.errors import one_line
 from world_server.arena.face import wire as arena_proto
 
 
@@ -103,15 +102,11 @@ class ArenaAgentRuntime(AgentRuntime):
         for brain, agent in zip(brains, ids, strict=True):
             if agent not in self.recorded or agent in self.quiet:
                 continue
-            try:
-                record = brain.record()
-                why = None if isinstance(record, dict) else f"it gave {str(record)[:80]!r}, not a dict"
-                values = {} if why else arena_proto.record_values(record, tick)
-                if not values and not why:
-                    continue  # nothing to show this tick
-                message = None if why else arena_proto.record_message(tick, agent, values)
-            except Exception as exc:  # whatever a user's controller raises
-                why, message = f"it raised {one_line(exc)}", None
+            record, why = record_of(brain)
+            values = arena_proto.record_values(record, tick)
+            if why is None and not values:
+                continue  # nothing to show this tick
+            message = None if why else arena_proto.record_message(tick, agent, values)
             if message is None:
                 self.quiet.add(agent)
                 why = why or f"it passed {arena_proto.MAX_RECORD_BYTES} bytes"

@@ -141,6 +141,16 @@ class StepGuard:
         print(f"swarm: {what}; {then} (--on-controller-error stop ends the run instead)", file=sys.stderr, flush=True)
 
 
+def record_of(controller) -> tuple[dict, str | None]:
+    """(its record(), None), or ({}, why it gives none: it raised, or gave no dict), so that the
+    recorder and the agent processes leave a user's broken record() out the same way, in one line."""
+    try:
+        record = controller.record()
+    except Exception as exc:  # whatever a user's controller raises
+        return {}, f"it raised {one_line(exc)}"
+    return (record, None) if isinstance(record, dict) else ({}, f"it gave {str(record)[:80]!r}, not a dict")
+
+
 def make_controller(name: str) -> ArenaController:
     """A fresh controller of the registry's entry `name` (agents.controllers.CONTROLLERS)."""
     return CONTROLLERS[name].make()

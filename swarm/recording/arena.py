@@ -35,7 +35,7 @@ import sys
 
 import numpy as np
 
-from swarm.core.errors import one_line
+from agents.controllers.arena import record_of
 from swarm.core.registry import resolve
 from swarm.engines.goals import ArenaGoals, optimum_planner
 from swarm.recording.grid import FORMAT_VERSION, software_versions
@@ -259,17 +259,12 @@ class ArenaRecorder:
         """Each controller's record(): one that raises or gives no dict is told once and shows nothing."""
         out = []
         for a, c in enumerate(self.controllers):
-            record: object = {}
+            record: dict = {}
             if a not in self._quiet:
-                try:
-                    record = c.record()
-                    why = None if isinstance(record, dict) else f"it gave {str(record)[:80]!r}, not a dict"
-                except Exception as exc:  # whatever a user's controller raises
-                    why = f"it raised {one_line(exc)}"
+                record, why = record_of(c)
                 if why is not None:
                     self._quiet.add(a)
                     print(f"swarm: the recording leaves out robot {a}'s record(): {why}", file=sys.stderr)
-                    record = {}
             out.append(record)
         return out
 
