@@ -189,3 +189,18 @@ def test_the_viewer_opens_on_the_arena_and_what_explains_each_groups_controller(
         arena_view, _, explained = blueprint(rrb, scenario, records_of(scenario)).root_container.contents
         assert arena_view.origin == "/world"
         assert {str(v.origin) for v in explained.contents} == origins  # the group's first robot
+
+
+def test_an_installed_packages_flocking_agents_equal_the_in_process_run_bit_for_bit():
+    """The example package's controller (entry point `flocking`) with its range-and-bearing broadcasts,
+    as agent processes in lock-step: every pose equal to the in-process run's, not only to the summary's
+    decimals."""
+    flock = Path(__file__).resolve().parents[1] / "examples" / "flocking" / "flock.toml"
+    if "flocking" not in CONTROLLERS:
+        pytest.skip("the example package is not installed (make install installs it)")
+    scenario = load_scenario(str(flock)).with_overrides(agents=4, max_ticks=150, seed=3)
+    engine = ArenaEngine(scenario)
+    engine.run()
+    summary, world = run_world(scenario, "own-flock", [("flocking", 2, 2)], deadline=60.0)
+    assert summary["agents_lost"] == 0
+    np.testing.assert_array_equal(world.pose, engine.world.pose)

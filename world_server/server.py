@@ -392,7 +392,7 @@ class WorldServer:
         first, last = self.window()
         return first <= tick <= last
 
-    def _drain(self, timeout: float) -> bool:
+    def drain(self, timeout: float) -> bool:
         """Handle queued events; wait up to `timeout` for the first one."""
         try:
             kind, item = self.events.get(timeout=timeout)
@@ -410,7 +410,7 @@ class WorldServer:
         if self.resumed:
             deadline = time.monotonic() + self.resume_timeout
             while (self.slots == JOINING).any() and time.monotonic() < deadline:
-                self._drain(0.05)
+                self.drain(0.05)
             for agent in np.flatnonzero(self.slots == JOINING):
                 self._lose(int(agent))  # did not come back
             return
@@ -418,7 +418,7 @@ class WorldServer:
         while int((self.slots == ACTIVE).sum()) < self.start_with:
             if time.monotonic() > deadline:
                 raise TimeoutError(f"only {int((self.slots == ACTIVE).sum())} of {self.start_with} agents joined")
-            self._drain(0.05)
+            self.drain(0.05)
 
     def _wait_for_any_agent(self) -> None:
         deadline = time.monotonic() + self.start_timeout
@@ -426,7 +426,7 @@ class WorldServer:
             if time.monotonic() > deadline:
                 raise TimeoutError(f"every agent is gone and none joined for {self.start_timeout:g} s; "
                                    "start agents with `swarm agent --run-id ...`")  # fmt: skip
-            self._drain(0.05)
+            self.drain(0.05)
 
     def step(self) -> None:
         started = time.perf_counter()
@@ -442,11 +442,11 @@ class WorldServer:
                 left = deadline - time.monotonic()
                 if left <= 0:
                     break
-                self._drain(left)
+                self.drain(left)
         else:  # real time: the tick lasts one period, whoever has answered
             deadline = started + self.period
             while (left := deadline - time.monotonic()) > 0:
-                self._drain(left)
+                self.drain(left)
         self.kind.barrier_passed()
         answered = self.acted[active]
         self.agent_steps += int(answered.sum())
@@ -502,7 +502,7 @@ class WorldServer:
             if not (self.slots == ACTIVE).any():
                 self._wait_for_any_agent()  # a world with nobody in it does not tick on alone
             self.step()
-        self._drain(0.0)
+        self.drain(0.0)
         self.kind.finish()
         self.kind.save()
         self.final = summary = self.summary()
@@ -518,7 +518,7 @@ class WorldServer:
         """Keep serving the key space (shared spaces, info) after the run until
         `until()` is true: clients can still read the final environment."""
         while not until():
-            self._drain(0.1)
+            self.drain(0.1)
 
     def info(self) -> dict:
         """What `swarm status`, `swarm monitor` and agents checking their

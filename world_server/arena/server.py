@@ -14,6 +14,7 @@ the runner lends the world process (RunnerServices.goals): it is kept above the 
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +48,7 @@ class ArenaKind:
         self.shared_out: list[tuple[int, str, bytes]] = []  # last tick's, going out with this tick's observations
         self.shares = ShareLog()
         self.memory: list[bytes | None] = [None] * self.world.n  # each controller's memory at the last save
+        self.recorded_tick = np.full(self.world.n, -1, np.int64)  # the last tick of each robot's record() logged
         self.state_file = Path(server.state_dir) / f"{server.keys.run}.arena.npz" if server.state_dir else None
         # every publication, for `get <share>/**`, kept across a restart
         self.shared_history = SharedHistory(self.state_file.with_suffix(".shared.msgpack") if self.state_file else None)
@@ -114,8 +116,7 @@ class ArenaKind:
         elif event == "plan":
             self._on_recorded(item, arena_proto.parse_plan, "plan", lambda r, m: r.log_plan(m.tick, m.agent, m.path))
         elif event == "record":
-            self._on_recorded(item, arena_proto.parse_record, "record",
-                              lambda r, m: r.log_record(m.tick, m.agent, m.values))  # fmt: skip
+            self._on_recorded(item, arena_proto.parse_record, "record", self._log_record)
 
     def _on_recorded(self, sample, parse, what: str, log) -> None:
         """A plan or a record() an agent process sends for the recording, logged when it names one of the
@@ -129,6 +130,21 @@ class ArenaKind:
             s.stats.reject(f"{what}: names an agent of another process")
         elif s.recorder is not None:
             log(s.recorder, message)
+
+    def _log_record(self, recorder, message: arena_proto.Record) -> None:
+        recorder.log_record(message.tick, message.agent, message.values)
+        self.recorded_tick[message.agent] = max(self.recorded_tick[message.agent], message.tick)
+
+    def _await_last_records(self) -> None:
+        """A record() rides its own key, so the last tick's may still be on its way when that tick's actions
+        are in: wait for it (at most the tick deadline) from every active robot that sends one."""
+        s = self.server
+        if s.recorder is None:
+            return
+        until = time.monotonic() + s.deadline
+        sending = self.recorded_tick >= 0
+        while ((self.recorded_tick < s.tick - 1) & sending & (s.slots == ACTIVE)).any() and time.monotonic() < until:
+            s.drain(0.05)
 
     # ------------------------------------------------------------------ joins
 
@@ -175,6 +191,7 @@ class ArenaKind:
         self.world.remove_agent(agent)
 
     def finish(self) -> None:
+        self._await_last_records()
         self._pass_on_shared()  # the last tick's publications go on their keys too: nothing written is lost
         self.shared_history.flush()
 
