@@ -548,3 +548,38 @@ def test_the_swarm_summary_measures_how_much_earlier_robot_0_replans():
     last = summary[-1]
     assert (last["south_alone"], last["south_scout"], last["sooner_with_scout"]) == (1, 2, 2)
     assert last["median_ticks_earlier"] == 270 and "a median of 270 ticks earlier" in md
+
+
+def test_cases_1_and_2_run_on_a_floor_and_pairs_given_and_refuse_bad_ones_in_one_line(tmp_path):
+    """`--scenario FILE` (pairs drawn from the seed on that floor) and `--pairs FILE` (runs.csv is one)."""
+    import csv
+    import re
+    from pathlib import Path
+
+    from swarm.experiments.billing2015.dft import run_dft_experiment
+
+    floor = tmp_path / "hall.toml"  # the Z-maze without its middle bar: a floor the paper never used
+    zmaze = (Path(__file__).parents[1] / "swarm" / "scenarios" / "zmaze.toml").read_text()
+    kept = [block for block in zmaze.split("[[wall]]") if 'name = "z_middle_bar"' not in block]
+    floor.write_text("[[wall]]".join(kept).replace('name = "zmaze"', 'name = "hall"'))
+    drawn = run_dft_experiment("dft-case2", str(floor), 1, 1, 5, tmp_path / "drawn", noise="low", max_ticks=40,
+                               progress=False)  # fmt: skip
+    rows = list(csv.DictReader((tmp_path / "drawn" / "runs.csv").read_text().splitlines()))
+    assert {r["scenario"] for r in rows} == {str(floor)} and len({r["pair"] for r in rows}) == 1
+    assert "in " + str(floor) in drawn["markdown"] and "drawn from seed 5" in drawn["markdown"]
+    given = run_dft_experiment("dft-case1", None, None, 1, 0, tmp_path / "given", noise="low", max_ticks=40,
+                               progress=False, pairs=str(tmp_path / "drawn" / "runs.csv"))  # fmt: skip
+    again = list(csv.DictReader((tmp_path / "given" / "runs.csv").read_text().splitlines()))
+    assert {(r["start_x"], r["goal_y"]) for r in again} == {(r["start_x"], r["goal_y"]) for r in rows}
+    assert "in zmaze" in given["markdown"]
+    (tmp_path / "bad.csv").write_text("x,y\n1,2\n")
+    for kwargs, words in [({"pairs": str(tmp_path / "bad.csv")}, "needs a header with start_x"),
+                          ({"scenario": "setup1"}, "runs on an arena floor"),
+                          ({"pairs": str(tmp_path / "nowhere.csv")}, "cannot read it")]:  # fmt: skip
+        case = "dft-case2"
+        with pytest.raises(ScenarioError, match=re.escape(words)) as e:
+            run_dft_experiment(case, kwargs.get("scenario"), 1, 1, 0, tmp_path / "bad", pairs=kwargs.get("pairs"),
+                               progress=False)  # fmt: skip
+        assert "\n" not in str(e.value)
+    with pytest.raises(ScenarioError, match="dft-case3 runs on zmaze"):
+        run_dft_experiment("dft-case3", str(floor), 1, 1, 0, tmp_path / "bad", progress=False)

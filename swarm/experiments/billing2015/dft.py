@@ -69,15 +69,63 @@ def label(controller: str, noise: str) -> str:
 # ---------------------------------------------------------------- cases 1, 2
 
 
-def pair_jobs(case: str, reps: int, seed: int, max_ticks: int | None) -> list[tuple]:
-    name = CASE_SCENARIO[case]
-    if name == "zmaze":
-        pairs, heading = zmaze_pairs()[:reps], 0.0
+def pair_jobs(case: str, reps: int, seed: int, max_ticks: int | None, floor: str | None = None,
+              given: list[tuple] | None = None) -> list[tuple]:  # fmt: skip
+    """Every condition on every pair: the paper's Z-maze pairs (case 1), pairs drawn from the seed on the
+    large maze (case 2) or on `floor`, or the `given` pairs (`--pairs`)."""
+    name = floor or CASE_SCENARIO[case]
+    if given is not None:
+        pairs = [(k + 1, *p[:4]) for k, p in enumerate(given[:reps])]
+        headings = [p[4] if len(p) > 4 else 0.0 for p in given[:reps]]
     else:
-        pairs, heading = random_pairs(name, reps, seed), LARGE_HEADING
+        if name == "zmaze":
+            pairs, heading = zmaze_pairs()[:reps], 0.0
+        else:
+            pairs, heading = random_pairs(name, reps, seed), LARGE_HEADING if name == "large-maze" else 0.0
+        headings = [heading] * len(pairs)
     # dft runs first: they are the long ones, so the pool's tail is short
-    return [(name, noise, *p, heading, seed + p[0], controller, max_ticks) for controller, noise in CONDITIONS
-            for p in pairs]  # fmt: skip
+    return [(name, noise, *p, h, seed + p[0], controller, max_ticks) for controller, noise in CONDITIONS
+            for p, h in zip(pairs, headings, strict=True)]  # fmt: skip
+
+
+def read_pairs(path: str) -> list[tuple[float, ...]]:
+    """Start/goal pairs from a CSV with the columns start_x, start_y, goal_x, goal_y and, optionally, heading
+    (radians; default 0): runs.csv of an earlier run is one."""
+    import csv
+
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        raise ScenarioError(path, "--pairs", f"cannot read it: {e.strerror}") from None
+    wanted = ("start_x", "start_y", "goal_x", "goal_y")
+    if not rows or any(c not in rows[0] for c in wanted):
+        raise ScenarioError(path, "--pairs", f"needs a header with {', '.join(wanted)} (and optionally heading) "
+                            "and a row per pair")  # fmt: skip
+    pairs, seen = [], set()
+    for line, row in enumerate(rows, start=2):
+        try:
+            pair = (*(float(row[c]) for c in wanted), float(row.get("heading") or 0.0))
+        except ValueError:
+            raise ScenarioError(path, f"line {line}", "the coordinates and the heading are numbers") from None
+        if not all(math.isfinite(v) for v in pair):
+            raise ScenarioError(path, f"line {line}", "a pair's coordinates are finite numbers")
+        if pair not in seen:  # runs.csv repeats each pair under every condition
+            seen.add(pair)
+            pairs.append(pair)
+    return pairs
+
+
+def pair_floor(case: str, scenario: str | None) -> str:
+    """The floor of cases 1 and 2: the paper's, or `scenario` (any arena floor: a file or a bundled name)."""
+    from swarm.scenario import load_scenario
+
+    if scenario is None:
+        return CASE_SCENARIO[case]
+    floor = load_scenario(scenario)
+    if getattr(floor, "kind", "grid") != "arena":  # a grid scenario has no kind field
+        raise ScenarioError(scenario, "kind", f"{case} runs on an arena floor (a [arena] table, as zmaze.toml)")
+    return scenario
 
 
 def summarise_pairs(rows: list[dict]) -> tuple[list[dict], str]:
@@ -113,7 +161,7 @@ def summarise_pairs(rows: list[dict]) -> tuple[list[dict], str]:
     head = ("| condition | reached | L_p / L_o (mean ± sd, reached runs) | median ticks to goal |\n"
             "|---|---|---|---|\n")  # fmt: skip
     tail = (f"\nOne-way ANOVA of L_p / L_o over the paper's five conditions, {'; '.join(anovas)}; paper F = "
-            f"{PAPER_F[name]} (no significant difference).  "
+            f"{PAPER_F.get(name, 'not given for this floor')} (no significant difference).  "
             f"SPA low against high noise alone: F = {fmt(f_spa.statistic if f_spa else math.nan, 2)}, "
             f"p = {fmt(f_spa.pvalue if f_spa else math.nan, 3)}.\n"
             "\nThe paper shows successes and L_p / L_o as bar charts (Figures 7 and 8), which we do not have; its "
@@ -414,10 +462,16 @@ def plot_together(rows: list[dict], path: Path) -> None:
 
 def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
                        out: Path | None, noise: str | None = None, max_ticks: int | None = None,
-                       progress: bool = True) -> dict:  # fmt: skip
+                       progress: bool = True, pairs: str | None = None) -> dict:  # fmt: skip
     expected = CASE_SCENARIO[case]
-    if scenario not in (None, expected):
-        raise ScenarioError("command line", "--scenario", f"{case} runs on {expected} (the paper's)")
+    paired = case in ("dft-case1", "dft-case2")
+    if not paired and scenario not in (None, expected):
+        raise ScenarioError("command line", "--scenario", f"{case} runs on {expected} (its start, goal and boxes "
+                            "are the paper's maze's); dft-case1 and dft-case2 take any floor")  # fmt: skip
+    if not paired and pairs is not None:
+        raise ScenarioError("command line", "--pairs", f"{case} has no start/goal pairs; dft-case1 and dft-case2 do")
+    floor = pair_floor(case, scenario) if paired else expected
+    given = read_pairs(pairs) if pairs is not None else None
     out = Outputs(out, case)
     if case == "dft-together":
         reps = 60 if reps is None else reps
@@ -444,11 +498,11 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
             f"type and noise level; seed {seed}.\n\n"
         )
     else:
-        limit = 100 if expected == "zmaze" else 10_000
-        reps = 100 if reps is None else reps
-        if not 1 <= reps <= limit:
+        own = given is None and floor == "zmaze"  # the paper's 100 pairs
+        reps = (len(given) if given is not None else 100) if reps is None else reps
+        if own and not 1 <= reps <= 100:
             raise ScenarioError("command line", "--reps", "zmaze has the paper's 100 pairs: --reps 1 to 100")
-        work = pair_jobs(case, reps, seed, max_ticks)
+        work = pair_jobs(case, reps, seed, max_ticks, floor, given)
         if noise:
             work = [j for j in work if j[1] == noise]
         rows = batch_run(run_pair, work, jobs=jobs, desc=case, progress=progress)
@@ -458,7 +512,10 @@ def run_dft_experiment(case: str, scenario: str | None, reps: int | None, jobs: 
         summary, md = summarise_pairs(rows)
         plot_pairs(rows, out / "plot.png")
         number = case[-1]
-        title = (f"# Case {number} (Billing et al. 2015): SPA beside follow the carrot in {expected}\n\n{reps} "
-                 f"start/goal pairs per condition; seed {seed}; at most {max_ticks or 3000} steps of 64 ms; a run "
-                 f"succeeds when the robot dwelt 40 steps within 7 cm of its goal or ends there.\n\n")  # fmt: skip
+        drawn = f"from {pairs}" if given is not None else "the paper's" if own else f"drawn from seed {seed}"
+        source = "" if given is None and scenario is None else f" ({drawn})"
+        title = (f"# Case {number} (Billing et al. 2015): SPA beside follow the carrot in {floor}\n\n"
+                 f"{len({job[2] for job in work})} start/goal pairs per condition{source}; seed {seed}; at most "
+                 f"{max_ticks or 3000} steps of 64 ms; a run succeeds when the robot dwelt 40 steps within 7 cm of "
+                 "its goal or ends there.\n\n")  # fmt: skip
     return out.finish(summary, title + md)
