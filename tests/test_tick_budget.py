@@ -1,0 +1,35 @@
+"""scripts/tick_budget.py: the model behind docs/scale.md adds up a tick's parts and splits them by region."""
+
+import importlib.util
+import subprocess
+import sys
+from pathlib import Path
+
+SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "tick_budget.py"
+
+
+def load():
+    spec = importlib.util.spec_from_file_location("tick_budget", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclass looks itself up there
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_split_divides_the_worlds_work_and_adds_a_region_exchange():
+    budget = load()
+    setup = budget.Setup()
+    whole, split = budget.tick(setup, 1), budget.tick(setup, 16)
+    assert whole["exchange"] == 0 < split["exchange"]
+    assert whole["world"] / 16 < split["world"] < whole["world"] / 8  # a ghost band on top of a 16th
+    assert whole["total"] == sum(whole[k] for k in ("world", "hops", "exchange")) + max(whole["wire"], whole["agents"])
+    slower = budget.tick(budget.Setup(agent_step_seconds=1.3e-3), 1)  # DFT robots: the agent hosts set the pace
+    assert slower["agents"] > slower["wire"]
+
+
+def test_the_command_prints_one_row_per_split():
+    done = subprocess.run([sys.executable, str(SCRIPT), "--robots", "1000", "--splits", "1,4"], capture_output=True,
+                          text=True, timeout=60)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    rows = [line for line in done.stdout.splitlines() if line.startswith("| 1 |") or line.startswith("| 4 |")]
+    assert len(rows) == 2
