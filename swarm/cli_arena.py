@@ -34,6 +34,9 @@ def add_arena_run_args(g) -> None:
     g.add_argument("--goal", type=_floats(2, 2, "X,Y (metres)"), metavar="X,Y", help="goal of a one-robot run")
     g.add_argument("--noise", choices=["none", "low", "high"], help="sensor noise level (the DFT paper's)")
     g.add_argument("--max-ticks", type=int, metavar="T", help="stop after T control periods")
+    g.add_argument("--threads", type=int, metavar="N",
+                   help="cores for the world's sensing pass (default 1; 0: every core); the readings are the same "
+                        "for every N")  # fmt: skip
     g.add_argument("--on-controller-error", choices=ON_ERROR, metavar="{idle,stop}",
                    help="a robot whose controller raises: holds still while the others go on (idle, the default), "
                         "or ends the run (stop); for the controllers in this process (swarm run) or in the agent "
@@ -41,7 +44,14 @@ def add_arena_run_args(g) -> None:
 
 
 def arena_overrides(scenario, args, common: dict):
-    """The scenario with the command line's values (`common`: agents, controller, seed)."""
+    """The scenario with the command line's values (`common`: agents, controller, seed); --threads is set
+    for this process's sensing pass (it is not part of the scenario: it changes no reading)."""
+    if (threads := getattr(args, "threads", None)) is not None:
+        if threads < 0:
+            raise ScenarioError("command line", "--threads", "0 (every core) or a number of cores")
+        from world_server.arena.raycast import set_threads
+
+        set_threads(threads)
     return scenario.with_overrides(
         **common, **{k: getattr(args, k, None) for k in ("start", "goal", "noise", "max_ticks")}
     )
@@ -65,6 +75,8 @@ def arena_world_args(args) -> list[str]:
         out += ["--noise", args.noise]
     if getattr(args, "max_ticks", None):
         out += ["--max-ticks", str(args.max_ticks)]
+    if getattr(args, "threads", None) is not None:
+        out += ["--threads", str(args.threads)]
     return out
 
 

@@ -20,11 +20,27 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 NO_HIT = -1
 SOLID, MARK = 1, 2
+_threads = 1  # of the sensing pass in this process (set_threads)
+
+
+def set_threads(threads: int) -> int:
+    """Cast the rays over `threads` cores (0: every core; 1: the serial pass).  Each ray is cast alone,
+    so every count gives the same readings, bit for bit.  Returns the count in use."""
+    global _threads
+    _threads = numba.config.NUMBA_NUM_THREADS if threads == 0 else min(threads, numba.config.NUMBA_NUM_THREADS)
+    if _threads > 1:
+        numba.set_num_threads(_threads)
+    return _threads
+
+
+def threads() -> int:
+    return _threads
 
 
 def grid_shape(extent: tuple[float, float, float, float], cell: float) -> tuple[int, int]:
@@ -192,6 +208,22 @@ def cast_rays(pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, 
         r = ray_robot[k]
         if r != last:
             last, ch, sh = r, math.cos(pose[r, 2]), math.sin(pose[r, 2])
+        dx = ch * ray_cos[k] - sh * ray_sin[k]
+        dy = sh * ray_cos[k] + ch * ray_sin[k]
+        d, w = cast_one(pose[r, 0], pose[r, 1], dx, dy, ray_range[k], r, ray_mask[k], s_coords, s_ids, seg_on, s_start,
+                        d_xyr, d_ids, d_start, x0, y0, cell, nx, ny)  # fmt: skip
+        out_range[k] = d
+        out_hit[k] = w
+
+
+@njit(cache=True, parallel=True)
+def cast_rays_parallel(pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr,
+                       d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
+    """`cast_rays` over the cores, ray by ray: each ray takes its robot's heading afresh (the same
+    cosine and sine the serial pass computes once per robot), so the readings are the same."""
+    for k in prange(ray_robot.shape[0]):
+        r = ray_robot[k]
+        ch, sh = math.cos(pose[r, 2]), math.sin(pose[r, 2])
         dx = ch * ray_cos[k] - sh * ray_sin[k]
         dy = sh * ray_cos[k] + ch * ray_sin[k]
         d, w = cast_one(pose[r, 0], pose[r, 1], dx, dy, ray_range[k], r, ray_mask[k], s_coords, s_ids, seg_on, s_start,

@@ -15,10 +15,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from world_server.arena import raycast
 from world_server.arena.drive import DiffDrive
 from world_server.arena.face.sensors.zones import ZONE_KINDS
 from world_server.arena.metabolism import ACTS, Metabolism
-from world_server.arena.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, cast_rays, grid_shape
+from world_server.arena.raycast import MARK, NO_HIT, SOLID, build_disc_index, build_segment_index, grid_shape
 from world_server.arena.scenario import ArenaScenario
 from world_server.arena.sensors import Suite
 from world_server.arena.wheels import (
@@ -205,9 +206,10 @@ class ArenaWorld:
             mask = np.full(len(robot), SOLID | MARK, np.uint8)
         ranges = np.empty(len(robot))
         what = np.empty(len(robot), np.int64)
-        cast_rays(self.pose, robot.astype(np.int64), c, s, max_range, mask, self.s_coords, self.s_items, self.seg_on,
-                  self.s_start, self.d_xyr, self.d_items, self.d_start, 0.0, 0.0, self.cell, self.nx, self.ny,
-                  ranges, what)  # fmt: skip
+        cast = raycast.cast_rays_parallel if raycast.threads() > 1 else raycast.cast_rays
+        cast(self.pose, robot.astype(np.int64), c, s, max_range, mask, self.s_coords, self.s_items, self.seg_on,
+             self.s_start, self.d_xyr, self.d_items, self.d_start, 0.0, 0.0, self.cell, self.nx, self.ny,
+             ranges, what)  # fmt: skip
         return ranges, what
 
     def in_sight(self, robots: np.ndarray, others: np.ndarray, bearing: np.ndarray,

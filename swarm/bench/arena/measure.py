@@ -30,28 +30,28 @@ SIDE = 20.0
 LASER_BOT = RobotModel("laser64", 0.2, 0.3, 0.5, 0.5, 1.0, sensors=Sensors(laser=Laser(beams=64, range=8.0)))
 
 
-def bench_world(robots: int, model: RobotModel, obstacles: int = 100, seed: int = 1) -> ArenaWorld:
+def bench_world(robots: int, model: RobotModel, obstacles: int = 100, seed: int = 1, side: float = SIDE) -> ArenaWorld:
     rng = np.random.default_rng([seed, 0xBE4C])
-    walls = [Wall("rect", (0.0, 0.0, SIDE, 0.1)), Wall("rect", (0.0, SIDE - 0.1, SIDE, SIDE)),
-             Wall("rect", (0.0, 0.0, 0.1, SIDE)), Wall("rect", (SIDE - 0.1, 0.0, SIDE, SIDE))]  # fmt: skip
+    walls = [Wall("rect", (0.0, 0.0, side, 0.1)), Wall("rect", (0.0, side - 0.1, side, side)),
+             Wall("rect", (0.0, 0.0, 0.1, side)), Wall("rect", (side - 0.1, 0.0, side, side))]  # fmt: skip
     rects = []
     for _ in range(obstacles):
         w, h = rng.uniform(0.3, 1.5, 2)
-        x, y = rng.uniform(0.2, SIDE - 0.2 - w), rng.uniform(0.2, SIDE - 0.2 - h)
+        x, y = rng.uniform(0.2, side - 0.2 - w), rng.uniform(0.2, side - 0.2 - h)
         rects.append((x, y, x + w, y + h))
         walls.append(Wall("rect", rects[-1], (int(rng.integers(30, 255)),) * 3))
-    starts = _lattice(robots, model.radius, np.array(rects).reshape(-1, 4), rng)
+    starts = _lattice(robots, model.radius, np.array(rects).reshape(-1, 4), rng, side)
     group = Group(robots, "carrot", model, tuple(map(tuple, starts)), 0.0)
-    s = ArenaScenario("bench", "bench", (SIDE, SIDE), (group,), tuple(walls), seed=seed, max_ticks=10**9)
+    s = ArenaScenario("bench", "bench", (side, side), (group,), tuple(walls), seed=seed, max_ticks=10**9)
     return ArenaWorld(s)
 
 
-def _lattice(n: int, radius: float, rects: np.ndarray, rng) -> np.ndarray:
+def _lattice(n: int, radius: float, rects: np.ndarray, rng, side: float) -> np.ndarray:
     from world_server.arena.scenario import clearance_at
 
     spacing = 1.5
     while True:
-        g = np.arange(0.3, SIDE - 0.3, spacing)
+        g = np.arange(0.3, side - 0.3, spacing)
         xy = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
         xy = xy + rng.uniform(-0.05, 0.05, xy.shape) * min(spacing - 2 * radius, 0.1) * 10
         free = xy[clearance_at(xy, rects, np.zeros((0, 4))) > radius + 0.02]
@@ -116,9 +116,28 @@ def bench_arena(quick: bool = False) -> dict:
         bar.update()
     epuck = {"suite": "epuck", **_measure(bench_world(100, EPUCK), 100 if quick else 500)}
     bar.update()
+    cores = _cores(quick)
+    bar.update()
     bar.close()
     return {"world": f"{SIDE:g} x {SIDE:g} m, 100 obstacles 0.3-1.5 m, robots r = 0.2 m (e-pucks 37 mm)",
-            "rows": rows, "walls": walls, "epuck100": epuck}  # fmt: skip
+            "rows": rows, "walls": walls, "epuck100": epuck, "cores": cores}  # fmt: skip
+
+
+def _cores(quick: bool) -> list[dict]:
+    """Laser robots sensed on one core and on every core (`--threads 0`), 1000 and 10,000 of them (the
+    10,000 with 1000 obstacles in a 63 m square: as dense as the 1000 in 20 m; not with --quick)."""
+    from world_server.arena import raycast
+
+    rows = []
+    for n in (1000,) if quick else (1000, 10_000):
+        world = bench_world(n, LASER_BOT, obstacles=n // 10, side=SIDE * math.sqrt(n / 1000))
+        for threads in (1, 0):
+            try:
+                used = raycast.set_threads(threads)
+                rows.append({"robots": n, "threads": used, **_measure(world, 10 if quick else 30)})
+            finally:
+                raycast.set_threads(1)
+    return rows
 
 
 def format_arena_bench(result: dict) -> str:
@@ -135,6 +154,13 @@ def format_arena_bench(result: dict) -> str:
         lines.append(f"| {r['obstacles']} | {r['sense_ms']} | {r['rays_per_second']:,} | {r['physics_ms']} |")
     laser = next(r for r in result["rows"] if r["suite"] == "laser64" and r["robots"] == 1000)
     e = result["epuck100"]
+    lines += ["", "Laser robots on one core and on every core (--threads 0)", "",
+              "| robots | threads | sensing ms | speed-up | physics ms | ticks/s | rays/s |",
+              "|---|---|---|---|---|---|---|"]  # fmt: skip
+    one = {r["robots"]: r["sense_ms"] for r in result["cores"] if r["threads"] == 1}
+    for r in result["cores"]:
+        lines.append(f"| {r['robots']:,} | {r['threads']} | {r['sense_ms']} | {one[r['robots']] / r['sense_ms']:.2f} | "
+                     f"{r['physics_ms']} | {r['ticks_per_second']} | {r['rays_per_second']:,} |")  # fmt: skip
     lines += ["", f"targets: 1000 robots x 64-beam laser sensing {laser['sense_ms']} ms/tick (target <= 10 ms); "
               f"100 e-pucks whole tick {e['ticks_per_second']} ticks/s (target >= 500)"]  # fmt: skip
     return "\n".join(lines)
