@@ -329,7 +329,10 @@ class _Losses:
                 say(f"swarm: {self._what(p)}")
 
     def summary(self) -> dict:
-        """The launcher's own keys of the summary."""
+        """The launcher's own keys of the summary, only when an agent process died: a run without a
+        loss has the summary it always had."""
+        if not self.died:
+            return {}
         out = {"agent_processes_died": self.died}
         if self.on_loss == "respawn":
             out["agent_processes_replaced"] = self.replaced
