@@ -11,6 +11,8 @@ a family's controllers are and how their messages look is the subclass's:
 
 from __future__ import annotations
 
+import json
+import os
 import threading
 import time
 import uuid
@@ -30,8 +32,9 @@ class AgentRuntime:
 
     def __init__(self, run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
                  join_timeout: float = 60.0, idle_timeout: float = 120.0, null: bool = False,
-                 rejoin_after: float = 5.0, on_error: str = "idle"):  # fmt: skip
+                 rejoin_after: float = 5.0, on_error: str = "idle", ids_file: str | None = None):  # fmt: skip
         self.keys = wire.Keys(run_id)
+        self.ids_file = ids_file  # where our agents' ids go once joined (`swarm up` names them if we die)
         self.controller = controller
         self.on_error = on_error  # a controller that raises: its robot holds still, or the process stops
         self.null = null  # benchmark floor: answer without running the controller
@@ -53,6 +56,7 @@ class AgentRuntime:
         for slot in range(count):
             self.agents.append(self._join(join_timeout, slot))
         self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
+        self._tell_ids()
 
     # ------------------------------------------------------- hooks of a family
 
@@ -197,6 +201,16 @@ class AgentRuntime:
             except TimeoutError:
                 break
         self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
+        self._tell_ids()
+
+    def _tell_ids(self) -> None:
+        """Our agents' ids, as a JSON list in `ids_file` (replaced whole): the launcher reads them
+        to say which agents a process ran when it dies, and whether it had joined at all."""
+        if self.ids_file:
+            part = f"{self.ids_file}.part"
+            with open(part, "w") as f:
+                json.dump(self.agents, f)
+            os.replace(part, self.ids_file)
 
     def close(self) -> None:
         self._closed.set()

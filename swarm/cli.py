@@ -180,6 +180,7 @@ def _add_agent(sub) -> None:
     _client_args(agent)
     agent.add_argument("--count", type=positive, default=1, metavar="K", help="independent agents in this process")
     agent.add_argument("--null", action="store_true", help=argparse.SUPPRESS)  # benchmark floor
+    agent.add_argument("--ids-file", help=argparse.SUPPRESS)  # swarm up: where the agents' ids go once joined
     agent.add_argument("--join-timeout", type=float, default=60.0, metavar="S",
                        help="give up when no world has answered within S seconds (default 60)")  # fmt: skip
 
@@ -197,6 +198,16 @@ def _add_up(sub) -> None:
     up.add_argument("--listen", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router's endpoint")
     _record_args(up, "where the recording goes (default runs/<run-id>.rrd)")
     up.add_argument("--no-record", action="store_true", help="do not record the run")
+    loss = up.add_mutually_exclusive_group()
+    loss.add_argument("--respawn", action="store_true",
+                      help="an agent process that dies mid-run is replaced: the same command again, whose agents "
+                      "take the lost ones' places (by default the run goes on without them)")  # fmt: skip
+    loss.add_argument(
+        "--strict", action="store_true", help="an agent process that dies stops the whole run (exit status 2)"
+    )
+    up.add_argument("--max-respawns", type=positive, metavar="K",
+                    help="with --respawn: replace the agents of one process at most K times (default 3); a "
+                    "replacement that dies before its agents joined is not replaced")  # fmt: skip
 
 
 def _add_replay(sub) -> None:
@@ -458,7 +469,8 @@ def cmd_agent(args) -> int:
 
     try:
         runtime = make_runtime(args.run_id, args.controller, args.connect, args.count, null=args.null,
-                               join_timeout=args.join_timeout, on_error=args.on_controller_error)  # fmt: skip
+                               join_timeout=args.join_timeout, on_error=args.on_controller_error,
+                               ids_file=args.ids_file)  # fmt: skip
     except JoinRefused as exc:
         print(f"swarm: {exc}", file=sys.stderr)
         return 0 if ENDED in str(exc) else 2  # a late agent of a finished run has nothing to do
@@ -470,9 +482,11 @@ def cmd_agent(args) -> int:
 
 
 def cmd_up(args) -> int:
-    from swarm.launcher import swarm_up
+    from swarm.launcher import MAX_RESPAWNS, swarm_up
     from world_server.server import new_run_id
 
+    if args.max_respawns is not None and not args.respawn:
+        raise ScenarioError("command line", "--max-respawns", "needs --respawn")
     scenario = resolve_scenario(args)
     _check(scenario, args.until)
     run_id = args.run_id or new_run_id()
@@ -481,7 +495,9 @@ def cmd_up(args) -> int:
     summary = swarm_up(args.scenario, scenario.agents, seed=args.seed, run_id=run_id, listen=args.listen,
                        until=args.until, max_iterations=args.max_iterations, deadline=args.deadline,
                        progress=not args.json and sys.stderr.isatty(), mode=args.mode, rate=args.rate,
-                       record=record, viewer=args.viewer, **kind_options)  # fmt: skip
+                       record=record, viewer=args.viewer,
+                       on_loss="strict" if args.strict else "respawn" if args.respawn else "go-on",
+                       max_respawns=args.max_respawns or MAX_RESPAWNS, **kind_options)  # fmt: skip
     if summary.get("recording"):
         _point_at_recording(summary["recording"])
     return _print_any(summary, args.json, args.until)

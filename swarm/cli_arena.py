@@ -148,6 +148,10 @@ def print_arena_summary(summary: dict, as_json: bool, until: str | None = None) 
             print(f"  distributed ({summary['mode']}): {summary['ticks_per_second']} ticks/s, rejected messages "
                   f"{summary['rejected_messages']}, agents joined {summary['joins']}, lost {summary['agents_lost']}, "
                   f"missed ticks {summary['missed_ticks']}")  # fmt: skip
+        if summary.get("agent_processes_died"):  # swarm up: agent processes that died and the run went on
+            replaced = summary.get("agent_processes_replaced")
+            print(f"  agent processes died {summary['agent_processes_died']}"
+                  f"{'' if replaced is None else f', replacements started {replaced}'}")  # fmt: skip
     return 0 if summary["finished"] else 1
 
 

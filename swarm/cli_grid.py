@@ -71,4 +71,8 @@ def print_grid_summary(summary: dict, as_json: bool, until: str) -> int:
                 f"agents joined {summary['joins']} (at most {summary.get('agents_peak')} at once), "
                 f"lost {summary['agents_lost']}, missed ticks {summary['missed_ticks']}"
             )
+        if summary.get("agent_processes_died"):  # swarm up: agent processes that died and the run went on
+            replaced = summary.get("agent_processes_replaced")
+            print(f"  agent processes died {summary['agent_processes_died']}"
+                  f"{'' if replaced is None else f', replacements started {replaced}'}")  # fmt: skip
     return 0 if summary["finished"] else 1

@@ -59,12 +59,13 @@ def test_an_agent_that_cannot_reach_the_router(tmp_path):
     assert ".rs:" not in line  # zenoh's source locations are not the user's business
 
 
-def test_an_agent_process_that_dies_stops_the_run(tmp_path):
-    """A real-time run at 20 ticks/s lasts many minutes: kill one agent process mid-run."""
+def test_with_strict_an_agent_process_that_dies_stops_the_run(tmp_path):
+    """A real-time run at 20 ticks/s lasts many minutes: kill one agent process mid-run.  Without
+    --strict the run goes on (tests/test_up_losses.py)."""
     run = f"killed{os.getpid()}"
-    up = subprocess.Popen([*SWARM, "up", "setup1", "--agents", "2", "--no-record", "--mode", "realtime", "--run-id",
-                           run, "--listen", free_endpoint()], cwd=tmp_path, stderr=subprocess.PIPE, text=True,
-                          start_new_session=True)  # fmt: skip
+    up = subprocess.Popen([*SWARM, "up", "setup1", "--agents", "2", "--no-record", "--mode", "realtime", "--strict",
+                           "--run-id", run, "--listen", free_endpoint()], cwd=tmp_path, stderr=subprocess.PIPE,
+                          text=True, start_new_session=True)  # fmt: skip
     try:
         deadline = time.monotonic() + 180
         agents: list[int] = []

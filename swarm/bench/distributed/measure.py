@@ -37,8 +37,9 @@ def _one(agents: int, ticks: int, per_process: int, null: bool, port: int) -> di
     and a real run timed over fewer ticks than the floor beside it would
     weigh the first ticks' warm-up more."""
     run_id = f"bench{new_run_id()}"  # fresh: never resume an earlier bench's saved state
+    # strict: an agent process lost would skew the measurement, so it stops the run
     s = swarm_up("setup1", agents, "cmarking", 1, run_id, f"tcp/127.0.0.1:{port}", "both", ticks,
-                 deadline=10.0, progress=False, per_process=per_process, null=null)  # fmt: skip
+                 deadline=10.0, progress=False, per_process=per_process, null=null, on_loss="strict")  # fmt: skip
     steps = max(1, s["agent_steps"])
     return {"agents": agents, "per_process": per_process, "null": null, "ticks": s["iterations"],
             "ticks_per_second": s["ticks_per_second"], "agent_steps_per_second": round(s["ticks_per_second"] * agents),

@@ -99,7 +99,7 @@ def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int
             path = tmp / f"{run_id}.rrd"
             s = swarm_up("setup1", agents, "cmarking", 1, run_id, f"tcp/127.0.0.1:{port + record}", deadline=10.0,
                          max_iterations=max_ticks, progress=False, per_process=per_process,
-                         record=str(path) if record else None)  # fmt: skip
+                         record=str(path) if record else None, on_loss="strict")  # fmt: skip
             rates[record].append(s["ticks_per_second"])
             if record:
                 size, ticks = path.stat().st_size, s["iterations"]
