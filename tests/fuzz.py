@@ -77,28 +77,27 @@ def tally_table() -> str:
 
 
 @contextmanager
-def guarded(data_size: int = 0) -> Iterator[None]:
-    """Fail on a hang (SIGALRM after HANG_SECONDS) or an allocation far beyond the input (a claimed length
-    believed).  Main thread only, as pytest runs tests."""
+def guarded(data_size: int | None = None) -> Iterator[None]:
+    """Fail on a hang (SIGALRM after HANG_SECONDS) and, given the input's size, on an allocation far beyond
+    it (a claimed length believed).  Main thread only, as pytest runs tests."""
 
     def hang(signum, frame):
         raise TimeoutError(f"no answer within {HANG_SECONDS} s")
 
     previous = signal.signal(signal.SIGALRM, hang)
     signal.setitimer(signal.ITIMER_REAL, HANG_SECONDS)
-    started = tracemalloc.is_tracing()
-    if not started:
+    tracing = data_size is not None and not tracemalloc.is_tracing()
+    if tracing:
         tracemalloc.start()
-    tracemalloc.reset_peak()
-    before = tracemalloc.get_traced_memory()[0]
     try:
         yield
-        peak = tracemalloc.get_traced_memory()[1] - before
-        assert peak <= 4 * data_size + ALLOCATION_SLACK, f"{peak} bytes allocated for a {data_size}-byte input"
+        if tracing:
+            peak = tracemalloc.get_traced_memory()[1]
+            assert peak <= 4 * data_size + ALLOCATION_SLACK, f"{peak} bytes allocated for a {data_size}-byte input"
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
-        if not started:
+        if tracing:
             tracemalloc.stop()
 
 
@@ -209,7 +208,7 @@ def _mutate_value(draw, old: Any) -> Any:
 
 
 @st.composite
-def _mutate_tree(draw, tree: Any) -> Any:
+def mutate_tree(draw, tree: Any) -> Any:
     places = _places(tree, [])
     if not places:
         return draw(values())
@@ -257,7 +256,7 @@ def mutated(draw, valid: bytes | st.SearchStrategy) -> bytes:
     if draw(st.integers(0, 3)):
         tree = _tree(data)
         for _ in range(draw(st.integers(1, 2))):
-            tree = draw(_mutate_tree(tree))
+            tree = draw(mutate_tree(tree))
         with suppress(OverflowError, TypeError, ValueError):  # an int msgpack cannot hold: left as it was
             data = _pack(tree)
     if draw(st.integers(0, 3)) == 0:
