@@ -36,6 +36,7 @@ HANG_SECONDS = 10.0  # one input decoded (or one scenario parsed) longer than th
 ALLOCATION_SLACK = 4 * 1024 * 1024  # bytes a decoder may allocate beyond a few copies of its input
 
 TALLY: Counter = Counter()  # (decoder, reason) -> rejections seen in this process
+ACCEPTED: Counter = Counter()  # decoder -> inputs it decoded
 
 # ----------------------------------------------------------------- reasons
 
@@ -64,13 +65,16 @@ def check(decoder: str, result: Any, accepted: type | tuple, reasons: list[re.Pa
         TALLY[decoder, reason] += 1
     else:
         assert isinstance(result, accepted), f"{decoder} gave a {type(result).__name__}"
+        ACCEPTED[decoder] += 1
     return result
 
 
 def tally_table() -> str:
-    """The rejections counted so far, by decoder and reason (most frequent first)."""
+    """The inputs decoded and the rejections counted so far, by decoder and reason (most frequent first)."""
     width = max((len(d) for d, _ in TALLY), default=0)
-    return "\n".join(f"{count:8d}  {d:<{width}}  {reason}" for (d, reason), count in TALLY.most_common())
+    rows = [(count, d, "(decoded)") for d, count in ACCEPTED.most_common()]
+    rows += [(count, d, reason) for (d, reason), count in TALLY.most_common()]
+    return "\n".join(f"{count:8d}  {d:<{width}}  {reason}" for count, d, reason in rows)
 
 
 # ------------------------------------------------------------ the guard

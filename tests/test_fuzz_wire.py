@@ -27,7 +27,7 @@ NONCE = "0123456789abcdef"
 def _report_tally():
     """The rejections by reason, printed after the module (seen with `-s`); every decoder rejected something."""
     yield
-    print(f"\nrejections by decoder and reason ({sum(TALLY.values())} in all):\n{tally_table()}")
+    print(f"\ninputs decoded and rejections by decoder and reason ({sum(TALLY.values())} rejections):\n{tally_table()}")
 
 
 def _rng(seed: int) -> np.random.Generator:
