@@ -93,17 +93,16 @@ class AgentRuntime:
                 if not reply.ok:
                     continue
                 data, reply = reply.ok.payload.to_bytes(), None  # zenoh's copy goes: a welcome may carry MBs
-                msg, data = wire.unpack(data, wire.MAX_WELCOME_BYTES), None
+                msg, data = wire.parse_welcome(data, nonce), None
                 if isinstance(msg, wire.Rejected):
                     continue
-                if msg.get("type") == "refused":
-                    raise JoinRefused(f"the world refused this agent: {msg.get('reason')}")
-                if msg.get("type") == "welcome" and msg.get("nonce") == nonce:
-                    agent = int(msg["agent"])
-                    self.lockstep = bool(msg.get("lockstep"))
-                    self._welcomed(slot, agent, msg)
-                    self.tokens[agent] = self.session.liveliness().declare_token(self.keys.alive(agent))
-                    return agent
+                if msg["type"] == "refused":
+                    raise JoinRefused(f"the world refused this agent: {msg['reason']}")
+                agent = msg["agent"]
+                self.lockstep = bool(msg.get("lockstep"))
+                self._welcomed(slot, agent, msg)
+                self.tokens[agent] = self.session.liveliness().declare_token(self.keys.alive(agent))
+                return agent
             time.sleep(0.2)
         raise TimeoutError(f"no world answered on {self.keys.join} within {timeout:.0f} s")
 

@@ -212,6 +212,24 @@ def parse_join(data: bytes) -> dict | Rejected:
     return m
 
 
+def parse_welcome(data: bytes, nonce: str) -> dict | Rejected:
+    """The world's answer to the join `nonce`: a welcome (its agent id, seed and params checked; the rest
+    is the family's) or a refusal (with its reason).  Anything else, or a welcome for another join, is
+    a reason, and the agent asks again."""
+    m = unpack(data, MAX_WELCOME_BYTES)
+    if isinstance(m, Rejected):
+        return m
+    if m.get("type") == "refused":
+        return m if isinstance(m.get("reason"), str) else Rejected("refused: expected a reason")
+    if m.get("type") != "welcome" or m.get("nonce") != nonce:
+        return Rejected("not a welcome for this join")
+    if bad := first_rejection(int_field(m, "agent"), int_field(m, "seed", -INT64_MAX - 1)):
+        return bad
+    if not isinstance(m.get("params"), list | dict):
+        return Rejected("params: expected a list or a map")
+    return m
+
+
 def world_info(session, keys: Keys, timeout: float = 2.0) -> dict | None:
     """The world's answer on swarm/<run>/info, or None if no world answers."""
     for reply in session.get(keys.info, timeout=timeout):

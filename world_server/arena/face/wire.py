@@ -219,7 +219,8 @@ def _memory_pieces(memory: Memories | MemoryPieces) -> list:
 
 
 def _decode(entry) -> np.ndarray | Rejected:
-    if not (isinstance(entry, list) and len(entry) == 3 and entry[0] in DTYPES and isinstance(entry[2], bytes)):
+    if not (isinstance(entry, list) and len(entry) == 3 and isinstance(entry[0], str) and entry[0] in DTYPES
+            and isinstance(entry[2], bytes)):  # fmt: skip
         return Rejected("perception: expected [dtype, shape, bytes]")
     kind, shape, raw = entry
     if not (isinstance(shape, list) and len(shape) <= MAX_DIMS
@@ -375,8 +376,8 @@ def parse_record(data: bytes) -> Record | Rejected:
         return values
     if not isinstance(values, dict) or not all(isinstance(k, str) for k in values):
         return Rejected("record: expected a map of names to numbers and arrays")
-    for key, value in values.items():
+    for value in values.values():  # the reason names no key: the world counts reasons by their text
         if not (isinstance(value, float) or (isinstance(value, np.ndarray) and value.dtype == np.float64
                 and 1 <= value.ndim <= 2)):  # fmt: skip
-            return Rejected(f"record: {key!r} is not a number or a numeric array of 1 or 2 dimensions")
+            return Rejected("record: a value is not a number or a numeric array of 1 or 2 dimensions")
     return Record(tick, agent, values)
