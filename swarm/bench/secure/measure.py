@@ -13,6 +13,8 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import zenoh
+
 from swarm.core import credentials
 from swarm.core.bus import open_client, open_router
 from swarm.core.wire import Keys
@@ -77,14 +79,15 @@ def _wrong_password(folder: Path, name: str, into: Path) -> credentials.Identity
 
 
 def _stream(endpoint: str, identity: credentials.Identity | None, router_identity, puts: int) -> float:
-    """Puts per second from one agent process to the world's subscriber, all of them heard."""
+    """Puts per second from one agent process to the world's subscriber, counted as heard (by the
+    router's own session: the world of `swarm up`)."""
     keys = Keys(RUN)
     router = open_router(endpoint, router_identity)
     heard = _Heard(router)
     agent = open_client(endpoint, identity=identity)
     try:
         key = keys.act(credentials.agent_name(1))
-        pub = agent.declare_publisher(key)
+        pub = agent.declare_publisher(key, congestion_control=zenoh.CongestionControl.BLOCK)  # none dropped
         time.sleep(0.3)
         start = time.perf_counter()
         for _ in range(puts):
