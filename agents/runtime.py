@@ -19,6 +19,7 @@ import uuid
 
 from swarm.core import wire
 from swarm.core.bus import DEFAULT_ENDPOINT, open_client
+from swarm.core.credentials import Identity, own_group
 from swarm.core.errors import RunError
 from swarm.core.wire import world_info
 
@@ -32,7 +33,8 @@ class AgentRuntime:
 
     def __init__(self, run_id: str, controller: str, connect: str = DEFAULT_ENDPOINT, count: int = 1,
                  join_timeout: float = 60.0, idle_timeout: float = 120.0, null: bool = False,
-                 rejoin_after: float = 5.0, on_error: str = "idle", ids_file: str | None = None):  # fmt: skip
+                 rejoin_after: float = 5.0, on_error: str = "idle", ids_file: str | None = None,
+                 identity: Identity | None = None):  # fmt: skip
         self.keys = wire.Keys(run_id)
         self.ids_file = ids_file  # where our agents' ids go once joined (`swarm up` names them if we die)
         self.controller = controller
@@ -40,8 +42,9 @@ class AgentRuntime:
         self.null = null  # benchmark floor: answer without running the controller
         self._prepare(count)  # before joining: the world observes us at once
         self.idle_timeout = idle_timeout
-        self.session = open_client(connect, timeout=join_timeout)
-        self.group = uuid.uuid4().hex  # this process: its agents' messages travel together
+        self.session = open_client(connect, timeout=join_timeout, identity=identity)
+        # this process: its agents' messages travel together (a secure run's router lets it put on its own only)
+        self.group = own_group(identity) or uuid.uuid4().hex
         # Subscribed before joining: the world starts observing an agent as soon as it sees its token.
         # A FIFO channel read by the main thread: no Python callback thread between zenoh and the step.
         self.inbox = self.session.declare_subscriber(self.keys.obs(self.group))

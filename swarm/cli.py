@@ -11,6 +11,7 @@ from pathlib import Path
 from agents.controllers import CONTROLLERS as CONTROLLER_REGISTRY
 from swarm.cli_check import add_check_parsers
 from swarm.cli_reproduce import add_reproduce_parser, cmd_reproduce
+from swarm.cli_secure import add_credentials_parser, credentials_arg, identity, up_args
 from swarm.cli_sweep import add_sweep_parser
 from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_interrupt
 from swarm.core.registry import Option, Registry, resolve
@@ -87,6 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_status(sub)
     add_check_parsers(sub)
     _add_router(sub)
+    add_credentials_parser(sub)
     _add_prepare(sub)
     for kind in WORLD_KINDS:  # a world kind's own commands (swarm sense); each sets its handler
         for add_command in kind.commands:
@@ -160,6 +162,7 @@ def _add_world(sub) -> None:
     world.add_argument("--linger", type=float, default=0.0, metavar="S",
                        help="keep serving swarm/<run-id>/marks/** for S seconds after the run")  # fmt: skip
     _record_args(world, "write a rerun recording of the run to FILE (.rrd), or into FOLDER/ as <run-id>-<UTC time>.rrd")
+    credentials_arg(world, "`router` when it hosts the router, `world` with --connect")
 
 
 def _add_agent(sub) -> None:
@@ -208,6 +211,7 @@ def _add_up(sub) -> None:
     up.add_argument("--max-respawns", type=positive, metavar="K",
                     help="with --respawn: replace the agents of one process at most K times (default 3); a "
                     "replacement that dies before its agents joined is not replaced")  # fmt: skip
+    up_args(up)
 
 
 def _add_replay(sub) -> None:
@@ -273,6 +277,7 @@ def _add_router(sub) -> None:
     )
     router.add_argument("--listen", default="tcp/0.0.0.0:7447", metavar="ENDPOINT",
                         help="where to listen (default tcp/0.0.0.0:7447)")  # fmt: skip
+    credentials_arg(router, "`router`: check logins and enforce the access rules")
 
 
 def _add_prepare(sub) -> None:
@@ -358,6 +363,7 @@ def _client_args(p: argparse.ArgumentParser) -> None:
     """Where a client of a running world finds it: agents, monitor, status."""
     p.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
     p.add_argument("--run-id", default="default", help="the world's run id (default: default)")
+    credentials_arg(p, "`agent<i>` for agent process i, `monitor` for monitor and status")
 
 
 def _tick_args(p: argparse.ArgumentParser) -> None:
@@ -458,7 +464,8 @@ def cmd_world(args) -> int:
                     max_iterations=args.max_iterations, linger=args.linger,
                     start_timeout=args.start_timeout, null=args.null,
                     state_dir=args.state_dir, persist_every=args.persist_every, mode=args.mode,
-                    rate=args.rate, record=args.record, viewer=_viewer_url(args.viewer))  # fmt: skip
+                    rate=args.rate, record=args.record, viewer=_viewer_url(args.viewer),
+                    identity=identity(args))  # fmt: skip
     return _print_any(summary, args.json, args.until)
 
 
@@ -470,7 +477,7 @@ def cmd_agent(args) -> int:
     try:
         runtime = make_runtime(args.run_id, args.controller, args.connect, args.count, null=args.null,
                                join_timeout=args.join_timeout, on_error=args.on_controller_error,
-                               ids_file=args.ids_file)  # fmt: skip
+                               ids_file=args.ids_file, identity=identity(args))  # fmt: skip
     except JoinRefused as exc:
         print(f"swarm: {exc}", file=sys.stderr)
         return 0 if ENDED in str(exc) else 2  # a late agent of a finished run has nothing to do
@@ -495,7 +502,7 @@ def cmd_up(args) -> int:
     summary = swarm_up(args.scenario, scenario.agents, seed=args.seed, run_id=run_id, listen=args.listen,
                        until=args.until, max_iterations=args.max_iterations, deadline=args.deadline,
                        progress=not args.json and sys.stderr.isatty(), mode=args.mode, rate=args.rate,
-                       record=record, viewer=args.viewer,
+                       record=record, viewer=args.viewer, secure=args.secure, credentials=args.credentials,
                        on_loss="strict" if args.strict else "respawn" if args.respawn else "go-on",
                        max_respawns=args.max_respawns or MAX_RESPAWNS, **kind_options)  # fmt: skip
     if summary.get("recording"):
@@ -568,14 +575,14 @@ def cmd_monitor(args) -> int:
     from swarm.monitor import monitor
 
     summary = monitor(args.connect, args.run_id, progress=not args.json and sys.stderr.isatty(),
-                      log_every=args.log_every, start_timeout=args.start_timeout)  # fmt: skip
+                      log_every=args.log_every, start_timeout=args.start_timeout, identity=identity(args))  # fmt: skip
     return _print_any(summary, args.json, summary.get("until", "foraged"))
 
 
 def cmd_status(args) -> int:
     from swarm.monitor import status
 
-    info = status(args.connect, args.run_id, router_only=args.router, timeout=args.timeout)
+    info = status(args.connect, args.run_id, router_only=args.router, timeout=args.timeout, identity=identity(args))
     if info is None:
         what = f"router at {args.connect}" if args.router else f"world of run {args.run_id!r} via {args.connect}"
         print(f"swarm: no {what} answered", file=sys.stderr)
@@ -595,7 +602,7 @@ def cmd_status(args) -> int:
 def cmd_router(args) -> int:
     from swarm.monitor import serve_router
 
-    serve_router(args.listen)
+    serve_router(args.listen, identity(args))
     return 0
 
 

@@ -32,6 +32,8 @@ from pathlib import Path
 from agents.controllers import aot
 from swarm.core import wire
 from swarm.core.bus import open_client
+from swarm.core.credentials import MONITOR, ROUTER, Identity, agent_name, identity_in
+from swarm.core.credentials import make as make_credentials
 from swarm.core.errors import RunError, raise_interrupt
 from swarm.core.registry import resolve
 from swarm.scenario import load_scenario
@@ -61,7 +63,7 @@ def swarm_up(
     per_process: int = 1, null: bool = False, mode: str = "lockstep", rate: float = 20.0,
     physics: PhysicsParams | None = None, record: str | None = None, viewer: str | None = None,
     world_args: list[str] | None = None, agent_args: list[str] | None = None, on_loss: str = "go-on",
-    max_respawns: int = MAX_RESPAWNS,
+    max_respawns: int = MAX_RESPAWNS, secure: bool = False, credentials: str | None = None,
 ) -> dict:  # fmt: skip
     """Run the swarm as processes; `per_process` agents share one agent process
     (`swarm agent --count`), `null` runs the benchmark floor (messaging only).
@@ -69,7 +71,9 @@ def swarm_up(
     each group's agents run its own).  `on_loss`: an agent process that dies
     mid-run is a loss the run goes on without ("go-on"), is replaced by a new
     one, at most `max_respawns` times for the agents of one process
-    ("respawn"), or stops the run ("strict")."""
+    ("respawn"), or stops the run ("strict").  `secure` makes the run's
+    credentials (swarm/core/credentials.py) or uses those in the folder `credentials`:
+    the router checks every login and enforces swarm/core/acl.py's rules."""
     if agents % per_process:
         raise ValueError(f"{agents} agents do not split into processes of {per_process}")
     if on_loss not in ON_LOSS:
@@ -100,6 +104,7 @@ def swarm_up(
             null,
             agent_args or [],
             _Losses(on_loss, max_respawns, let_go=3 * deadline + 10.0),
+            credentials if credentials is not None or not secure else "",
         )
     finally:
         signal.signal(signal.SIGTERM, previous)
@@ -140,7 +145,8 @@ def _agent_counts(scenario_ref: str, agents: int, controller: str | None) -> lis
 
 
 def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null,
-              agent_args, losses: _Losses) -> dict:  # fmt: skip
+              agent_args, losses: _Losses, credentials: str | None) -> dict:  # fmt: skip
+    """`credentials`: None for a plain run, "" to make them, else the folder that holds them."""
     prepare(scenario_ref, progress)
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
@@ -157,11 +163,16 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
             agent_cmds += [cmd + (["--null"] if null else [])] * (n // per_process)
         if null:
             world_cmd.append("--null")
+        folder = None
+        if credentials is not None:
+            folder = Path(credentials) if credentials else make_credentials(Path(tmp) / "credentials", len(agent_cmds),
+                                                                            hosts=(_host_of(listen),))  # fmt: skip
+            world_cmd, agent_cmds = _secured(folder, world_cmd, agent_cmds)
         children = _Children(Path(tmp), run_id)
         session = None
         try:
             world = children.start("the world", world_cmd)
-            session = _connect(listen, world)
+            session = _connect(listen, world, identity_in(folder, MONITOR) if folder else None)
             rss = {}
             if session is not None:  # None: the world is already done (e.g. it resumed a finished run)
                 for i, cmd in enumerate(agent_cmds):
@@ -386,12 +397,27 @@ class _Losses:
                 f"(replacement {self.generation[new.pid]} of at most {self.max_respawns})")  # fmt: skip
 
 
-def _connect(listen: str, world: subprocess.Popen, timeout: float = 300.0):
+def _secured(folder: Path, world_cmd: list[str], agent_cmds: list[list[str]]):
+    """The commands, each given its own identity: the world hosts the router, agent process i is `agent<i>`."""
+    names = [ROUTER, *(agent_name(i + 1) for i in range(len(agent_cmds)))]
+    for name in names:
+        identity_in(folder, name)  # a one-line error now, not a child's failure later
+    world_cmd = [*world_cmd, "--credentials", str(folder / ROUTER)]
+    agent_cmds = [[*cmd, "--credentials", str(folder / name)] for cmd, name in zip(agent_cmds, names[1:], strict=True)]
+    return world_cmd, agent_cmds
+
+
+def _host_of(endpoint: str) -> str:
+    """The host of `proto/host:port` ([v6] unbracketed): the name the router's certificate must carry."""
+    return endpoint.split("/", 1)[-1].rsplit(":", 1)[0].strip("[]")
+
+
+def _connect(listen: str, world: subprocess.Popen, identity: Identity | None = None, timeout: float = 300.0):
     """A client session to the world's router, or None if the world exits first."""
     deadline = time.monotonic() + timeout
     while world.poll() is None:
         try:
-            return open_client(listen, timeout=2.0)
+            return open_client(listen, timeout=2.0, identity=identity)
         except ConnectionError:
             if time.monotonic() > deadline:
                 raise

@@ -17,14 +17,16 @@ import time
 
 from swarm.core import wire
 from swarm.core.bus import open_client, open_router
+from swarm.core.credentials import Identity
 from swarm.core.wire import world_info
 from world_server import progress_keys
 
 
-def status(connect: str, run_id: str, router_only: bool = False, timeout: float = 3.0) -> dict | None:
+def status(connect: str, run_id: str, router_only: bool = False, timeout: float = 3.0,
+           identity: Identity | None = None) -> dict | None:  # fmt: skip
     """{"router": ...} if only the router is asked, else the world's info; None if nobody answers."""
     try:
-        session = open_client(connect, timeout=timeout)
+        session = open_client(connect, timeout=timeout, identity=identity)
     except ConnectionError:
         return None
     try:
@@ -35,9 +37,10 @@ def status(connect: str, run_id: str, router_only: bool = False, timeout: float 
         session.close()
 
 
-def serve_router(listen: str) -> None:
-    """A bare zenoh router until SIGTERM or Ctrl-C."""
-    session = open_router(listen)
+def serve_router(listen: str, identity: Identity | None = None) -> None:
+    """A bare zenoh router until SIGTERM or Ctrl-C; with `identity` (the `router` folder) it checks
+    logins and enforces the access rules."""
+    session = open_router(listen, identity)
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     print(f"swarm: zenoh router listening on {listen}", file=sys.stderr, flush=True)
@@ -48,7 +51,8 @@ def serve_router(listen: str) -> None:
         session.close()
 
 
-def monitor(connect: str, run_id: str, progress: bool, log_every: float = 5.0, start_timeout: float = 600.0) -> dict:
+def monitor(connect: str, run_id: str, progress: bool, log_every: float = 5.0, start_timeout: float = 600.0,
+            identity: Identity | None = None) -> dict:  # fmt: skip
     """Follow a run until its world says it has ended; returns the final summary.
 
     Progress goes to stderr: a bar on a terminal, else one line every
@@ -58,7 +62,7 @@ def monitor(connect: str, run_id: str, progress: bool, log_every: float = 5.0, s
     from tqdm import tqdm
 
     keys = wire.Keys(run_id)
-    session = open_client(connect, timeout=start_timeout)
+    session = open_client(connect, timeout=start_timeout, identity=identity)
     states: queue.Queue = queue.Queue()
     sub = session.declare_subscriber(keys.state, states.put)
     bar = tqdm(desc="delivered", unit="unit", disable=not progress, leave=False)

@@ -8,7 +8,9 @@ import socket
 import subprocess
 import sys
 import threading
+from pathlib import Path
 
+from swarm.core.credentials import agent_name
 from swarm.world_process import make_server
 
 
@@ -18,10 +20,13 @@ def free_endpoint() -> str:
         return f"tcp/127.0.0.1:{s.getsockname()[1]}"
 
 
-def start_agents(endpoint: str, run_id: str, controller: str, n: int, count: int = 1) -> list[subprocess.Popen]:
+def start_agents(endpoint: str, run_id: str, controller: str, n: int, count: int = 1,
+                 credentials: Path | None = None) -> list[subprocess.Popen]:  # fmt: skip
+    """`credentials`: a secure run's folder; process i gets the identity agent<i>."""
     cmd = [sys.executable, "-m", "swarm", "agent", "--connect", endpoint, "--run-id", run_id,
            "--controller", controller, "--count", str(count)]  # fmt: skip
-    return [subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for _ in range(n)]
+    own = [[] if credentials is None else ["--credentials", str(credentials / agent_name(i + 1))] for i in range(n)]
+    return [subprocess.Popen(cmd + own[i], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for i in range(n)]
 
 
 def stop(procs: list[subprocess.Popen]) -> None:

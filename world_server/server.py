@@ -29,6 +29,7 @@ import zenoh
 
 from swarm.core import wire
 from swarm.core.bus import open_client, open_router
+from swarm.core.credentials import Identity
 from swarm.core.errors import ScenarioError
 
 # JOINING: welcomed, but its observation subscriber may not be routed yet; it is
@@ -142,7 +143,7 @@ class WorldServer:
 
     def __init__(
         self, kind: Callable[[WorldServer], WorldKind], scenario, run_id: str, listen: str | None = None,
-        connect: str | None = None,
+        connect: str | None = None, identity: Identity | None = None,
         deadline: float = 2.0, max_misses: int = 3, start_with: int | None = None, start_timeout: float = 60.0,
         until: str = "foraged", max_iterations: int = 1_000_000, null: bool = False,
         state_dir: str | None = None, persist_every: int = 50, resume_timeout: float = 30.0,
@@ -176,7 +177,7 @@ class WorldServer:
         self.resumed = self.kind.resume()
         self.recording_path: str | None = None
         self.recorder = None if null or not record else self._recorder(record, viewer)
-        self._open_session(listen, connect)
+        self._open_session(listen, connect, identity)
 
     def _init_bookkeeping(self) -> None:
         """Traffic and timing counters, the agent slots and their message groups, and the event queue."""
@@ -200,9 +201,11 @@ class WorldServer:
         self.events: queue.SimpleQueue = queue.SimpleQueue()
         self.started = 0.0
 
-    def _open_session(self, listen: str | None, connect: str | None) -> None:
-        """The zenoh session, with the join, info, action, liveliness, shared and state keys declared."""
-        self.session = open_client(connect) if connect else open_router(listen or "tcp/127.0.0.1:7447")
+    def _open_session(self, listen: str | None, connect: str | None, identity: Identity | None) -> None:
+        """The zenoh session, with the join, info, action, liveliness, shared and state keys declared.
+        `identity`: a secure run's credentials (the router's when hosting it, the world's when joining one)."""
+        self.session = (open_client(connect, identity=identity) if connect
+                        else open_router(listen or "tcp/127.0.0.1:7447", identity))  # fmt: skip
         put = self.events.put
         k = self.keys
         self._decls = [

@@ -3,6 +3,12 @@
 Facts this relies on (zenoh-python 1.x): sessions must be closed explicitly;
 callbacks run on zenoh's threads, so they only enqueue; sessions do not
 survive fork (agents are started with `spawn` or as separate commands).
+
+With an `Identity` (swarm/core/credentials.py) a session logs in with its
+user and password, and on `tls/` endpoints shows its certificate and checks
+the router's against the run's CA; a router with one checks every login
+against its dictionary and enforces swarm/core/acl.py's rules.  Without one,
+nothing is added: plain runs are configured exactly as before.
 """
 
 from __future__ import annotations
@@ -13,10 +19,14 @@ import time
 
 import zenoh
 
+from swarm.core.acl import access_control
+from swarm.core.credentials import Identity
+
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 
 
-def config(mode: str, listen: list[str] | None = None, connect: list[str] | None = None) -> zenoh.Config:
+def config(mode: str, listen: list[str] | None = None, connect: list[str] | None = None,
+           identity: Identity | None = None) -> zenoh.Config:  # fmt: skip
     c = zenoh.Config()
     c.insert_json5("mode", json.dumps(mode))
     c.insert_json5("scouting/multicast/enabled", "false")
@@ -29,7 +39,24 @@ def config(mode: str, listen: list[str] | None = None, connect: list[str] | None
         c.insert_json5("connect/endpoints", json.dumps(connect))
         # Fail over to retries here rather than hang: the router may still be starting.
         c.insert_json5("connect/timeout_ms", "2000")
+    if identity is not None:
+        _secure(c, mode, [*(listen or []), *(connect or [])], identity)
     return c
+
+
+def _secure(c: zenoh.Config, mode: str, endpoints: list[str], me: Identity) -> None:
+    """Login, TLS certificates and, for a router, the dictionary and the access rules."""
+    tls = any(e.startswith("tls/") for e in endpoints)
+    login = {"user": me.name, "password": me.password}
+    if mode == "router":
+        login["dictionary_file"] = str(me.users_file)
+        c.insert_json5("access_control", json.dumps(access_control(me.users(), tls)))
+    c.insert_json5("transport/auth/usrpwd", json.dumps(login))
+    if tls:
+        side = "listen" if mode == "router" else "connect"
+        c.insert_json5("transport/link/tls", json.dumps({
+            "root_ca_certificate": str(me.ca), "enable_mtls": True,
+            f"{side}_certificate": str(me.cert), f"{side}_private_key": str(me.key)}))  # fmt: skip
 
 
 def _said(exc: Exception) -> str:
@@ -37,25 +64,27 @@ def _said(exc: Exception) -> str:
     return re.sub(r" at /\S+\.rs:\d+\.?", "", str(exc))
 
 
-def open_router(listen: str = DEFAULT_ENDPOINT) -> zenoh.Session:
+def open_router(listen: str = DEFAULT_ENDPOINT, identity: Identity | None = None) -> zenoh.Session:
     """A session in router mode: the embedded router every other process joins."""
     try:
-        return zenoh.open(config("router", listen=[listen]))
+        return zenoh.open(config("router", listen=[listen], identity=identity))
     except zenoh.ZError as exc:
         raise ConnectionError(
             f"cannot listen on {listen} ({_said(exc)}); is another world running? pick another --listen"
         ) from None
 
 
-def open_client(connect: str = DEFAULT_ENDPOINT, timeout: float = 30.0) -> zenoh.Session:
+def open_client(connect: str = DEFAULT_ENDPOINT, timeout: float = 30.0, identity: Identity | None = None
+                ) -> zenoh.Session:  # fmt: skip
     """A client session, retried until the router answers or `timeout` passes."""
     deadline = time.monotonic() + timeout
     while True:
         try:
-            return zenoh.open(config("client", connect=[connect]))
+            return zenoh.open(config("client", connect=[connect], identity=identity))
         except zenoh.ZError as exc:
             if time.monotonic() > deadline:
-                raise ConnectionError(
-                    f"no zenoh router at {connect} after {timeout:.0f} s ({_said(exc)}); start `swarm world` first"
-                ) from None
+                hint = (f"or it refused the credentials of {identity.name!r}" if identity is not None
+                        else "start `swarm world` first")  # fmt: skip
+                raise ConnectionError(f"no zenoh router at {connect} after {timeout:.0f} s ({_said(exc)}); {hint}"
+                                      ) from None  # fmt: skip
             time.sleep(0.2)

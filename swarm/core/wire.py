@@ -47,8 +47,9 @@ ENDED = "the run has ended"  # the world's refusal to a join after the run (the 
 class Keys:
     """Key expressions of one run."""
 
-    def __init__(self, run: str):
-        if not run or any(ch in run for ch in "/*$?#"):
+    def __init__(self, run: str, every_run: bool = False):
+        """`every_run`: `run` is a wildcard (`*`), for rules that hold in any run (the router's access control)."""
+        if not every_run and (not run or any(ch in run for ch in "/*$?#")):
             raise ValueError(f"run id {run!r}: use letters, digits, '-' and '_' only")
         self.run = run
         self.prefix = f"swarm/{run}"

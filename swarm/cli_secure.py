@@ -1,0 +1,62 @@
+"""The command line of secure runs: `swarm credentials`, and the `--credentials` option of every
+process that opens a zenoh session (docs/security.md)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+
+from swarm.core.credentials import Identity, load
+from swarm.core.tables import positive
+
+ENV = "SWARM_CREDENTIALS"  # the default of --credentials: a container gets its folder without a new command
+
+
+def credentials_arg(p: argparse.ArgumentParser, who: str) -> None:
+    p.add_argument("--credentials", metavar="FOLDER", default=os.environ.get(ENV),
+                   help=f"this process's own credentials folder ({who}) of a secure run "
+                   f"(default: ${ENV}); see `swarm credentials`")  # fmt: skip
+
+
+def identity(args: argparse.Namespace) -> Identity | None:
+    """The identity `--credentials` names, or None (a plain run)."""
+    return load(args.credentials) if args.credentials else None
+
+
+def up_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--secure", action="store_true",
+                   help="make this run's credentials: logins, TLS certificates and the router's access rules "
+                   "(an agent may put on its own keys only)")  # fmt: skip
+    p.add_argument(
+        "--credentials",
+        metavar="DIR",
+        help="a secure run with the credentials `swarm credentials DIR` made (implies --secure)",
+    )
+
+
+def add_credentials_parser(sub) -> None:
+    made = sub.add_parser(
+        "credentials",
+        help="make a secure run's credentials (a CA, and a login and a certificate per process)",
+        description="Write DIR/router, DIR/world, DIR/monitor and DIR/agent1..agentN: each process's own "
+        "folder, to pass with --credentials (mount only its own into its container).",
+    )
+    made.add_argument("dir", metavar="DIR", help="where to write them (made private to this user)")
+    made.add_argument("--agent-processes", type=positive, default=1, metavar="N",
+                      help="identities agent1..agentN, one per agent process (default 1)")  # fmt: skip
+    made.add_argument("--host", action="append", default=[], metavar="NAME",
+                      help="a name or address the router is reached by besides localhost (repeat it); "
+                      "TLS clients check it")  # fmt: skip
+    made.add_argument("--shared-agents", action="store_true",
+                      help="also an `agents` identity for identical replicas (compose --scale): any of them "
+                      "may put on any agent process's keys; the world still refuses actions for another's "
+                      "agents")  # fmt: skip
+    made.set_defaults(handler=cmd_credentials)
+
+
+def cmd_credentials(args: argparse.Namespace) -> int:
+    from swarm.core.credentials import make
+
+    folder = make(args.dir, args.agent_processes, tuple(args.host), args.shared_agents)
+    print(f"swarm: credentials for {args.agent_processes} agent processes in {folder}")
+    return 0

@@ -1,0 +1,75 @@
+"""The router's access control for a secure run: who may put, subscribe and ask on which keys.
+
+Everything not allowed here is denied at the router, before it reaches the
+world: an agent process puts only on its own group's keys (its actions, mark
+writes, plans and records, and its own observation key, where it wakes
+itself), subscribes only to its own observations, and may ask the world's
+queryables (join, info, shared spaces) and declare liveliness tokens.  The
+world may do anything in the run's key space; a monitor only reads.  Rules
+name every run (`swarm/*/...`), so one router serves any run id.
+"""
+
+from __future__ import annotations
+
+from swarm.core import credentials
+from swarm.core.wire import Keys
+
+ANY = Keys("*", every_run=True)
+WORLD_MESSAGES = ["put", "delete", "declare_subscriber", "declare_queryable", "query", "reply",
+                  "liveliness_token", "declare_liveliness_subscriber", "liveliness_query"]  # fmt: skip
+
+
+def _rule(rule_id: str, messages: list[str], flows: list[str], keys: list[str]) -> dict:
+    return {"id": rule_id, "messages": messages, "flows": flows, "permission": "allow", "key_exprs": keys}
+
+
+def _reader(name: str) -> list[dict]:
+    """Ask the world's queryables and hear their replies (join, info, marks, shared spaces)."""
+    return [_rule(f"{name}-ask", ["query", "liveliness_query"], ["ingress"], [f"{ANY.prefix}/**"]),
+            _rule(f"{name}-answers", ["reply"], ["egress"], [f"{ANY.prefix}/**"])]  # fmt: skip
+
+
+def _agent(name: str, group: str) -> list[dict]:
+    """An agent process whose messages travel as `group` (`*`: any group, a shared identity)."""
+    own = [ANY.act(group), ANY.mark(group), f"{ANY.mark(group)}/**", ANY.plan(group), ANY.record(group)]
+    return [
+        _rule(f"{name}-put", ["put"], ["ingress"], [*own, ANY.obs(group)]),
+        # A declared publisher sends only once it has heard of a matching subscriber: the world's
+        # declarations (key expressions such as `act/*`, no data) must reach the agent.
+        _rule(f"{name}-matched", ["declare_subscriber"], ["egress"], [f"{ANY.prefix}/**"]),
+        _rule(f"{name}-subscribe", ["declare_subscriber"], ["ingress"], [ANY.obs(group)]),
+        _rule(f"{name}-hear", ["put"], ["egress"], [ANY.obs(group)]),
+        _rule(f"{name}-alive", ["liveliness_token"], ["ingress"], [ANY.alive_all]),
+        *_reader(name),
+    ]
+
+
+def _rules_of(name: str) -> list[dict]:
+    if name == credentials.WORLD:
+        return [_rule(f"{name}-all", WORLD_MESSAGES, ["ingress", "egress"], [f"{ANY.prefix}/**"])]
+    if name == credentials.MONITOR:
+        return [_rule(f"{name}-subscribe", ["declare_subscriber"], ["ingress"], [ANY.state]),
+                _rule(f"{name}-hear", ["put"], ["egress"], [ANY.state]), *_reader(name)]  # fmt: skip
+    if name == credentials.SHARED_AGENTS:
+        return _agent(name, "*")
+    if name.startswith("agent") and name[len("agent") :].isdigit():
+        return _agent(name, name)
+    return []  # the router's own name, or one this version does not know: nothing
+
+
+def access_control(users: list[str], tls: bool) -> dict:
+    """zenoh's `access_control` section for these users; over TLS a subject must also show the
+    certificate of its name (both must match: a password alone, or a certificate alone, is not enough)."""
+    rules, subjects, policies = [], [], []
+    for name in users:
+        mine = _rules_of(name)
+        if not mine:
+            continue
+        rules += mine
+        subject = {"id": name, "usernames": [name]}
+        if tls:
+            subject["cert_common_names"] = [name]
+        subjects.append(subject)
+        policies.append({"id": name, "rules": [r["id"] for r in mine], "subjects": [name]})
+    return {"enabled": True, "default_permission": "deny", "rules": rules, "subjects": subjects,
+            "policies": policies}  # fmt: skip

@@ -1,0 +1,196 @@
+"""A secure run's credentials: a certificate authority, and a password and a certificate per process.
+
+Every process holds only its own folder, so an agent process cannot speak as
+another one or as the world:
+
+    DIR/<name>/identity.json   {"user": name, "password": ...}            (0600)
+    DIR/<name>/ca.pem          the run's CA: checks the router's certificate, and the router checks ours
+    DIR/<name>/cert.pem        this process's certificate, common name = its name
+    DIR/<name>/key.pem         its private key                               (0600)
+    DIR/router/users.txt       every user:password, the router's dictionary  (0600)
+
+Names: `router` (whoever hosts the router: `swarm router`, or the world of
+`swarm up`), `world` (a world that joins a router), `monitor` (the launcher,
+`swarm monitor`, `swarm status`), `agent1`..`agentN` (one per agent process;
+the name is also its message group, so the router's rules can name its keys)
+and, made only on request, `agents`: one identity shared by identical
+replicas that cannot each be handed their own (compose's `--scale`).
+
+Passwords and keys come from the operating system's randomness, never from
+the run's seed: a seed is public, a credential must not be derivable from it.
+"""
+
+from __future__ import annotations
+
+import datetime
+import ipaddress
+import json
+import os
+import secrets
+from dataclasses import dataclass
+from pathlib import Path
+
+from swarm.core.errors import RunError
+
+ROUTER, WORLD, MONITOR, SHARED_AGENTS = "router", "world", "monitor", "agents"
+LOCAL_HOSTS = ("localhost", "127.0.0.1", "::1")
+VALID_DAYS = 30
+
+
+class CredentialsError(RunError):
+    """Credentials missing, unreadable or too few for the run."""
+
+
+def agent_name(i: int) -> str:
+    """The identity (and message group) of agent process `i`, from 1."""
+    return f"agent{i}"
+
+
+def own_group(identity: Identity | None) -> str | None:
+    """The message group an agent process must use: its identity's name, which the router's rules name;
+    None (any group) without credentials or with the shared `agents` identity."""
+    if identity is None or identity.name == SHARED_AGENTS:
+        return None
+    return identity.name
+
+
+@dataclass(frozen=True)
+class Identity:
+    """One process's credentials, as read from its folder."""
+
+    name: str
+    password: str
+    folder: Path
+
+    @property
+    def ca(self) -> Path:
+        return self.folder / "ca.pem"
+
+    @property
+    def cert(self) -> Path:
+        return self.folder / "cert.pem"
+
+    @property
+    def key(self) -> Path:
+        return self.folder / "key.pem"
+
+    @property
+    def users_file(self) -> Path:
+        return self.folder / "users.txt"
+
+    def users(self) -> list[str]:
+        """The names in the router's dictionary (only a router's folder has one)."""
+        try:
+            lines = self.users_file.read_text().splitlines()
+        except OSError:
+            raise CredentialsError(f"{self.folder}: no users.txt; host the router with the `router` folder") from None
+        return [line.split(":", 1)[0] for line in lines if ":" in line]
+
+
+def load(folder: str | Path) -> Identity:
+    """The identity in `folder` (DIR/<name>), or a one-line CredentialsError."""
+    folder = Path(folder)
+    try:
+        data = json.loads((folder / "identity.json").read_text())
+        name, password = data["user"], data["password"]
+    except (OSError, ValueError, KeyError, TypeError):
+        raise CredentialsError(f"{folder}: not a credentials folder (no readable identity.json)") from None
+    missing = [f for f in ("ca.pem", "cert.pem", "key.pem") if not (folder / f).is_file()]
+    if missing:
+        raise CredentialsError(f"{folder}: missing {', '.join(missing)}")
+    return Identity(str(name), str(password), folder)
+
+
+def identity_in(run_folder: str | Path, name: str) -> Identity:
+    """The identity `name` of a run's credentials folder (as `make` writes it)."""
+    return load(Path(run_folder) / name)
+
+
+def make(folder: str | Path, agent_processes: int, hosts: tuple[str, ...] = (), shared_agents: bool = False) -> Path:
+    """Write a run's credentials into `folder` (made, and left private to this user): a CA, the
+    router's certificate for `hosts` and this machine's loopback names, and one identity per process."""
+    from cryptography.hazmat.primitives.asymmetric import ec
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+    names = [ROUTER, WORLD, MONITOR, *(agent_name(i) for i in range(1, agent_processes + 1))]
+    names += [SHARED_AGENTS] if shared_agents else []
+    ca_key = ec.generate_private_key(ec.SECP256R1())
+    ca_cert = _certificate("swarm run CA", ca_key.public_key(), ca_key, None, ca=True)
+    ca_pem = _pem(ca_cert)
+    passwords = {name: secrets.token_urlsafe(24) for name in names}
+    for name in names:
+        where = folder / name
+        where.mkdir(exist_ok=True, mode=0o700)
+        key = ec.generate_private_key(ec.SECP256R1())
+        sans = (*LOCAL_HOSTS, *hosts) if name == ROUTER else ()
+        cert = _certificate(name, key.public_key(), ca_key, ca_cert, sans=sans)
+        (where / "ca.pem").write_bytes(ca_pem)
+        (where / "cert.pem").write_bytes(_pem(cert))
+        _private(where / "key.pem", _key_pem(key))
+        _private(where / "identity.json", json.dumps({"user": name, "password": passwords[name]}).encode())
+    users = "".join(f"{name}:{passwords[name]}\n" for name in names)
+    _private(folder / ROUTER / "users.txt", users.encode())
+    return folder
+
+
+def _private(path: Path, data: bytes) -> None:
+    """Write a secret readable by this user only (created 0600, never world-readable in between)."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(fd, "wb") as f:
+        f.write(data)
+    os.chmod(path, 0o600)
+
+
+def _certificate(common_name: str, public_key, signing_key, issuer, ca: bool = False, sans: tuple[str, ...] = ()):
+    from cryptography import x509
+    from cryptography.hazmat.primitives import hashes
+    from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
+
+    subject = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, common_name)])
+    now = datetime.datetime.now(datetime.UTC)
+    builder = (
+        x509.CertificateBuilder()
+        .subject_name(subject)
+        .issuer_name(issuer.subject if issuer is not None else subject)
+        .public_key(public_key)
+        .serial_number(x509.random_serial_number())
+        .not_valid_before(now - datetime.timedelta(minutes=5))
+        .not_valid_after(now + datetime.timedelta(days=VALID_DAYS))
+        .add_extension(x509.BasicConstraints(ca=ca, path_length=0 if ca else None), critical=True)
+    )
+    if ca:
+        builder = builder.add_extension(
+            x509.KeyUsage(digital_signature=True, key_cert_sign=True, crl_sign=True, content_commitment=False,
+                          key_encipherment=False, data_encipherment=False, key_agreement=False,
+                          encipher_only=False, decipher_only=False),
+            critical=True,
+        )  # fmt: skip
+    else:
+        usages = [ExtendedKeyUsageOID.CLIENT_AUTH, ExtendedKeyUsageOID.SERVER_AUTH]
+        builder = builder.add_extension(x509.ExtendedKeyUsage(usages), critical=False)
+        if sans:
+            builder = builder.add_extension(x509.SubjectAlternativeName([_san(h) for h in sans]), critical=False)
+    return builder.sign(signing_key, hashes.SHA256())
+
+
+def _san(host: str):
+    from cryptography import x509
+
+    try:
+        return x509.IPAddress(ipaddress.ip_address(host))
+    except ValueError:
+        return x509.DNSName(host)
+
+
+def _pem(cert) -> bytes:
+    from cryptography.hazmat.primitives import serialization
+
+    return cert.public_bytes(serialization.Encoding.PEM)
+
+
+def _key_pem(key) -> bytes:
+    from cryptography.hazmat.primitives import serialization
+
+    return key.private_bytes(serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8,
+                             serialization.NoEncryption())  # fmt: skip

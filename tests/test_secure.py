@@ -1,0 +1,174 @@
+"""Secure runs at a real router: zenoh's own login, access control (swarm/core/acl.py) and TLS.
+
+What the router refuses never reaches the world: no session without the
+run's credentials, no put of an agent process on another's keys or on the
+world's; a secure run ends exactly as a plain one."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from swarm.core import credentials
+from swarm.core.bus import open_client, open_router
+from swarm.core.credentials import MONITOR, ROUTER, WORLD, agent_name, identity_in
+from swarm.core.wire import Keys
+from swarm.engines.grid import Engine
+from swarm.scenario import load_scenario
+from tests.distributed import ServerThread, free_endpoint, start_agents, stop
+from world_server.grid.face import wire as proto
+
+KEYS = Keys("sec")
+
+
+@pytest.fixture(scope="module")
+def creds(tmp_path_factory) -> Path:
+    return credentials.make(tmp_path_factory.mktemp("creds"), 3)
+
+
+class Heard:
+    """Every sample on the run's keys, as the world's side receives them."""
+
+    def __init__(self, session):
+        self.keys: list[str] = []
+        self.lock = threading.Lock()
+        self.sub = session.declare_subscriber(f"{KEYS.prefix}/**", self._on)
+
+    def _on(self, sample) -> None:
+        with self.lock:
+            self.keys.append(str(sample.key_expr))
+
+    def settled(self, wait: float = 0.5) -> set[str]:
+        time.sleep(wait)
+        with self.lock:
+            return set(self.keys)
+
+
+def _wrong_password(creds: Path, tmp_path: Path) -> credentials.Identity:
+    copy = shutil.copytree(creds / agent_name(1), tmp_path / "guessed")
+    (copy / "identity.json").write_text(json.dumps({"user": agent_name(1), "password": "guessed"}))
+    return credentials.load(copy)
+
+
+def test_no_or_wrong_credentials_are_refused_and_never_reach_the_world(creds, tmp_path):
+    endpoint = free_endpoint()
+    router = open_router(endpoint, identity_in(creds, ROUTER))  # the world hosts the router
+    try:
+        heard = Heard(router)
+        with pytest.raises(ConnectionError, match="start `swarm world` first"):
+            open_client(endpoint, timeout=1.0)
+        with pytest.raises(ConnectionError, match="refused the credentials of 'agent1'"):
+            open_client(endpoint, timeout=1.0, identity=_wrong_password(creds, tmp_path))
+        assert heard.settled(0.1) == set()
+        agent = open_client(endpoint, timeout=5.0, identity=identity_in(creds, agent_name(1)))
+        agent.put(KEYS.act(agent_name(1)), b"mine")
+        assert heard.settled() == {KEYS.act(agent_name(1))}
+        agent.close()
+    finally:
+        router.close()
+
+
+def test_an_agent_process_puts_only_on_its_own_keys_through_a_bare_router(creds):
+    endpoint = free_endpoint()
+    router = open_router(endpoint, identity_in(creds, ROUTER))  # `swarm router --credentials DIR/router`
+    world = open_client(endpoint, timeout=5.0, identity=identity_in(creds, WORLD))
+    agent = open_client(endpoint, timeout=5.0, identity=identity_in(creds, agent_name(1)))
+    monitor = open_client(endpoint, timeout=5.0, identity=identity_in(creds, MONITOR))
+    try:
+        heard = Heard(world)
+        spied: list[bytes] = []
+        agent.declare_subscriber(KEYS.obs(agent_name(2)), lambda s: spied.append(s.payload.to_bytes()))
+        mine = [KEYS.act(agent_name(1)), KEYS.mark(agent_name(1)), KEYS.plan(agent_name(1))]
+        publisher = agent.declare_publisher(mine[0])
+        time.sleep(0.3)
+        other = agent_name(2)
+        for key in (KEYS.act(other), KEYS.mark(other), KEYS.plan(other), KEYS.record(other), KEYS.obs(other),
+                    KEYS.state, KEYS.join, KEYS.alive(0)):  # fmt: skip
+            agent.put(key, b"forged")
+        monitor.put(mine[0], b"forged")
+        world.put(KEYS.obs(other), b"for agent2 only")
+        publisher.put(b"mine")
+        for key in mine[1:]:
+            agent.put(key, b"mine")
+        assert heard.settled() == {*mine, KEYS.obs(other)}  # the world's own put, heard by its own subscriber
+        assert b"for agent2 only" not in spied  # (its own forged put comes back to it inside its session)
+    finally:
+        for s in (monitor, agent, world, router):
+            s.close()
+
+
+def test_tls_refuses_a_client_without_the_runs_certificate(creds, tmp_path):
+    endpoint = free_endpoint().replace("tcp/", "tls/")
+    foreign = credentials.make(tmp_path / "other", 1)  # another run's CA: its agent1 has the right name
+    router = open_router(endpoint, identity_in(creds, ROUTER))
+    try:
+        heard = Heard(router)
+        for stranger in (None, identity_in(foreign, agent_name(1))):
+            with pytest.raises(ConnectionError):
+                open_client(endpoint, timeout=1.0, identity=stranger)
+        agent = open_client(endpoint, timeout=5.0, identity=identity_in(creds, agent_name(1)))
+        agent.put(KEYS.act(agent_name(2)), b"forged")
+        agent.put(KEYS.act(agent_name(1)), b"mine")
+        assert heard.settled() == {KEYS.act(agent_name(1))}
+        agent.close()
+    finally:
+        router.close()
+
+
+def test_a_secure_world_never_sees_a_forged_action_and_ends_as_the_engine(creds):
+    scenario = load_scenario("setup2").with_overrides(agents=2, seed=21)
+    engine = Engine(scenario)
+    expected = engine.run().summary
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "sec", endpoint, deadline=10.0, identity=identity_in(creds, ROUTER)).start()
+    procs = start_agents(endpoint, "sec", scenario.controller, 2, credentials=creds)
+    forger = open_client(endpoint, timeout=30.0, identity=identity_in(creds, agent_name(3)))  # a spare process
+    try:
+        stay = np.array([[4, 0, 0, 0, 0, 0, 0, 0]], dtype=np.int64)
+        for _ in range(200):  # a plain run counts each: "names an agent of another process"
+            forger.put(KEYS.act(agent_name(1)), proto.actions(0, [0], stay, [False]))
+            forger.put(KEYS.act(agent_name(2)), b"\x00\xffgarbage")
+        summary = world.join(timeout=120)
+        for p in procs:
+            assert p.wait(timeout=30) == 0, p.stderr.read().decode()[-2000:]
+    finally:
+        forger.close()
+        stop(procs)
+        world.close()
+    assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
+    for key in ("iterations", "delivered", "total", "finished", "explored_cells"):
+        assert summary[key] == expected[key], key
+
+
+def test_swarm_up_secure_over_tls_ends_as_the_engine(tmp_path):
+    scenario = load_scenario("setup2").with_overrides(agents=2, seed=9)
+    expected = Engine(scenario).run().summary
+    up = subprocess.run([sys.executable, "-m", "swarm", "up", "setup2", "--agents", "2", "--seed", "9", "--secure",
+                         "--listen", free_endpoint().replace("tcp/", "tls/"), "--no-record", "--json"],
+                        capture_output=True, text=True, timeout=300, cwd=tmp_path)  # fmt: skip
+    assert up.returncode == 0, up.stderr[-3000:]
+    summary = json.loads(up.stdout)
+    for key in ("iterations", "delivered", "total", "finished", "explored_cells"):
+        assert summary[key] == expected[key], key
+    assert summary["rejected_messages"] == 0
+
+
+def test_credentials_are_private_and_a_bad_folder_is_one_line(creds, tmp_path):
+    for name in (ROUTER, agent_name(1)):
+        assert (creds / name / "key.pem").stat().st_mode & 0o777 == 0o600
+        assert (creds / name / "identity.json").stat().st_mode & 0o777 == 0o600
+    assert (creds / ROUTER / "users.txt").stat().st_mode & 0o777 == 0o600
+    assert not (creds / agent_name(1) / "users.txt").exists()  # an agent holds its own password only
+    bad = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(tmp_path), "--connect",
+                          free_endpoint()], capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert bad.returncode == 2
+    assert bad.stderr.strip().splitlines() == [f"swarm: error: {tmp_path}: not a credentials folder "
+                                               "(no readable identity.json)"]  # fmt: skip
