@@ -15,6 +15,7 @@ processes fall back to the JIT (same step, more memory).
 
 from __future__ import annotations
 
+import fcntl
 import importlib
 import os
 import shutil
@@ -58,6 +59,14 @@ def build() -> Path:
     """Compile the step module (about a minute on 2 cores) unless it exists."""
     if (done := built()) is not None:
         return done
+    out = build_dir()
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / ".build.lock", "w") as lock:  # a second builder (another test worker or swarm up) waits,
+        fcntl.flock(lock, fcntl.LOCK_EX)  # then finds the first one's module instead of compiling it again
+        return built() or _compile(out)
+
+
+def _compile(out: Path) -> Path:
     from numba.pycc import CC
 
     from agents.controllers.grid.dispatch import answer_rows
@@ -65,9 +74,6 @@ def build() -> Path:
 
     for module in kernel_modules():  # they declare their kernels on import
         importlib.import_module(module)
-
-    out = build_dir()
-    out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=out) as tmp:  # concurrent builds: atomic rename at the end
         cc = CC(module_name())
         cc.output_dir = tmp
