@@ -175,3 +175,15 @@ def test_kill_9_at_random_moments_of_a_world_saving_every_tick_ends_as_swarm_run
         assert summary["missed_ticks"] == 0 and summary["rejected_messages"] == 0
     finally:
         stop(procs)
+
+
+def test_a_sweep_row_cut_inside_its_last_number_is_run_again(tmp_path):
+    from swarm.sweeps.outputs import RunsFile
+
+    path = tmp_path / "runs.csv"
+    runs = RunsFile(path, ["scenario", "seed"], ["delivered", "wall_s"], fresh=True)
+    runs.write([{"scenario": "setup1", "seed": 1, "delivered": 60, "wall_s": 1.25}])
+    with open(path, "a") as f:
+        f.write("setup1,2,60,1.2")  # killed while appending: the rest of 1.25 and the newline never came
+    again = RunsFile(path, ["scenario", "seed"], ["delivered", "wall_s"], fresh=False)
+    assert list(again.rows) == [("setup1", "1")]

@@ -1,9 +1,8 @@
 """The world's state on disk: what a restarted world resumes from.
 
-One `.npz` per run id, written atomically: a temporary file beside it (`<name>.tmp`,
-fsynced), renamed over it, then the folder fsynced, so a kill -9 or a power cut in
-the middle of a write leaves the previous whole snapshot.  A `.tmp` left by a kill
-is never read and the next save overwrites it.  The file carries a SHA-256 of its
+One `.npz` per run id, replaced whole (swarm.core.atomic: a fsynced `.tmp`, renamed,
+the folder fsynced), so a kill -9 or a power cut in the middle of a write leaves the
+previous whole snapshot.  The file carries a SHA-256 of its
 content and a format number: a cut, damaged or foreign file is refused in one line
 (`StateError`) rather than resumed from.  The scenario is stored with it: resuming
 a run under another scenario is refused.
@@ -14,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
-import os
 import struct
 import zipfile
 from collections.abc import Iterator
@@ -22,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from swarm.core import atomic
 from swarm.core.errors import StateError
 
 FORMAT = 1  # bumped when the saved content changes: a file of another format is refused
@@ -42,25 +41,9 @@ def save(path: Path, world, tick: int, slots: np.ndarray, stats: dict, scenario:
 
 def save_arrays(path: Path, arrays: dict, meta: dict) -> None:
     """Any world kind's state: its arrays and a JSON meta, written atomically."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
     text = json.dumps(meta)
     check = json.dumps({"format": FORMAT, "sha256": digest(text, arrays)})
-    with open(tmp, "wb") as f:  # a .tmp left by a killed write is overwritten here
-        np.savez(f, meta=np.array(text), **{CHECK: np.array(check)}, **arrays)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-    _fsync_dir(path.parent)
-
-
-def _fsync_dir(folder: Path) -> None:
-    """The rename itself on disk: without it a power cut may bring back the old name's content."""
-    fd = os.open(folder, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
+    atomic.replace(path, lambda f: np.savez(f, meta=np.array(text), **{CHECK: np.array(check)}, **arrays))
 
 
 def digest(meta: str, arrays: dict) -> str:
