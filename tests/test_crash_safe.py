@@ -137,6 +137,7 @@ def test_a_damaged_or_incomplete_state_stops_swarm_world_in_one_line(tmp_path):
         assert "delete it to start the run over, or point --state-dir elsewhere" in lines[0]
 
 
+@pytest.mark.experiment  # four world starts: 2-3 minutes on a loaded 2-core machine (-m experiment)
 def test_kill_9_at_random_moments_of_a_world_saving_every_tick_ends_as_swarm_run(tmp_path):
     """The world saves after every tick; kill -9 at seeded random moments (mid-save or not),
     restart it each time: every restart resumes from a whole snapshot at or after the last one,
@@ -187,3 +188,32 @@ def test_a_sweep_row_cut_inside_its_last_number_is_run_again(tmp_path):
         f.write("setup1,2,60,1.2")  # killed while appending: the rest of 1.25 and the newline never came
     again = RunsFile(path, ["scenario", "seed"], ["delivered", "wall_s"], fresh=False)
     assert list(again.rows) == [("setup1", "1")]
+
+
+def test_a_recording_world_killed_mid_run_leaves_a_readable_file(tmp_path):
+    """kill -9 a recording world past tick 600: the file reads back (run meta, map, ticks) up to the
+    last batch the recorder handed rerun, so at most 256 ticks are lost."""
+    from swarm.review.report import RecordingError, read_recording
+
+    endpoint = free_endpoint()
+    state = persist.state_path(tmp_path, "rec")
+    rrd = tmp_path / "rec.rrd"
+    world = subprocess.Popen([sys.executable, "-m", "swarm", "world", "maze", "--agents", "4", "--seed", "3",
+                              "--run-id", "rec", "--listen", endpoint, "--state-dir", str(tmp_path),
+                              "--persist-every", "100", "--record", str(rrd)],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)  # fmt: skip
+    procs = [world, *start_agents(endpoint, "rec", "cmarking", 2, count=2)]
+    try:
+        deadline = time.monotonic() + 120
+        while not (state.exists() and persist.load(state)["tick"] >= 600):
+            assert time.monotonic() < deadline and world.poll() is None, "the world never reached tick 600"
+            time.sleep(0.01)
+        os.kill(world.pid, signal.SIGKILL)
+        world.wait()
+        saved = persist.load(state)["tick"]
+        with pytest.raises(RecordingError, match=r"truncated: it holds ticks 0\.\.(\d+)") as cut:
+            read_recording(rrd)
+        last = int(str(cut.value).split("ticks 0..")[1].split(" ")[0])
+        assert (last + 1) % 256 == 0 and last >= saved - 256, (last, saved)
+    finally:
+        stop(procs)
