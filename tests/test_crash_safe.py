@@ -137,7 +137,7 @@ def test_a_damaged_or_incomplete_state_stops_swarm_world_in_one_line(tmp_path):
         assert "delete it to start the run over, or point --state-dir elsewhere" in lines[0]
 
 
-@pytest.mark.experiment  # four world starts: 2-3 minutes on a loaded 2-core machine (-m experiment)
+@pytest.mark.experiment  # four world starts: 43 s on a quiet 2-core machine, minutes under load
 def test_kill_9_at_random_moments_of_a_world_saving_every_tick_ends_as_swarm_run(tmp_path):
     """The world saves after every tick; kill -9 at seeded random moments (mid-save or not),
     restart it each time: every restart resumes from a whole snapshot at or after the last one,
