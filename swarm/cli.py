@@ -13,7 +13,7 @@ from swarm.cli_check import add_check_parsers
 from swarm.cli_reproduce import add_reproduce_parser, cmd_reproduce
 from swarm.cli_secure import add_credentials_parser, credentials_arg, identity, up_args
 from swarm.cli_sweep import add_sweep_parser
-from swarm.core.errors import RecordingError, RunError, ScenarioError, raise_interrupt
+from swarm.core.errors import RecordingError, RunError, ScenarioError, StateError, raise_interrupt
 from swarm.core.registry import Option, Registry, resolve
 from swarm.core.tables import positive, seed
 from swarm.scenario import PRESET_HELP, bundled_scenarios, load_scenario
@@ -427,7 +427,7 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGTERM, raise_interrupt)
     try:
         return (COMMANDS.get(args.command) or args.handler)(args)
-    except (ScenarioError, RecordingError) as exc:
+    except (ScenarioError, RecordingError, StateError) as exc:
         print(f"swarm: error: {exc}", file=sys.stderr)
         return 2
     except (ConnectionError, TimeoutError, RunError) as exc:

@@ -114,7 +114,7 @@ def test_damaged_cut_and_unfinished_recordings_give_clear_errors(tmp_path):
     recorder.flush()
     recorder.rec.flush()
     recorder.rec.disconnect()
-    for path, message in ((cut, "damaged"), (garbage, "damaged"), (unfinished, "truncated"),
+    for path, message in ((cut, "truncated"), (garbage, "damaged"), (unfinished, "truncated"),
                           (tmp_path / "missing.rrd", "no such file")):  # fmt: skip
         with pytest.raises(RecordingError, match=message):
             read_recording(path)

@@ -33,3 +33,7 @@ def one_line(exc: BaseException) -> str:
     """An exception as one line: its type and the first line of its message (a user's code raised it)."""
     text = str(exc).strip().splitlines()
     return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
+
+
+class StateError(Exception):
+    """A saved world state that cannot be resumed from: cut short, damaged, or of another format."""

@@ -19,6 +19,8 @@ from functools import partial
 from pathlib import Path
 from typing import Any, TypeVar
 
+from swarm.core import atomic
+
 Job = TypeVar("Job")
 
 
@@ -74,12 +76,16 @@ def _numbered(fn: Callable[[Job], dict], numbered: tuple[int, Job]) -> tuple[int
 
 
 def write_csv(path: Path, rows: Sequence[dict], fields: Sequence[str] | None = None) -> None:
-    """`rows` as CSV; the columns `fields` (others left out), by default every key in first-seen order."""
+    """`rows` as CSV, replaced whole (a kill leaves the old file or the new); the columns `fields`
+    (others left out), by default every key in first-seen order."""
     fields = list(fields) if fields is not None else list(dict.fromkeys(k for row in rows for k in row))
-    with open(path, "w", newline="") as f:
+
+    def write(f) -> None:
         writer = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         writer.writeheader()
         writer.writerows(rows)
+
+    atomic.replace(path, write, text=True)
 
 
 class Outputs:

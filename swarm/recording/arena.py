@@ -363,6 +363,7 @@ class ArenaRecorder:
         rec.set_time("tick", sequence=int(ticks[-1]))
         rec.log("world/trajectories", rr.LineStrips2D([flip(p) for p in paths], colors=self.colours, radii=0.002,
                                                       draw_order=4.0))  # fmt: skip
+        rec.flush(timeout_sec=0)  # on disk without waiting: a kill loses at most `flush_every` ticks
 
     def close(self, summary: dict | None = None) -> None:
         if not self._static_done:

@@ -182,6 +182,7 @@ class Recorder:
         # per layer kind (swarm.recording.layer_classes): the value that gets the last class
         self.scales = (max(1, int(world.layout.bfs.max())), 0, max(1, int(world.layers[L_RES].max())))
         self._log_static()
+        self.rec.flush(timeout_sec=0)  # the meta and the map on disk now: a killed run's file still has them
 
     # ------------------------------------------------------------------ static
 
@@ -270,6 +271,7 @@ class Recorder:
                 rec.send_columns(f"world/{name}", indexes=[rr.TimeColumn("tick", sequence=ticks_changed)],
                                  columns=rr.SegmentationImage.columns(
                                      buffer=classes.reshape(len(classes), -1).view(np.uint8)))  # fmt: skip
+        rec.flush(timeout_sec=0)  # rerun's batches too, without waiting: a kill loses at most `flush_every` ticks
 
     def close(self, summary: dict | None = None) -> None:
         """Flush what is left, store the printed summary, close the file."""

@@ -23,6 +23,7 @@ import numpy as np
 
 from swarm.core.errors import RecordingError
 from swarm.core.registry import resolve
+from swarm.recording import frames
 from world_server import kind_of
 
 
@@ -45,14 +46,12 @@ def read_recording(path: str | Path) -> Recording:
     path = Path(path)
     if not path.is_file():
         raise RecordingError(f"{path}: no such file (recordings land in runs/<run-id>.rrd)")
-    from rerun.chunk import RrdReader
-
     meta = printed = None
     parts: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # rerun warns before it fails on a cut file; we explain below
-            chunks = list(RrdReader(path).stream())
+            chunks = _chunks(path)
         for chunk in chunks:
             entity = chunk.entity_path.lstrip("/")
             if entity == "run/meta" and chunk.is_static:
@@ -92,6 +91,19 @@ def read_recording(path: str | Path) -> Recording:
         raise RecordingError(f"{path}: truncated: it holds {upto} but no end-of-run record (the run was "
                              "killed or is still going, or the file was cut).")  # fmt: skip
     return rec
+
+
+def _chunks(path: Path) -> list:
+    """The file's chunks; a file a kill cut inside a frame: those of its whole frames."""
+    from rerun.chunk import RrdReader
+
+    try:
+        return list(RrdReader(path).stream())
+    except Exception:  # rerun raises its own types for broken files
+        with frames.whole_frames(path) as whole:
+            if whole is None:
+                raise
+            return list(RrdReader(whole).stream())
 
 
 def _any_value(chunk, column: str) -> str:

@@ -6,15 +6,16 @@ from __future__ import annotations
 
 import csv
 import importlib.util
+import io
 import json
 import math
-import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from swarm.core import atomic
 from swarm.core.errors import ScenarioError
 
 CONFIDENCE = 0.95
@@ -43,15 +44,17 @@ class RunsFile:
             self._load()
 
     def _load(self) -> None:
-        with open(self.path, newline="") as f:
-            reader = csv.DictReader(f)
-            if reader.fieldnames != self.fields:
-                raise ScenarioError(str(self.path), "columns", "written by another sweep (its columns differ); "
-                                    "rerun with --fresh, or give another --out")  # fmt: skip
-            for row in reader:
-                if None in row.values() or None in row or not all(_is_number(row[k]) for k in self.values):
-                    continue
-                self.rows[self.key(row)] = row
+        text = self.path.read_text()
+        if not text.endswith("\n"):  # a row a kill cut short (perhaps inside its last number) is run again
+            text = text[: text.rfind("\n") + 1]
+        reader = csv.DictReader(io.StringIO(text, newline=""))
+        if reader.fieldnames != self.fields:
+            raise ScenarioError(str(self.path), "columns", "written by another sweep (its columns differ); "
+                                "rerun with --fresh, or give another --out")  # fmt: skip
+        for row in reader:
+            if None in row.values() or None in row or not all(_is_number(row[k]) for k in self.values):
+                continue
+            self.rows[self.key(row)] = row
 
     def key(self, row: dict[str, Any]) -> tuple[str, ...]:
         return tuple(cell(row[k]) if not isinstance(row[k], str) else row[k] for k in self.keys)
@@ -64,12 +67,13 @@ class RunsFile:
 
     def write(self, rows: Sequence[dict[str, str]]) -> None:
         """Replace the file with `rows` at once (a kill leaves the old file or the new, never half)."""
-        tmp = self.path.with_suffix(".csv.tmp")
-        with open(tmp, "w", newline="") as f:
+
+        def write(f) -> None:
             writer = csv.DictWriter(f, self.fields, extrasaction="ignore")
             writer.writeheader()
             writer.writerows(rows)
-        os.replace(tmp, self.path)
+
+        atomic.replace(self.path, write, text=True)
 
 
 def _is_number(text: str) -> bool:

@@ -65,15 +65,16 @@ class ArenaKind:
         if loaded is None:
             return False
         arrays, meta = loaded
-        self.server.check_same_scenario(meta["scenario"], self.state_file)
-        self.world.restore(arrays)
-        self.goals.restore(arrays)
-        self.server.resume_membership(int(arrays["tick"]), arrays["slots"], meta["stats"])
-        self.memory = persist.unpack_blobs(arrays["memory"], arrays["memory_at"])
-        payloads = persist.unpack_blobs(arrays["pending"], arrays["pending_at"])
-        pending = zip(arrays["pending_agents"].tolist(), arrays["pending_shares"].tolist(), payloads, strict=True)
-        self.pending_shared = {a: (s, p) for a, s, p in pending}
-        self.shares.restore(meta["shares"])
+        with persist.resuming(self.state_file):
+            self.server.check_same_scenario(meta["scenario"], self.state_file)
+            self.world.restore(arrays)
+            self.goals.restore(arrays)
+            self.server.resume_membership(int(arrays["tick"]), arrays["slots"], meta["stats"])
+            self.memory = persist.unpack_blobs(arrays["memory"], arrays["memory_at"])
+            payloads = persist.unpack_blobs(arrays["pending"], arrays["pending_at"])
+            pending = zip(arrays["pending_agents"].tolist(), arrays["pending_shares"].tolist(), payloads, strict=True)
+            self.pending_shared = {a: (s, p) for a, s, p in pending}
+            self.shares.restore(meta["shares"])
         self.shared_history.open(keep_before=self.server.tick - 1)  # the last tick's publications go out again
         return True
 

@@ -87,13 +87,14 @@ class GridKind:
         state = persist.load(self.state_file) if self.state_file else None
         if state is None:
             return False
-        self.server.check_same_scenario(state["scenario"], self.state_file)
-        w = self.world
-        for key in persist.ARRAYS:
-            getattr(w, key)[...] = state[key]
-        w.bodies.place(state["body_xy"])
-        self.server.resume_membership(int(state["tick"]), state["slots"], state["stats"])
-        self.memory[...] = state["memory"]
+        with persist.resuming(self.state_file):
+            self.server.check_same_scenario(state["scenario"], self.state_file)
+            w = self.world
+            for key in persist.ARRAYS:
+                getattr(w, key)[...] = state[key]
+            w.bodies.place(state["body_xy"])
+            self.server.resume_membership(int(state["tick"]), state["slots"], state["stats"])
+            self.memory[...] = state["memory"]
         return True
 
     def save(self) -> None:
