@@ -32,7 +32,7 @@ def command(executor: str, reps: int, out: Path) -> list[str]:
 def bench_executors(quick: bool = False) -> dict:
     import swarm
 
-    reps, rounds = (1, 1) if quick else (8, 2)
+    reps, rounds = (1, 1) if quick else (24, 2)
     # the commands import this swarm (a checkout's, too), as this process does
     here = str(Path(swarm.__file__).resolve().parents[1])
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [here, os.environ.get("PYTHONPATH")])))
