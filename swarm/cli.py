@@ -16,6 +16,7 @@ from swarm.cli_sweep import add_sweep_parser
 from swarm.core.errors import RecordingError, RunError, ScenarioError, StateError, raise_interrupt
 from swarm.core.registry import Option, Registry, resolve
 from swarm.core.tables import positive, seed
+from swarm.experiments.executors import add_executor_options, executor_for, use
 from swarm.scenario import PRESET_HELP, bundled_scenarios, load_scenario
 from world_server import WORLD_KINDS, kind_of
 from world_server.grid.scenario import DEFAULT_CONTROLLER
@@ -305,7 +306,8 @@ def _add_experiment(sub) -> None:
                      help="; ".join(f"{e.name}: {e.description}" for e in EXPERIMENTS))  # fmt: skip
     exp.add_argument("--reps", type=positive, help="runs per configuration (default per experiment)")
     _add_entry_options(exp, EXPERIMENTS)
-    exp.add_argument("--jobs", type=positive, help="worker processes (default: all cores)")
+    exp.add_argument("--jobs", type=positive, help="workers (default: all cores, or the Ray cluster's CPUs)")
+    add_executor_options(exp)
     exp.add_argument("--seed", type=seed, default=0, help="first seed (runs use seed..seed+reps-1)")
     exp.add_argument("--out", type=Path, help="output folder (default results/NAME)")
 
@@ -426,7 +428,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     signal.signal(signal.SIGTERM, raise_interrupt)
     try:
-        return (COMMANDS.get(args.command) or args.handler)(args)
+        with use(executor_for(args)):  # where batch_run runs the command's runs (--executor)
+            return (COMMANDS.get(args.command) or args.handler)(args)
     except (ScenarioError, RecordingError, StateError) as exc:
         print(f"swarm: error: {exc}", file=sys.stderr)
         return 2

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from swarm.core.registry import resolve
 from swarm.core.tables import positive
+from swarm.experiments.executors import add_executor_options
 
 
 def add_reproduce_parser(sub) -> None:
@@ -24,7 +25,8 @@ def add_reproduce_parser(sub) -> None:
     rep.add_argument("paper", choices=(*PAPERS.names(), "all"), metavar="PAPER",
                      help=f"{', '.join(PAPERS.names())} or all")  # fmt: skip
     rep.add_argument("--quick", action="store_true", help="a few runs per condition: checks that it all runs")
-    rep.add_argument("--jobs", type=positive, help="worker processes (default: all cores)")
+    rep.add_argument("--jobs", type=positive, help="workers (default: all cores, or the Ray cluster's CPUs)")
+    add_executor_options(rep)
     rep.add_argument("--out", type=Path, help="output folder (default results/reproduce/PAPER; with all, "
                      "one subfolder per paper)")  # fmt: skip
 

@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 from swarm.core.tables import positive
+from swarm.experiments.executors import add_executor_options
 
 EPILOG = """\
 a sweep file:
@@ -40,7 +41,8 @@ def add_sweep_parser(sub) -> None:
         epilog=EPILOG,
     )
     p.add_argument("file", type=Path, metavar="FILE.toml", help="the sweep file")
-    p.add_argument("--jobs", type=positive, metavar="N", help="worker processes (default: every core)")
+    p.add_argument("--jobs", type=positive, metavar="N", help="workers (default: every core, or the Ray cluster's)")
+    add_executor_options(p)
     p.add_argument("--out", type=Path, metavar="DIR", help="output folder (default results/sweeps/<file stem>)")
     p.add_argument("--fresh", action="store_true", help="start over: forget the runs already in runs.csv")
     p.add_argument("--json", action="store_true", help="print one JSON object: runs, folder, files")

@@ -1,13 +1,11 @@
 """The one experiment runner: jobs over a real spawned process pool, rows in the jobs' order, the files
-every experiment writes."""
+every experiment writes.  Retries, failures and Ray: test_executors.py."""
 
 from __future__ import annotations
 
 import csv
 import os
 import time
-
-import pytest
 
 from swarm.experiments.runner import Outputs, batch_run, cross, processes_for, write_csv
 
@@ -23,12 +21,6 @@ def _slow_first(job: tuple[int, float]) -> dict:
     k, delay = job
     time.sleep(delay)
     return {"job": k, "pid": os.getpid(), "warmed": list(_WARMED)}
-
-
-def _fails_on_two(job: int) -> dict:
-    if job == 2:
-        raise ValueError("job 2 is bad")
-    return {"job": job}
 
 
 def test_rows_come_back_in_the_jobs_order_whichever_worker_finishes_first():
@@ -48,12 +40,6 @@ def test_warm_up_runs_here_and_in_every_worker_before_any_job():
 def test_one_process_runs_here_without_a_pool():
     rows = batch_run(_slow_first, [(0, 0.0), (1, 0.0)], jobs=1, progress=False)
     assert {r["pid"] for r in rows} == {os.getpid()}
-
-
-@pytest.mark.parametrize("jobs", [1, 2])
-def test_a_failing_job_raises_its_own_error(jobs):
-    with pytest.raises(ValueError, match="job 2 is bad"):
-        batch_run(_fails_on_two, [0, 1, 2, 3], jobs=jobs, progress=False)
 
 
 def test_processes_never_outnumber_the_work():

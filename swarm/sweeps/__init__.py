@@ -34,7 +34,7 @@ def run_sweep(path_or_dict: str | Path | Mapping[str, Any], jobs: int | None = N
     """sweep(), and what it did: {"rows", "ran", "reused", "out", "files", "no_parquet"
     (why there is no runs.parquet, or None)}.  The folder also keeps
     sweep.json: the settings every run shares."""
-    from swarm.experiments.runner import batch_run, cross, processes_for
+    from swarm.experiments.runner import batch_run, cross
     from swarm.sweeps.jobs import check_metrics, run_job, warm_up
 
     spec = read_spec(path_or_dict)
@@ -50,10 +50,8 @@ def run_sweep(path_or_dict: str | Path | Mapping[str, Any], jobs: int | None = N
     (folder / "sweep.json").write_text(json.dumps(fixed, indent=1) + "\n")
     runs.write(list(runs.rows.values()))  # a row a kill cut short is left out, so appending goes on cleanly
     if todo:
-        pool = processes_for(jobs, len(todo)) > 1
-        batch_run(run_job, todo, jobs=jobs, desc=f"sweep {spec.name}", progress=progress,
-                  warm_up=warm_up if pool else None, warm_args=tuple(firsts),
-                  on_row=lambda i, row: runs.append(columns(todo[i], spec) | row))  # fmt: skip
+        batch_run(run_job, todo, jobs=jobs, desc=f"sweep {spec.name}", progress=progress, warm_up=warm_up,
+                  warm_args=tuple(firsts), on_row=lambda i, row: runs.append(columns(todo[i], spec) | row))  # fmt: skip
     return _finish(spec, work, runs, folder) | {"ran": len(todo), "reused": len(work) - len(todo)}
 
 

@@ -379,13 +379,13 @@ def run_experiment(
     reps = exp.default_reps if reps is None else reps
     if reps < 1:
         raise ValueError("--reps must be at least 1")
-    jobs = jobs or os.cpu_count() or 1
     out = Outputs(out, name)
     specs = plan(name, reps, seed, floor)
     physics = sorted({s.physics for s in specs})
     # many short runs go in chunks (less messaging); a few long ones one by one (a live progress bar)
+    chunks = max(1, min(16, len(specs) // ((jobs or os.cpu_count() or 1) * 100)))
     rows = batch_run(run_one, specs, jobs=jobs, desc=exp.title.split(":")[0], progress=progress, warm_up=warm_up,
-                     warm_args=(physics,), chunksize=max(1, min(16, len(specs) // (jobs * 100))))  # fmt: skip
+                     warm_args=(physics,), chunksize=chunks)  # fmt: skip
     rows.sort(key=lambda r: (r["size"], r["agents"], r["controller"], r["physics"], r["seed"]))
     out.runs(rows, RUN_FIELDS)
     summary, md = exp.report(rows, floor)

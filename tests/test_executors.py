@@ -1,0 +1,247 @@
+"""Executors: the runs of an experiment, a sweep or a reproduction on worker processes here or on Ray
+actors, with the same rows; a failed run retried once, then reported in one line.  Ray is tested on
+a real local cluster that the tests start as a user would (`ray start --head`), and every process of
+it is gone when they end."""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pytest
+
+from swarm.cli import main
+from swarm.experiments.executors import LocalExecutor, RayExecutor, use
+from swarm.experiments.runner import JobFailed, batch_run
+
+ROOT = Path(__file__).resolve().parents[1]
+RAY = Path(sys.executable).with_name("ray")
+SWEEP = """scenarios = ["zmaze"]
+controller = "wander"
+seeds = [1, 2]
+max_ticks = 40
+metrics = ["reached", "distance"]
+[grid]
+"wander.speed" = [0.4, 0.8]
+"""
+WALL_CLOCK = {"wall_s", "wall_seconds"}  # columns of seconds taken, which no two runs share
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _processes() -> dict[int, tuple[int, int, str]]:
+    """Every live process (zombies left out): pid -> (parent, session, command line)."""
+    found = {}
+    for name in filter(str.isdigit, os.listdir("/proc")):
+        with contextlib.suppress(OSError):
+            fields = Path(f"/proc/{name}/stat").read_text().rpartition(")")[2].split()
+            cmd = Path(f"/proc/{name}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+            if fields[0] != "Z":
+                found[int(name)] = (int(fields[1]), int(fields[3]), cmd)
+    return found
+
+
+def _in_session(session: int):
+    """Which processes of `session` run (a function of the process table)."""
+    return lambda processes: [(p, cmd) for p, (_, sid, cmd) in processes.items() if sid == session]
+
+
+def _none_left(which, seconds: float = 30) -> None:
+    """Wait until `which(processes)` lists none of them; fail naming those still running."""
+    deadline = time.monotonic() + seconds
+    while (left := which(_processes())) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not left, f"processes outlived the test: {left}"
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A Ray cluster of 2 CPUs on this machine, its workers importing this checkout: its address.
+    At the end every process of it (its own session) is killed, and none is left running."""
+    port = _free_port()
+    temp = tempfile.mkdtemp(prefix="ray", dir="/tmp")  # short: Ray's socket paths must fit in 107 bytes
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
+    cmd = [str(RAY), "start", "--head", f"--port={port}", "--num-cpus=2", "--include-dashboard=false",
+           "--disable-usage-stats", f"--temp-dir={temp}", "--block"]  # fmt: skip
+    with open(Path(temp) / "head.log", "w") as log:
+        head = subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            assert head.poll() is None, (Path(temp) / "head.log").read_text()
+            with contextlib.suppress(OSError), socket.create_connection(("127.0.0.1", port), timeout=1):
+                break
+            assert time.monotonic() < deadline, "the Ray head did not open its port in 60 s"
+            time.sleep(0.2)
+        yield f"127.0.0.1:{port}"
+    finally:
+        for pid in [p for p, (_, sid, _) in _processes().items() if sid == head.pid]:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+        head.wait(timeout=30)
+        _none_left(_in_session(head.pid))
+
+
+@pytest.fixture(autouse=True)
+def _ray_settings_restored():
+    """Ray's settings that connecting writes into this process's environment are undone after each test."""
+    before = {k: os.environ.get(k) for k in ("RAY_AUTH_MODE", "RAY_USAGE_STATS_ENABLED")}
+    yield
+    for key, value in before.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+
+
+@pytest.fixture(params=["here", "processes", "ray"])
+def executor(request):
+    """(executor, jobs): this process; two spawned processes; two Ray actors on the cluster."""
+    if request.param == "ray":
+        with use(RayExecutor(request.getfixturevalue("cluster"))) as ray:
+            yield ray, 2
+    else:
+        yield LocalExecutor(), 1 if request.param == "here" else 2
+
+
+def _rows(path: Path) -> list[dict]:
+    with open(path, newline="") as f:
+        return [{k: v for k, v in row.items() if k not in WALL_CLOCK} for row in csv.DictReader(f)]
+
+
+# ---------------------------------------------------------------------------------- the tests' jobs
+
+
+def _square(job: int) -> dict:
+    return {"job": job, "square": job * job, "pid": os.getpid()}
+
+
+def _fails_once(job: tuple[str, int]) -> dict:
+    """Job 1 raises on its first try (a marker file remembers it was tried), then gives its row."""
+    folder, k = job
+    if k == 1 and not (marker := Path(folder) / "tried").exists():
+        marker.touch()
+        raise ValueError("first try of job 1")
+    return {"job": k}
+
+
+def _dies_once(job: tuple[str, int]) -> dict:
+    """Job 1 kills its worker on its first try."""
+    folder, k = job
+    if k == 1 and not (marker := Path(folder) / "died").exists():
+        marker.touch()
+        os._exit(3)
+    return {"job": k}
+
+
+def _always_fails(job: int) -> dict:
+    if job == 2:
+        raise ValueError("job 2 is bad")
+    return {"job": job}
+
+
+def _sleepy(job: int) -> dict:
+    time.sleep(30)
+    return {"job": job}
+
+
+# -------------------------------------------------------------------------------------------- tests
+
+
+def test_a_job_that_fails_once_is_retried_and_said(executor, tmp_path, capsys):
+    on, jobs = executor
+    rows = batch_run(_fails_once, [(str(tmp_path), k) for k in range(4)], jobs=jobs, progress=False, executor=on)
+    assert [r["job"] for r in rows] == [0, 1, 2, 3]
+    err = capsys.readouterr().err
+    assert "run 2 of 4" in err and "ValueError: first try of job 1" in err and "running it once more" in err
+
+
+def test_a_job_that_fails_twice_stops_the_batch_naming_the_job_and_its_error(executor):
+    on, jobs = executor
+    with pytest.raises(JobFailed, match=r"^run 3 of 4 \(2\) failed twice: ValueError: job 2 is bad \(at .*\.py:\d+\)$"):
+        batch_run(_always_fails, [0, 1, 2, 3], jobs=jobs, progress=False, executor=on)
+
+
+@pytest.mark.parametrize("executor", ["processes", "ray"], indirect=True)
+def test_a_worker_that_dies_is_replaced_and_its_job_retried(executor, tmp_path, capsys):
+    on, jobs = executor
+    rows = batch_run(_dies_once, [(str(tmp_path), k) for k in range(5)], jobs=jobs, progress=False, executor=on)
+    assert [r["job"] for r in rows] == [0, 1, 2, 3, 4]
+    assert "run 2 of 5" in (err := capsys.readouterr().err) and "died" in err
+
+
+def test_a_sweep_through_ray_equals_the_local_pool(cluster, tmp_path):
+    (tmp_path / "s.toml").write_text(SWEEP)
+    for name, how in {"local": [], "ray": ["--executor", "ray", "--address", cluster]}.items():
+        assert main(["sweep", str(tmp_path / "s.toml"), "--jobs", "2", "--out", str(tmp_path / name), *how]) == 0
+    for file in ("runs.csv", "summary.csv"):
+        assert _rows(tmp_path / "ray" / file) == _rows(tmp_path / "local" / file)
+    assert len(_rows(tmp_path / "ray" / "runs.csv")) == 4
+
+
+def test_an_experiment_through_ray_equals_the_local_pool(cluster, tmp_path):
+    for name, how in {"local": [], "ray": ["--executor", "ray", "--address", cluster]}.items():
+        argv = ["experiment", "table1", "--reps", "1", "--jobs", "2", "--out", str(tmp_path / name), *how]
+        assert main(argv) == 0
+    for file in ("runs.csv", "summary.csv"):
+        assert _rows(tmp_path / "ray" / file) == _rows(tmp_path / "local" / file)
+
+
+def test_ray_started_here_takes_only_the_cores_asked_and_leaves_nothing_running():
+    script = (
+        "from swarm.experiments.executors import RayExecutor, use\n"
+        "from swarm.experiments.runner import batch_run\n"
+        "from tests.test_executors import _square\n"
+        "with use(RayExecutor(cpus=1)) as ray:\n"
+        "    rows = batch_run(_square, [1, 2, 3], progress=False)\n"
+        "    print(ray.width(None, 10), ray.width(4, 10), [r['square'] for r in rows], {r['pid'] for r in rows})\n"
+    )
+    python = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)  # fmt: skip
+    out, _ = python.communicate(timeout=120)
+    assert out.startswith("1 1 [1, 4, 9] {") and str(python.pid) not in out.split("{")[1]
+    _none_left(_in_session(python.pid))
+
+
+@pytest.mark.parametrize("command", [["sweep", "s.toml"], ["experiment", "table1"], ["reproduce", "simonin2007"]])
+def test_an_unreachable_cluster_is_one_line_saying_what_to_do(command, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.toml").write_text(SWEEP)
+    port = _free_port()
+    argv = [*command, "--out", str(tmp_path / "out")]
+    assert main([*argv, "--executor", "ray", "--address", f"127.0.0.1:{port}"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"swarm: error: no Ray cluster answers at 127.0.0.1:{port}") and err.count("\n") == 1
+    assert f"ray start --head --port={port}" in err
+    assert main([*argv, "--address", f"127.0.0.1:{port}"]) == 2  # an address is for Ray only
+    assert "add --executor ray" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_ctrl_c_ends_the_worker_processes():
+    script = (
+        "from swarm.experiments.runner import batch_run\n"
+        "from tests.test_executors import _sleepy\n"
+        "batch_run(_sleepy, list(range(4)), jobs=2, progress=False)\n"
+    )
+    python = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stderr=subprocess.PIPE, text=True,
+                              start_new_session=True)  # fmt: skip
+    deadline = time.monotonic() + 60
+    while len([p for p, cmd in _in_session(python.pid)(_processes()) if "spawn_main" in cmd]) < 2:
+        assert time.monotonic() < deadline and python.poll() is None, "the two workers did not start"
+        time.sleep(0.2)
+    os.kill(python.pid, signal.SIGINT)
+    assert "KeyboardInterrupt" in python.communicate(timeout=20)[1]
+    _none_left(_in_session(python.pid), seconds=10)
