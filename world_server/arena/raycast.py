@@ -196,6 +196,18 @@ def cast_one(ox, oy, dx, dy, rmax, me, mask, s_coords, s_ids, seg_on, s_start, d
     return best, what
 
 
+@njit(cache=True, inline="always")
+def _cast_ray(k, r, ch, sh, pose, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids,
+              d_start, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
+    """Ray k of robot r, whose heading has cosine ch and sine sh."""
+    dx = ch * ray_cos[k] - sh * ray_sin[k]
+    dy = sh * ray_cos[k] + ch * ray_sin[k]
+    d, w = cast_one(pose[r, 0], pose[r, 1], dx, dy, ray_range[k], r, ray_mask[k], s_coords, s_ids, seg_on, s_start,
+                    d_xyr, d_ids, d_start, x0, y0, cell, nx, ny)  # fmt: skip
+    out_range[k] = d
+    out_hit[k] = w
+
+
 @njit(cache=True)
 def cast_rays(pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids,
               d_start, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
@@ -208,12 +220,8 @@ def cast_rays(pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, 
         r = ray_robot[k]
         if r != last:
             last, ch, sh = r, math.cos(pose[r, 2]), math.sin(pose[r, 2])
-        dx = ch * ray_cos[k] - sh * ray_sin[k]
-        dy = sh * ray_cos[k] + ch * ray_sin[k]
-        d, w = cast_one(pose[r, 0], pose[r, 1], dx, dy, ray_range[k], r, ray_mask[k], s_coords, s_ids, seg_on, s_start,
-                        d_xyr, d_ids, d_start, x0, y0, cell, nx, ny)  # fmt: skip
-        out_range[k] = d
-        out_hit[k] = w
+        _cast_ray(k, r, ch, sh, pose, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr,
+                  d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit)  # fmt: skip
 
 
 @njit(cache=True, parallel=True)
@@ -224,12 +232,8 @@ def cast_rays_parallel(pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s
     for k in prange(ray_robot.shape[0]):
         r = ray_robot[k]
         ch, sh = math.cos(pose[r, 2]), math.sin(pose[r, 2])
-        dx = ch * ray_cos[k] - sh * ray_sin[k]
-        dy = sh * ray_cos[k] + ch * ray_sin[k]
-        d, w = cast_one(pose[r, 0], pose[r, 1], dx, dy, ray_range[k], r, ray_mask[k], s_coords, s_ids, seg_on, s_start,
-                        d_xyr, d_ids, d_start, x0, y0, cell, nx, ny)  # fmt: skip
-        out_range[k] = d
-        out_hit[k] = w
+        _cast_ray(k, r, ch, sh, pose, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr,
+                  d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit)  # fmt: skip
 
 
 def brute_force(
