@@ -130,8 +130,8 @@ def _cores(quick: bool) -> list[dict]:
 
     rows = []
     for n in (1000,) if quick else (1000, 10_000):
-        world = bench_world(n, LASER_BOT, obstacles=n // 10, side=SIDE * math.sqrt(n / 1000))
-        for threads in (1, 0):
+        for threads in (1, 0):  # a fresh world each: the same start, not one run on
+            world = bench_world(n, LASER_BOT, obstacles=n // 10, side=SIDE * math.sqrt(n / 1000))
             try:
                 used = raycast.set_threads(threads)
                 rows.append({"robots": n, "threads": used, **_measure(world, 10 if quick else 30)})
