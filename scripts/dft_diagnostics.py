@@ -28,13 +28,8 @@ from swarm.scenario import load_scenario
 from world_server.arena.scenario import clearance_at
 
 CLEARANCES = (0.04, 0.06, 0.08)  # metres; L_o's is the first
+NO_SEGMENTS = np.zeros((0, 4))
 NEAR_START = 0.15  # metres: a failed run that ended this close to its start barely left it
-
-
-def wall_arrays(walls) -> tuple[np.ndarray, np.ndarray]:
-    rects = np.array([w.coords for w in walls if w.shape == "rect"], np.float64).reshape(-1, 4)
-    segments = np.array([w.coords for w in walls if w.shape == "segment"], np.float64).reshape(-1, 4)
-    return rects, segments
 
 
 def spa_runs(runs: pd.DataFrame, case: str) -> pd.DataFrame:
@@ -44,10 +39,9 @@ def spa_runs(runs: pd.DataFrame, case: str) -> pd.DataFrame:
 def clearance_table(runs: pd.DataFrame) -> pd.DataFrame:
     """L_p / L_o of case 1's reached SPA runs, L_o planned with each clearance (bootstrap BCa 95%)."""
     scenario = load_scenario("zmaze")
-    rects, segments = wall_arrays(scenario.walls)
     rows = []
     for clearance in CLEARANCES:
-        planner = Planner(scenario.size, rects, segments, 0.01, clearance)
+        planner = Planner(scenario.size, scenario.wall_rects(), scenario.wall_segments(), 0.01, clearance)
         for noise, group in spa_runs(runs, "case1")[lambda d: d.reached].groupby("noise"):
             ratios = []
             for run in group.itertuples():
@@ -61,23 +55,24 @@ def clearance_table(runs: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows).round(3)
 
 
-def nearest_gap(point: np.ndarray, walls) -> tuple[str, str, float]:
-    """The two walls nearest the point and the free gap between them (metres)."""
-    each = [clearance_at(point[None], *wall_arrays([w]))[0] for w in walls]
+def nearest_gap(point: np.ndarray, names: list[str], rects: np.ndarray) -> tuple[str, str, float]:
+    """The two rectangular walls nearest the point and the free gap between them (metres)."""
+    each = [clearance_at(point[None], rect[None], NO_SEGMENTS)[0] for rect in rects]
     first, second = np.argsort(each)[:2]
-    a, b = walls[first].coords, walls[second].coords  # rectangles: x0, y0, x1, y1
+    a, b = rects[first], rects[second]  # x0, y0, x1, y1
     dx = max(a[0] - b[2], b[0] - a[2], 0.0)
     dy = max(a[1] - b[3], b[1] - a[3], 0.0)
-    return walls[first].name, walls[second].name, math.hypot(dx, dy)
+    return names[first], names[second], math.hypot(dx, dy)
 
 
 def failure_table(runs: pd.DataFrame) -> pd.DataFrame:
     """Case 2's SPA runs that missed their goal: where each ended, and what is around it."""
-    walls = load_scenario("large-maze").walls
+    maze = load_scenario("large-maze")
+    names, rects = [w.name for w in maze.walls if w.shape == "rect"], maze.wall_rects()
     failed = spa_runs(runs, "case2")[lambda d: ~d.reached].copy()
     failed["from_start"] = np.hypot(failed.final_x - failed.start_x, failed.final_y - failed.start_y)
     failed["to_goal"] = np.hypot(failed.final_x - failed.goal_x, failed.final_y - failed.goal_y)
-    around = [nearest_gap(np.array([x, y]), walls) for x, y in zip(failed.final_x, failed.final_y, strict=True)]
+    around = [nearest_gap(np.array([x, y]), names, rects) for x, y in zip(failed.final_x, failed.final_y, strict=True)]
     failed["walls"] = [" / ".join(sorted((a, b))) for a, b, _ in around]
     failed["gap_cm"] = [100 * gap for _, _, gap in around]
     columns = ["noise", "pair", "final_x", "final_y", "from_start", "to_goal", "path_length", "walls", "gap_cm"]

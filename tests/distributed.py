@@ -29,6 +29,14 @@ def start_agents(endpoint: str, run_id: str, controller: str, n: int, count: int
     return [subprocess.Popen(cmd + own[i], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for i in range(n)]
 
 
+def saving_world_cmd(tmp_path, run_id: str, endpoint: str, persist_every: int) -> list[str]:
+    """`swarm world` for setup1, 3 agents, seed 4, saving its state into tmp_path every `persist_every`
+    ticks and writing its summary to tmp_path/summary.json: the kill -9 and restart tests' world."""
+    return [sys.executable, "-m", "swarm", "world", "setup1", "--agents", "3", "--seed", "4", "--run-id", run_id,
+            "--listen", endpoint, "--state-dir", str(tmp_path), "--persist-every", str(persist_every),
+            "--deadline", "10", "--summary-file", str(tmp_path / "summary.json")]  # fmt: skip
+
+
 def stop(procs: list[subprocess.Popen]) -> None:
     for p in procs:
         if p.poll() is None:

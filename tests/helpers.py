@@ -1,5 +1,9 @@
 """Small helpers shared by the tests."""
 
+import importlib.util
+import sys
+from pathlib import Path
+
 import numpy as np
 
 from swarm.scenario import parse_scenario_text
@@ -55,3 +59,13 @@ def lemma41_violations(layers: np.ndarray, base: tuple[int, int]) -> int:
 def marks_equal_bfs(layers: np.ndarray) -> bool:
     reachable = layers[L_BFS] >= 0
     return bool((layers[L_MARK][reachable] == layers[L_BFS][reachable]).all())
+
+
+def load_script(name: str):
+    """A module of scripts/ (not a package), imported as the script runs it."""
+    path = Path(__file__).resolve().parents[1] / "scripts" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # a dataclass in it looks its module up there
+    spec.loader.exec_module(module)
+    return module

@@ -17,7 +17,7 @@ import pytest
 from swarm.core.errors import StateError
 from swarm.engines.grid import Engine
 from swarm.scenario import load_scenario
-from tests.distributed import free_endpoint, start_agents, stop
+from tests.distributed import free_endpoint, saving_world_cmd, start_agents, stop
 from world_server import persist
 
 
@@ -147,9 +147,7 @@ def test_kill_9_at_random_moments_of_a_world_saving_every_tick_ends_as_swarm_run
     endpoint = free_endpoint()
     state = persist.state_path(tmp_path, "kills")
     summary_file = tmp_path / "summary.json"
-    world_cmd = [sys.executable, "-m", "swarm", "world", "setup1", "--agents", "3", "--seed", "4", "--run-id",
-                 "kills", "--listen", endpoint, "--state-dir", str(tmp_path), "--persist-every", "1",
-                 "--deadline", "10", "--summary-file", str(summary_file)]  # fmt: skip
+    world_cmd = saving_world_cmd(tmp_path, "kills", endpoint, 1)
     rng = np.random.default_rng(5)
     procs = start_agents(endpoint, "kills", "cmarking", 3)
     try:

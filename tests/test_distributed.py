@@ -10,7 +10,7 @@ from swarm.core import wire
 from swarm.core.bus import open_client
 from swarm.engines.grid import Engine
 from swarm.scenario import load_scenario
-from tests.distributed import ServerThread, free_endpoint, run_world, start_agents, stop
+from tests.distributed import ServerThread, free_endpoint, run_world, saving_world_cmd, start_agents, stop
 from world_server.grid.face import wire as proto
 from world_server.grid.world import L_MARK
 
@@ -156,7 +156,6 @@ def test_kill_9_the_world_then_a_restart_ends_exactly_as_swarm_run(tmp_path, kil
     import os
     import signal
     import subprocess
-    import sys
     import time
 
     from world_server import persist
@@ -167,9 +166,7 @@ def test_kill_9_the_world_then_a_restart_ends_exactly_as_swarm_run(tmp_path, kil
     endpoint = free_endpoint()
     state = persist.state_path(tmp_path, "exact")
     summary_file = tmp_path / "summary.json"
-    world_cmd = [sys.executable, "-m", "swarm", "world", "setup1", "--agents", "3", "--seed", "4", "--run-id",
-                 "exact", "--listen", endpoint, "--state-dir", str(tmp_path), "--persist-every", "20",
-                 "--deadline", "10", "--summary-file", str(summary_file)]  # fmt: skip
+    world_cmd = saving_world_cmd(tmp_path, "exact", endpoint, 20)
     world = subprocess.Popen(world_cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     agents = start_agents(endpoint, "exact", "cmarking", 3)
     procs = [world, *agents]

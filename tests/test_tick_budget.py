@@ -1,23 +1,16 @@
 """scripts/tick_budget.py: the model behind docs/scale.md adds up a tick's parts and splits them by region."""
 
-import importlib.util
 import subprocess
 import sys
 from pathlib import Path
 
+from tests.helpers import load_script
+
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "tick_budget.py"
 
 
-def load():
-    spec = importlib.util.spec_from_file_location("tick_budget", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclass looks itself up there
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_a_split_divides_the_worlds_work_and_adds_a_region_exchange():
-    budget = load()
+    budget = load_script("tick_budget")
     setup = budget.Setup()
     whole, split = budget.tick(setup, 1), budget.tick(setup, 16)
     assert whole["exchange"] == 0 < split["exchange"]
