@@ -69,6 +69,12 @@ class ArenaAgentRuntime(AgentRuntime):
     def _parse(self, data: bytes):
         return arena_proto.parse_obs(data)
 
+    def rejections(self):
+        counts = super().rejections()
+        counts["memory: could not be restored"] += self.refused_memory
+        counts["shared: refused by a controller"] += self.refused_shared
+        return +counts  # the zero counts out
+
     def _answer(self, obs: arena_proto.ArenaObs) -> int:
         agents, wheels = [], []
         mine = [(self.brains[self.slot_of[a]], a) for a in obs.agents.tolist() if a in self.slot_of]

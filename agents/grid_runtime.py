@@ -67,7 +67,8 @@ class GridAgentRuntime(AgentRuntime):
         if size == proto.NOT_PLAIN:
             return None
         if size < 0:
-            return 0  # a malformed observation: not answered (the world counts the miss)
+            self.rejected["obs: malformed"] += 1
+            return 0  # not answered (the world counts the miss)
         self.act_publisher.put(self.out_bytes[:size])
         return self.rows_written[0]
 
@@ -82,6 +83,7 @@ class GridAgentRuntime(AgentRuntime):
         n = self.answer_rows(self.kind, np.frombuffer(obs.ints, "<i8"), np.frombuffer(obs.pf, "<f8"), self.mem,
                              self.slot_table, self.rows, self.params, self.seed, obs.tick, self.null)  # fmt: skip
         if n < 0:
-            return 0  # a malformed observation: not answered (the world counts the miss)
+            self.rejected["obs: malformed"] += 1
+            return 0  # not answered (the world counts the miss)
         self.act_publisher.put(proto.pack_actions(obs.tick, self.rows[:n]))
         return n

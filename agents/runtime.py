@@ -16,6 +16,7 @@ import os
 import threading
 import time
 import uuid
+from collections import Counter
 
 from swarm.core import wire
 from swarm.core.bus import DEFAULT_ENDPOINT, open_client
@@ -36,6 +37,7 @@ class AgentRuntime:
                  rejoin_after: float = 5.0, on_error: str = "idle", ids_file: str | None = None,
                  identity: Identity | None = None):  # fmt: skip
         self.keys = wire.Keys(run_id)
+        self.rejected: Counter[str] = Counter()  # messages to us refused, by reason: said when the process ends
         self.ids_file = ids_file  # where our agents' ids go once joined (`swarm up` names them if we die)
         self.controller = controller
         self.on_error = on_error  # a controller that raises: its robot holds still, or the process stops
@@ -98,6 +100,7 @@ class AgentRuntime:
                 data, reply = reply.ok.payload.to_bytes(), None  # zenoh's copy goes: a welcome may carry MBs
                 msg, data = wire.parse_welcome(data, nonce), None
                 if isinstance(msg, wire.Rejected):
+                    self.rejected[f"welcome: {msg.reason}"] += 1
                     continue
                 if msg["type"] == "refused":
                     raise JoinRefused(f"the world refused this agent: {msg['reason']}")
@@ -158,7 +161,9 @@ class AgentRuntime:
             elif isinstance(msg, wire.HandBack):
                 self._heard = time.monotonic()
                 self._restore(msg)
-            elif not isinstance(msg, wire.Rejected):
+            elif isinstance(msg, wire.Rejected):
+                self.rejected[f"obs: {msg.reason}"] += 1
+            else:
                 latest = msg
         if latest is not None:
             self._heard = time.monotonic()
@@ -204,6 +209,18 @@ class AgentRuntime:
                 break
         self.slot_of = {agent: i for i, agent in enumerate(self.agents)}
         self._tell_ids()
+
+    def rejections(self) -> Counter[str]:
+        """What this process refused, by reason: malformed messages, and a family's refused parts."""
+        return Counter(self.rejected)
+
+    def rejections_line(self) -> str | None:
+        """One line for the process's standard error when it ends (None: nothing was refused)."""
+        counts = self.rejections()
+        if not counts:
+            return None
+        reasons = "; ".join(f"{reason}: {n}" for reason, n in sorted(counts.items()))
+        return f"swarm: agent process refused {counts.total()} messages or parts of them ({reasons})"
 
     def _tell_ids(self) -> None:
         """Our agents' ids, as a JSON list in `ids_file` (replaced whole): the launcher reads them

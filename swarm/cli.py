@@ -488,6 +488,8 @@ def cmd_agent(args) -> int:
         runtime.run()
     finally:
         runtime.close()
+        if line := runtime.rejections_line():
+            print(line, file=sys.stderr)
     return 0
 
 

@@ -185,8 +185,6 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
             summary = json.loads(summary_file.read_text())
             if session is not None:
                 losses.last_look(_say)  # died as the run ended: said and counted, not replaced
-            for line in children.told():  # the files go with the folder: said here, once the run is over
-                print(line, file=sys.stderr)
             if rss:
                 summary["agent_process_rss_mb"] = round(max(rss.values()) / 1024, 1)
             summary.update(losses.summary())
@@ -194,6 +192,8 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
             for p in children.procs[1:]:
                 with contextlib.suppress(subprocess.TimeoutExpired):
                     p.wait(timeout=max(0.0, grace - time.monotonic()))
+            for line in children.told():  # the files go with the folder: said here, once the agents have left
+                print(line, file=sys.stderr)
             return summary
         finally:
             if session is not None:
@@ -236,11 +236,13 @@ class _Children:
 
     def told(self) -> list[str]:
         """What the agent processes told of their controllers (a controller that raised or answered
-        NaN: agents.controllers.arena.StepGuard), to say again when the run ends."""
+        NaN: agents.controllers.arena.StepGuard) and of the messages they refused, to say again when
+        the run ends."""
         lines = []
         for i in range(1, len(self.procs)):
             text = (self.folder / f"child-{i}.err").read_text(errors="replace")
-            lines += [line.strip() for line in text.splitlines() if line.startswith("swarm: controller ")]
+            lines += [line.strip() for line in text.splitlines()
+                      if line.startswith(("swarm: controller ", "swarm: agent process refused"))]  # fmt: skip
         return lines
 
     def failure(self, p: subprocess.Popen) -> RunError:

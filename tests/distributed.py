@@ -86,10 +86,11 @@ class ServerThread:
 
 
 def run_world(scenario, run_id: str, agents: list[tuple[str, int, int]], attack=None, deadline: float = 10.0,
-              **kw) -> tuple[dict, object]:  # fmt: skip
+              told: list[str] | None = None, **kw) -> tuple[dict, object]:  # fmt: skip
     """A world in a thread and its agent processes, `agents` as (controller,
     processes, agents per process); `attack(endpoint, keys)` runs once they are
-    started.  Returns the summary and the world, once every process exited 0."""
+    started.  Returns the summary and the world, once every process exited 0;
+    `told` gets each agent process's standard error."""
     from swarm.core import wire
 
     endpoint = free_endpoint()
@@ -101,7 +102,10 @@ def run_world(scenario, run_id: str, agents: list[tuple[str, int, int]], attack=
         summary = world.join(timeout=240)
         for p in procs:
             p.wait(timeout=30)
-            assert p.returncode == 0, p.stderr.read().decode()[-2000:]
+            err = p.stderr.read().decode()
+            assert p.returncode == 0, err[-2000:]
+            if told is not None:
+                told.append(err)
         return summary, world.server.world
     finally:
         stop(procs)

@@ -3,6 +3,8 @@
 Lock-step runs must equal the in-process engine bit for bit, and bad traffic
 must be counted and rejected without touching the world."""
 
+import time
+
 import numpy as np
 import pytest
 
@@ -15,8 +17,8 @@ from world_server.grid.face import wire as proto
 from world_server.grid.world import L_MARK
 
 
-def _run_distributed(scenario, run_id, count=1, attack=None):
-    return run_world(scenario, run_id, [(scenario.controller, scenario.agents // count, count)], attack)
+def _run_distributed(scenario, run_id, count=1, attack=None, told=None):
+    return run_world(scenario, run_id, [(scenario.controller, scenario.agents // count, count)], attack, told=told)
 
 
 @pytest.mark.parametrize(
@@ -67,13 +69,21 @@ def test_bad_traffic_is_counted_and_changes_nothing():
             )  # a mark write: not on this key
             for _ in range(300):  # a flood
                 s.put(keys.act("flood"), b"\x93\x01\x02")
+            deadline = time.monotonic() + 60  # garbage to every agent process once both have joined:
+            while len(list(s.liveliness().get(keys.alive("*"), timeout=1.0))) < 2 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            for _ in range(5):  # each process counts it and says so when it ends
+                s.put(keys.obs("*"), b"\x00\xffgarbage")
             replies = list(s.get(keys.marks, timeout=5.0))
             assert replies and replies[0].ok is not None
         finally:
             s.close()  # fmt: skip
 
-    summary, world = _run_distributed(scenario, "attack", attack=attack)
+    told = []
+    summary, world = _run_distributed(scenario, "attack", attack=attack, told=told)
     assert summary["rejected_messages"] >= 300
+    assert len(told) == 2 and all("swarm: agent process refused 5 messages" in err for err in told), told
+    assert all("obs: not msgpack: 5" in err and "Traceback" not in err for err in told), told
     assert summary["iterations"] == expected["iterations"]
     np.testing.assert_array_equal(world.layers[L_MARK], engine.world.layers[L_MARK])
 
