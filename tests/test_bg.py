@@ -483,6 +483,27 @@ def test_beside_food_a_moderate_need_tops_up_only_below_the_dorsal_threshold(dor
     assert (r["reloads"]["ReloadEp"] > 10 and r["potential"] > 0.8) == reloads, r["reloads"]
 
 
+@pytest.mark.parametrize("cross", [0.4, 0.0])
+def test_during_an_act_eq_10s_cross_term_is_what_keeps_the_ventral_loop_from_steering(cross):
+    """Hungry for Ep beside food, with the wheels not held: while ReloadEp is selected the trans-subthalamic
+    term (the declared 0.4) lifts the ventral outputs so that a direction is released in a minority of the
+    act's ticks; without it (0), in every one.  The loops, not a rule, stop the animat (docs/bg.md)."""
+    s = arena(FOOD.format(extra="energy = 1.0\npotential = 0.3\n", x=1.2, y=0.5), w=3.0, h=2.0, robot="animat",
+              noise="low", max_ticks=600)  # fmt: skip
+    params = dict(s.controller_params)
+    params["bg"] = {**params.get("bg", {}), "gpr": {"cross": cross}}
+    engine = ArenaEngine(dataclasses.replace(s.with_overrides(start=(1.2, 0.5, math.pi)), controller_params=params))
+    animat, acts, steered = engine.controllers[0], 0, 0
+    assert not animat.p.hold_wheels
+    for _ in range(400):
+        engine.step(1)
+        if animat.last["act"] > 0:
+            acts += 1
+            steered += not math.isnan(animat.last["direction"])
+    assert acts > 50, acts  # it ate
+    assert (steered < acts / 3) if cross else (steered == acts), (acts, steered)
+
+
 class _ReadLog(dict):
     """A perception that remembers which of its readings the controller asked for."""
 
@@ -798,6 +819,15 @@ def test_a_bg_experiment_runs_on_a_floor_given_as_a_file_and_says_what_a_floor_l
     with pytest.raises(ScenarioError, match="bg-tmaze needs Ep2") as e:
         run_bg_experiment("bg-tmaze", str(lacking), 2, 1, 0, None, maps=1, progress=False)
     assert "\n" not in str(e.value)
+    # a floor that tunes the animat, or runs another experiment's saliences, is refused before any run
+    tuned = tmp_path / "tuned.toml"
+    tuned.write_text(floor.read_text().replace('saliences = "tmaze"', 'saliences = "tmaze"\ndorsal_threshold = 0.3'))
+    untyped = tmp_path / "survival-saliences.toml"
+    untyped.write_text(floor.read_text().replace('saliences = "tmaze"', ""))
+    for bad, words in [(tuned, "not dorsal_threshold"), (untyped, 'set saliences = "tmaze"')]:
+        with pytest.raises(ScenarioError, match=re.escape(words)) as e:
+            run_bg_experiment("bg-tmaze", str(bad), 2, 1, 0, None, maps=1, progress=False)
+        assert "\n" not in str(e.value)
 
 
 def test_bg_experiment_maps_option_is_checked():
@@ -852,20 +882,20 @@ def test_swarm_run_prints_the_animats_metabolism_and_map():
 
 
 def test_the_ablation_switches_change_the_animat_and_bad_ones_are_one_clear_line():
-    """[bg] feedback = "literal" (eqs. 15-20 as printed), hold_wheels = false (the loops alone stop the
-    animat), [bg.gpr] cross and dopamine (eq. 10's weight, lambda): each reaches the GPR or the wheels, and
+    """[bg] feedback = "literal" (eqs. 15-20 as printed), hold_wheels = true (a rule holds the wheels during
+    an act), [bg.gpr] cross and dopamine (eq. 10's weight, lambda): each reaches the GPR or the wheels, and
     the declared animat is the default of each."""
     from agents.controllers.bg.controller import bg_params, check_table
 
     base = controller_params(load_scenario("bg-exp1"), 0)
     animat = BgController()
     animat.reset(0, 0, base)
-    assert animat.bg.cross == 0.4 and animat.bg.dopamine == 0.2 and animat.p.hold_wheels
+    assert animat.bg.cross == 0.4 and animat.bg.dopamine == 0.2 and not animat.p.hold_wheels
     assert np.isfinite(animat.bg.ctx_rest_d).all() and (animat.bg.ctx_rest_d > 0.5).all()  # from rest
     ablated = BgController()
-    ablated.reset(0, 0, {**base, "bg": {**base["bg"], "feedback": "literal", "hold_wheels": False,
+    ablated.reset(0, 0, {**base, "bg": {**base["bg"], "feedback": "literal", "hold_wheels": True,
                                         "gpr": {"cross": 0.0, "dopamine": 0.4}}})  # fmt: skip
-    assert ablated.bg.cross == 0.0 and ablated.bg.dopamine == 0.4 and not ablated.p.hold_wheels
+    assert ablated.bg.cross == 0.0 and ablated.bg.dopamine == 0.4 and ablated.p.hold_wheels
     assert (ablated.bg.ctx_rest_d == 0.0).all()  # the cortex's whole output fed back
     # literally, a salience of 0.1 selects an act outright (why the feedback counts from rest)
     ablated.bg.run(np.array([0.1, 0.0]), np.zeros(36), 2.0)

@@ -14,7 +14,7 @@ from agents.controllers.bg.gpr import (
 from agents.controllers.bg.params import BgParams
 
 THRESHOLD = 0.2
-VENTRAL = BgParams().ventral_threshold  # the animat's: below 1.3 times the resting output
+VENTRAL = BgParams().ventral_threshold  # the animat's: below 1.6 times the resting output
 
 
 def lone_loop(channels: int = 6, feedback: float = 0.2) -> BasalGanglia:

@@ -303,6 +303,55 @@ def spearman(x: Sequence[float], y: Sequence[float]) -> Comparison:
                       int(keep.sum()))  # fmt: skip
 
 
+def cochrans_q(outcomes: Sequence[Sequence[bool]]) -> Comparison:
+    """Binary outcomes of k conditions on the same cases (one sequence per condition, case i in place i):
+    Cochran's Q, the k-condition McNemar.  Effect: the first condition's share minus the last's."""
+    from statsmodels.stats.contingency_tables import cochrans_q as q
+
+    table = np.column_stack([np.asarray(o, bool) for o in outcomes]).astype(int)
+    n = len(table)
+    effect = float(table[:, 0].mean() - table[:, -1].mean()) if n else math.nan
+    if n == 0 or np.all(table == table[:, :1]):  # every case alike across conditions: nothing to test
+        return Comparison("Cochran's Q", 0.0, 1.0, effect, "difference of proportions", n)
+    res = q(table)
+    return Comparison("Cochran's Q", float(res.statistic), float(res.pvalue), effect, "difference of proportions", n)
+
+
+def _paired_finite(x: Sequence[float], y: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    u, v = np.asarray(x, float), np.asarray(y, float)
+    keep = np.isfinite(u) & np.isfinite(v)
+    return u[keep], v[keep]
+
+
+def _paired_bootstrap(x: Sequence[float], y: Sequence[float], statistic, what: str, seed: int) -> Estimate:
+    """A statistic of (x, y) pairs with its bootstrap interval, the pairs resampled together (BCa)."""
+    from scipy.stats import bootstrap
+
+    u, v = _paired_finite(x, y)
+    if len(u) < 3 or np.all(u == u[0]) or np.all(v == v[0]):
+        return Estimate(float(statistic(u, v)) if len(u) >= 3 else math.nan, math.nan, math.nan, len(u), what)
+    res = bootstrap((u, v), statistic, paired=True, vectorized=False, confidence_level=CONFIDENCE,
+                    n_resamples=RESAMPLES, method="BCa", random_state=np.random.default_rng(seed))  # fmt: skip
+    low, high = res.confidence_interval
+    return Estimate(float(statistic(u, v)), float(low), float(high), len(u), what)
+
+
+def _rho(u: np.ndarray, v: np.ndarray) -> float:
+    from scipy.stats import spearmanr
+
+    return float(spearmanr(u, v).statistic)
+
+
+def spearman_ci(x: Sequence[float], y: Sequence[float], seed: int = 0) -> Estimate:
+    """Spearman's rho of y with x, with a bootstrap interval over the (x, y) pairs."""
+    return _paired_bootstrap(x, y, _rho, "Spearman's rho", seed)
+
+
+def slope_ci(x: Sequence[float], y: Sequence[float], seed: int = 0) -> Estimate:
+    """The least-squares slope of y on x, with a bootstrap interval over the (x, y) pairs."""
+    return _paired_bootstrap(x, y, lambda u, v: float(np.polyfit(u, v, 1)[0]), "slope", seed)
+
+
 def binomial(successes: int, n: int, null: float = 0.5) -> Comparison:
     """One group's k of n against a share `null` (e.g. one of two options preferred): the exact binomial
     test.  Effect: the observed share minus `null`."""

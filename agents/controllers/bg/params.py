@@ -59,12 +59,11 @@ class BgParams:
         "needed from rest: the animat would reload at the faintest need (docs/bg.md, The GPR model)",
     )
     hold_wheels: bool = declared(
-        True,
-        source=OURS,
-        reason="a dorsal act holds the wheels: with eq. 10's cross term alone, our ventral read-out "
-        "(ventral_threshold) still releases a direction in about a third of the ticks of acts "
-        "longer than a second (bg-exp1, development seeds 1-2), which would walk the animat off "
-        "the resource mid-meal; False, an ablation (docs/bg.md, Selection)",
+        False,
+        source=PAPER,
+        where="section 2.2.3 and eq. 10: the loops alone stop the animat during an act (the "
+        "trans-subthalamic cross term); True, which sets the wheels to zero whenever a dorsal act "
+        "is selected, is an ablation (docs/bg.md, Selection)",
     )
     too_close: float = declared(
         0.45,

@@ -16,7 +16,8 @@ from swarm.core.params import OURS, declared
 class MapParams:
     """The topological map's numbers (the fingerprint paper's map, its [27] for loops; the BG animat's Filliat-
     style map): none is given by either paper, all ours (docs/fingerprint.md, the map; docs/bg.md,
-    Navigation).
+    Navigation).  The BG animat sets theta, closure_match, merge_match, near, recent and closure_radius from
+    its own NavParams; the values below are the fingerprint robot's and, for the rest, both.
     """
 
     theta: float = declared(

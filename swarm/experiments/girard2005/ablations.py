@@ -5,7 +5,7 @@ Each condition changes one thing of the declared animat (agents/controllers/bg/p
 
 - eq. 10's trans-subthalamic cross term off (`[bg.gpr] cross = 0`);
 - the cortical feedback of eqs. 15-20 as printed, not counted from rest (`[bg] feedback = "literal"`);
-- the wheels not held during a dorsal act, so only the loops stop the animat (`[bg] hold_wheels = false`);
+- the wheels held during a dorsal act, a rule stopping the animat beside the loops (`[bg] hold_wheels = true`);
 - the dopamine level lambda at 0.1 and 0.3 (the paper's 0.2; `[bg.gpr] dopamine`);
 - biased odometry and compass: the paper's +-5% odometric error and half its +-10 degree compass error
   drawn once per animat and run instead of every tick, so that the odometric position drifts.
@@ -40,7 +40,7 @@ ABLATIONS: dict[str, tuple[dict[str, Any], dict[str, dict[str, float]]]] = {
     MODEL: ({}, {}),
     "no cross term (eq. 10)": ({"gpr": {"cross": 0.0}}, {}),
     "literal cortical feedback": ({"feedback": "literal"}, {}),
-    "wheels not held": ({"hold_wheels": False}, {}),
+    "wheels held": ({"hold_wheels": True}, {}),
     "dopamine 0.1": ({"gpr": {"dopamine": 0.1}}, {}),
     "dopamine 0.3": ({"gpr": {"dopamine": 0.3}}, {}),
     "biased odometry and compass": ({}, {"odometry": {"bias": 0.05}, "compass": {"bias": 5 * DEG}}),

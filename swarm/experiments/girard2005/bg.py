@@ -49,6 +49,11 @@ EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze")
 SCENARIO = {"bg-survival": "bg-exp1", "bg-choice": "bg-exp2", "bg-forget": "bg-exp2", "bg-fear": "bg-exp3",
             "bg-tmaze": "tmaze", "bg-ablations": "tmaze-1", "bg-colony": "bg-colony"}  # fmt: skip
 REPS = {"bg-survival": 10, "bg-choice": 15, "bg-forget": 15, "bg-fear": 20, "bg-tmaze": 15}
+# What a floor's [bg] table may set: the paper's per-experiment changes (eqs. 15-20's variant, 3.1's F) and the
+# colony's shared map; every other number is the declared animat's (agents/controllers/bg/params.py).
+FLOOR_BG_KEYS = ("saliences", "fear", "share")
+VARIANT = {"bg-survival": "survival", "bg-choice": "survival", "bg-forget": "survival", "bg-fear": "fear",
+           "bg-tmaze": "tmaze", "bg-colony": "survival"}  # fmt: skip
 MAPPING_SECONDS = 7200.0  # the mapping phase of experiments 2 and 3: at most two hours of the animat's life ...
 MAPPING_LEVELS = (0.5, 0.5)  # E, Ep during mapping: needs enough to seek both resources and reload there ...
 MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping animat must live to map
@@ -455,11 +460,25 @@ def check_floors(experiment: str, scenario: str | None, ratios, changes: dict[st
         kinds = {o.zone for o in s.obstacles if o.zone is not None}
         if not {"ingesting", "digesting"} <= kinds:
             raise ScenarioError(floor, "resources", "the animat needs an ingesting (Ep) and a digesting (E) resource")
+        _check_floor_bg(experiment, floor, s.controller_params.get("bg", {}))
         try:
             check_table(_merged(s.controller_params.get("bg", {}), changes))
         except ValueError as e:
             raise ScenarioError("command line", "--bg", str(e)) from None
     return floors
+
+
+def _check_floor_bg(experiment: str, floor: str, table: dict[str, Any]) -> None:
+    """A floor sets only what the paper changes per experiment, and the saliences of this experiment: a floor
+    copied from another experiment's, or tuning the animat, would otherwise run another model unsaid."""
+    if extra := sorted(set(table) - set(FLOOR_BG_KEYS)):
+        raise ScenarioError(floor, "bg", f"{experiment} runs the declared animat: a floor's [bg] sets only "
+                            f"{', '.join(FLOOR_BG_KEYS)}, not {', '.join(extra)} (a model parameter: "
+                            "agents/controllers/bg/params.py; change one for a run with --bg)")  # fmt: skip
+    wanted = VARIANT.get(experiment)
+    if wanted is not None and table.get("saliences", "survival") != wanted:
+        raise ScenarioError(floor, "bg.saliences", f"{experiment} runs the {wanted!r} saliences (the paper's for "
+                            f"this experiment): set saliences = \"{wanted}\" in the floor's [bg]")  # fmt: skip
 
 
 def mapped_floors(experiment: str, floors: tuple[str, ...]) -> dict[str, tuple[str, tuple[str, ...]]]:
