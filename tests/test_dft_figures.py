@@ -31,14 +31,15 @@ def test_the_figures_are_drawn_and_the_planning_times_are_finite_one_row_per_run
     by = {int(r["pair"]): r for r in rows}
     assert int(by[2]["planning_ticks"]) < int(by[1]["planning_ticks"])
     md = result["markdown"]
-    assert "Spearman rho" in md and "Development seeds" in md
+    assert "Spearman rho" in md and "Development seeds" in md and "ticks per metre" in md
     with open(tmp_path / "summary.csv") as f:
         summary = list(csv.DictReader(f))
     assert summary[0]["figure"] == "planning" and summary[0]["planned"] == "3"
 
 
-def test_the_figures_refuse_confirmation_seeds_and_other_floors(tmp_path):
-    with pytest.raises(ScenarioError, match="development seeds"):
-        run_dft_figures("dft-figures", reps=1, jobs=1, seed=10_000, out=tmp_path, progress=False)
+def test_the_figures_refuse_seeds_across_both_ranges_and_other_floors(tmp_path):
+    with pytest.raises(ScenarioError, match="must lie in one range") as e:
+        run_dft_figures("dft-figures", reps=20, jobs=1, seed=9_990, out=tmp_path, progress=False)
+    assert "9990 to 10010" in str(e.value) and "\n" not in str(e.value)
     with pytest.raises(ScenarioError, match="--scenario"):
         run_dft_figures("dft-figures", reps=1, jobs=1, seed=0, out=tmp_path, scenario="zmaze", progress=False)

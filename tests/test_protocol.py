@@ -24,6 +24,7 @@ from swarm.experiments.protocol import (
 from swarm.experiments.stats import (
     Comparison,
     cochran_mantel_haenszel,
+    cochrans_q,
     fisher,
     kaplan_meier_median,
     logrank,
@@ -34,7 +35,9 @@ from swarm.experiments.stats import (
     proportion_ci,
     ratio_of_means,
     restricted_mean,
+    slope_ci,
     spearman,
+    spearman_ci,
     wilcoxon_paired,
 )
 
@@ -140,3 +143,22 @@ def test_ratio_of_means_tests_against_its_null_and_pairs_when_told():
 def test_spearman_sees_a_falling_trend():
     t = spearman([12, 25, 50, 100] * 5, [0.9, 0.7, 0.5, 0.3] * 5)
     assert t.effect == pytest.approx(-1.0) and t.p < 0.001
+
+
+def test_cochrans_q_with_two_conditions_is_mcnemars_chi_square_and_sees_a_paired_shift():
+    a, b = [True] * 12 + [False] * 8, [True] * 4 + [False] * 16  # 8 discordant pairs, all one way
+    q = cochrans_q([a, b])
+    assert q.statistic == pytest.approx(8.0) and q.p == pytest.approx(0.004677735, rel=1e-6)
+    assert q.effect == pytest.approx(0.4)
+    assert cochrans_q([a, a, a]).p == 1.0 and cochrans_q([a, a, a]).effect == 0.0
+
+
+def test_paired_bootstrap_intervals_hold_rho_and_slope_and_none_below_eight_pairs():
+    rng = np.random.default_rng(3)
+    x = rng.uniform(0.0, 2.0, 40)
+    y = 170.0 * x + 10.0 + rng.normal(0.0, 10.0, 40)
+    rho, slope = spearman_ci(x, y), slope_ci(x, y)
+    assert rho.low < rho.value <= rho.high <= 1.0 and rho.value > 0.95
+    assert slope.low < 170.0 < slope.high and slope.value == pytest.approx(np.polyfit(x, y, 1)[0])
+    few = slope_ci(x[:5], y[:5])
+    assert math.isfinite(few.value) and math.isnan(few.low) and math.isnan(few.high) and few.n == 5

@@ -323,23 +323,36 @@ def _paired_finite(x: Sequence[float], y: Sequence[float]) -> tuple[np.ndarray, 
     return u[keep], v[keep]
 
 
+PAIRED_MIN = 8  # pairs below which a paired bootstrap gives no interval: resamples of fewer are often degenerate
+
+
 def _paired_bootstrap(x: Sequence[float], y: Sequence[float], statistic, what: str, seed: int) -> Estimate:
-    """A statistic of (x, y) pairs with its bootstrap interval, the pairs resampled together (BCa)."""
+    """A statistic of (x, y) pairs with its bootstrap interval, the pairs resampled together (BCa); the
+    interval is nan below PAIRED_MIN pairs or when either side has no spread."""
     from scipy.stats import bootstrap
 
     u, v = _paired_finite(x, y)
-    if len(u) < 3 or np.all(u == u[0]) or np.all(v == v[0]):
-        return Estimate(float(statistic(u, v)) if len(u) >= 3 else math.nan, math.nan, math.nan, len(u), what)
+    value = float(statistic(u, v)) if len(u) >= 3 else math.nan
+    if len(u) < PAIRED_MIN or np.all(u == u[0]) or np.all(v == v[0]):
+        return Estimate(value, math.nan, math.nan, len(u), what)
     res = bootstrap((u, v), statistic, paired=True, vectorized=False, confidence_level=CONFIDENCE,
                     n_resamples=RESAMPLES, method="BCa", random_state=np.random.default_rng(seed))  # fmt: skip
     low, high = res.confidence_interval
-    return Estimate(float(statistic(u, v)), float(low), float(high), len(u), what)
+    return Estimate(value, float(low), float(high), len(u), what)
 
 
 def _rho(u: np.ndarray, v: np.ndarray) -> float:
     from scipy.stats import spearmanr
 
+    if np.all(u == u[0]) or np.all(v == v[0]):  # a resample without spread: no correlation to speak of
+        return math.nan
     return float(spearmanr(u, v).statistic)
+
+
+def _slope(u: np.ndarray, v: np.ndarray) -> float:
+    du = u - u.mean()
+    spread = float(du @ du)
+    return float(du @ (v - v.mean())) / spread if spread > 0 else math.nan
 
 
 def spearman_ci(x: Sequence[float], y: Sequence[float], seed: int = 0) -> Estimate:
@@ -349,7 +362,7 @@ def spearman_ci(x: Sequence[float], y: Sequence[float], seed: int = 0) -> Estima
 
 def slope_ci(x: Sequence[float], y: Sequence[float], seed: int = 0) -> Estimate:
     """The least-squares slope of y on x, with a bootstrap interval over the (x, y) pairs."""
-    return _paired_bootstrap(x, y, lambda u, v: float(np.polyfit(u, v, 1)[0]), "slope", seed)
+    return _paired_bootstrap(x, y, _slope, "slope", seed)
 
 
 def binomial(successes: int, n: int, null: float = 0.5) -> Comparison:

@@ -13,7 +13,8 @@ dft controller.
 Planning is complete at the first tick some intention field's output exceeds 0.5 within 15 cm of the robot
 (the robot starts to move: the paper's t = 210 of Figure 12; the goal's own intention forms at once); the
 plan reaches the robot at the first tick a motivation field is above zero within 15 cm of it.
-Every run is on development seeds (swarm/experiments/protocol.py).
+Its runs take seeds from one of the protocol's ranges (swarm/experiments/protocol.py): development, to look
+at, or confirmation, for the numbers docs/dft.md quotes.
 """
 
 from __future__ import annotations
@@ -25,9 +26,10 @@ import numpy as np
 
 from swarm.core.errors import ScenarioError
 from swarm.core.plots import pyplot, save_figure
+from swarm.experiments import stats as S
 from swarm.experiments.billing2015.carrot import LARGE_HEADING, random_pairs, zmaze_pairs
 from swarm.experiments.billing2015.dft import CASE3_BOXES, CASE3_GOAL, CASE3_START, classify
-from swarm.experiments.protocol import DEVELOPMENT_SEEDS
+from swarm.experiments.protocol import CONFIRMATION_SEEDS, DEVELOPMENT_SEEDS
 from swarm.experiments.runner import Outputs, batch_run
 
 EBS = ("N", "S", "W", "E")
@@ -325,8 +327,7 @@ def run_dft_figures(name: str, reps: int | None, jobs: int | None, seed: int, ou
 
     if scenario is not None:
         raise ScenarioError("command line", "--scenario", f"{name} draws the paper's mazes (zmaze, large-maze)")
-    if seed not in DEVELOPMENT_SEEDS or seed + max(reps or 20, CASE2_PAIRS) not in DEVELOPMENT_SEEDS:
-        raise ScenarioError("command line", "--seed", f"{name} runs on development seeds (0 to 9999)")
+    seeds = _seed_range(name, seed, seed + max(reps or 20, CASE2_PAIRS))
     reps = 20 if reps is None else reps
     if not 1 <= reps <= 100:
         raise ScenarioError("command line", "--reps", "zmaze has the paper's 100 pairs: --reps 1 to 100")
@@ -356,43 +357,66 @@ def run_dft_figures(name: str, reps: int | None, jobs: int | None, seed: int, ou
     else:
         rho = p = math.nan
     first, last = seed + 1, seed + reps
-    plot_planning(planning, rho, p, f"development seeds {first}-{last} (seed + pair)", out / "planning.png")
-    note = f"development seed {seed}"
+    plot_planning(planning, rho, p, f"{seeds} seeds {first}-{last} (seed + pair)", out / "planning.png")
+    note = f"{seeds} seed {seed}"
     plot_motivation(replan, note, out / "motivation.png")
     plot_activity(replan, note, out / "activity.png")
     plot_velocity(replan, note, out / "velocity.png")
-    plot_paths(paths, f"development seeds {seed + 1}-{seed + min(reps, CASE2_PAIRS)} (seed + pair)",
+    plot_paths(paths, f"{seeds} seeds {seed + 1}-{seed + min(reps, CASE2_PAIRS)} (seed + pair)",
                out / "paths.png")  # fmt: skip
 
-    summary, md = _report(planning, ok, replan, paths, rho, p, seed, reps, max_ticks)
+    summary, md = _report(planning, ok, replan, paths, rho, p, seed, reps, max_ticks, seeds)
     result = out.finish(summary, md)
     result["runs"] = len(rows)
     return result
 
 
+def _seed_range(name: str, first: int, last: int) -> str:
+    """Which of the protocol's ranges holds every seed from `first` to `last`; refused if none does."""
+    for label, pool in (("development", DEVELOPMENT_SEEDS), ("confirmation", CONFIRMATION_SEEDS)):
+        if first in pool and last in pool:
+            return label
+    raise ScenarioError("command line", "--seed", f"{name} uses seeds {first} to {last}: they must lie in one range, "
+                        "development (0 to 9999) or confirmation (10000 to 19999)")  # fmt: skip
+
+
 def _report(planning: list[dict], ok: list[dict], replan: dict, paths: list[dict], rho: float, p: float,
-            seed: int, reps: int, max_ticks: int | None) -> tuple[list[dict], str]:  # fmt: skip
+            seed: int, reps: int, max_ticks: int | None, seeds: str) -> tuple[list[dict], str]:  # fmt: skip
     """summary.csv's rows and table.md's text."""
     first, last = seed + 1, seed + reps
     ticks = np.array([r["planning_ticks"] for r in ok], float)
+    lengths = [r["optimal_length"] for r in ok]
+    rho_ci, slope = S.spearman_ci(lengths, ticks, seed), S.slope_ci(lengths, ticks, seed)
     summary = [{"figure": "planning", "pairs": len(planning), "planned": len(ok),
                 "planning_ticks_median": float(np.median(ticks)) if len(ok) else None,
                 "spearman_rho": round(rho, 3) if math.isfinite(rho) else None,
-                "spearman_p": float(f"{p:.3g}") if math.isfinite(p) else None},
+                "spearman_p": float(f"{p:.3g}") if math.isfinite(p) else None,
+                "spearman_rho_low": _round(rho_ci.low), "spearman_rho_high": _round(rho_ci.high),
+                "ticks_per_metre": _round(slope.value), "ticks_per_metre_low": _round(slope.low),
+                "ticks_per_metre_high": _round(slope.high)},
                {"figure": "replanning", "seed": seed, "planning_ticks": replan["planning_ticks"],
                 "route": replan["route"], "reached": replan["reached"], "ticks_to_goal": replan["ticks_to_goal"]},
                {"figure": "paths", "runs": len(paths), "reached": sum(bool(r["reached"]) for r in paths)}]  # fmt: skip
     lines = "\n".join(f"| {r['pair']} | {r['optimal_length']:.3f} | {r['plan_reached_tick']} | {r['planning_ticks']} |"
                       for r in planning)  # fmt: skip
-    md = (f"# Figures of Billing et al. (2015) from the dft controller\n\nDevelopment seeds: the planning runs "
-          f"{first}-{last}, the case-3 run {seed}, the case-2 runs {seed + 1}-{seed + min(reps, CASE2_PAIRS)}; "
+    md = (f"# Figures of Billing et al. (2015) from the dft controller\n\n{seeds.capitalize()} seeds: the planning "
+          f"runs {first}-{last}, the case-3 run {seed}, the case-2 runs {seed + 1}-{seed + min(reps, CASE2_PAIRS)}; "
           f"at most {max_ticks or 3000} steps a case-2 or case-3 run.\n\n"
           f"## Planning time against path length (planning.png)\n\n{len(ok)} of {len(planning)} Z-maze pairs "
-          f"planned at low noise; Spearman rho = {rho:.3f} (p = {p:.3g}) between A*'s L_o and the ticks until an "
-          f"intention formed.\n\n| pair | L_o (m) | plan reaches the robot (tick) | planning complete (tick) |\n"
+          f"planned at low noise; Spearman rho = {rho:.3f} (95% CI {_interval(rho_ci)}, p = {p:.3g}) between A*'s "
+          f"L_o and the ticks until an intention formed; least-squares slope {slope.text()} ticks per metre.\n\n"
+          f"| pair | L_o (m) | plan reaches the robot (tick) | planning complete (tick) |\n"
           f"|---|---|---|---|\n{lines}\n\n"
           f"## Case 3 (motivation.png, activity.png, velocity.png)\n\nFull obstacle at t = {REPLAN_APPEAR} for "
           f"{REPLAN_DURATION} steps; planning complete at t = {replan['planning_ticks']}; route {replan['route']}; "
           f"reached: {replan['reached']} (tick {replan['ticks_to_goal']}).\n\n"
           f"## Case 2 (paths.png)\n\n{summary[2]['reached']} of {len(paths)} runs reached their goal.\n")  # fmt: skip
     return summary, md
+
+
+def _round(x: float) -> float | None:
+    return round(x, 3) if math.isfinite(x) else None
+
+
+def _interval(e: S.Estimate) -> str:
+    return f"[{e.low:.3f}, {e.high:.3f}]" if math.isfinite(e.low) else "n/a"
