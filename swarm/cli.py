@@ -278,7 +278,21 @@ def _add_router(sub) -> None:
     )
     router.add_argument("--listen", default="tcp/0.0.0.0:7447", metavar="ENDPOINT",
                         help="where to listen (default tcp/0.0.0.0:7447)")  # fmt: skip
+    router.add_argument("--mesh", action="append", default=[], type=_mesh_endpoint, metavar="ENDPOINT",
+                        help="link to every other router this name resolves to, e.g. tcp/router:7447 for a "
+                        "Docker Swarm service with endpoint_mode dnsrr or a Kubernetes headless service "
+                        "(repeat it for more names; docs/deploy.md)")  # fmt: skip
     credentials_arg(router, "`router`: check logins and enforce the access rules")
+
+
+def _mesh_endpoint(text: str) -> str:
+    from swarm.core.mesh import split
+
+    try:
+        split(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
 
 
 def _add_prepare(sub) -> None:
@@ -607,7 +621,7 @@ def cmd_status(args) -> int:
 def cmd_router(args) -> int:
     from swarm.monitor import serve_router
 
-    serve_router(args.listen, identity(args))
+    serve_router(args.listen, identity(args), tuple(args.mesh))
     return 0
 
 

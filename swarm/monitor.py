@@ -18,6 +18,7 @@ import time
 from swarm.core import wire
 from swarm.core.bus import open_client, open_router
 from swarm.core.credentials import Identity
+from swarm.core.mesh import others
 from swarm.core.wire import world_info
 from world_server import progress_keys
 
@@ -37,13 +38,15 @@ def status(connect: str, run_id: str, router_only: bool = False, timeout: float 
         session.close()
 
 
-def serve_router(listen: str, identity: Identity | None = None) -> None:
+def serve_router(listen: str, identity: Identity | None = None, mesh: tuple[str, ...] = ()) -> None:
     """A bare zenoh router until SIGTERM or Ctrl-C; with `identity` (the `router` folder) it checks
-    logins and enforces the access rules."""
-    session = open_router(listen, identity)
+    logins and enforces the access rules; linked to every other router each `mesh` name lists."""
+    routers = [found for name in mesh for found in others(name)]
+    session = open_router(listen, identity, routers)
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    print(f"swarm: zenoh router listening on {listen}", file=sys.stderr, flush=True)
+    linked = f", linked to {', '.join(routers)}" if routers else ""
+    print(f"swarm: zenoh router listening on {listen}{linked}", file=sys.stderr, flush=True)
     try:
         while not stop.wait(1.0):
             pass

@@ -1,4 +1,5 @@
-"""`docker compose up swarm` against a real Docker engine (compose.yaml, Dockerfile).
+"""`docker compose up swarm` against a real Docker engine (compose.yaml, Dockerfile), and
+`docker stack deploy` of stack.yaml on a real two-node Docker Swarm.
 
 The image is built from a debootstrapped base and a host-built wheelhouse (no
 registry is reachable here).  One run of 3 agent containers goes to the end:
@@ -6,7 +7,10 @@ the monitor's summary and its exit code, and the recording in ./runs.  A second,
 longer run is scaled from 3 to 5 agents while the world ticks: the two new
 containers join it.  Debian ships compose v1 (`docker-compose`), whose
 `--exit-code-from` is broken on Python 3.11, so exit codes are read with
-`docker inspect`.  Everything is torn down, run or fail, the app image too.
+`docker inspect`.  Then the same image runs as a stack on this engine and a second one
+(tests/docker_swarm.py): a router on each node, meshed over the overlay network, the world
+on the labelled node, agents on both; the run equals the compose run.  Everything is torn
+down, run or fail, the app image too.
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ import pytest
 
 from tests.distributed import free_endpoint
 from tests.docker_engine import BASE_TAG, ROOT, build_base, build_wheelhouse, docker_engine, why_no_engine
+from tests.docker_swarm import Nodes, docker, two_node_swarm, why_no_second_node
 
 pytestmark = pytest.mark.timeout(900)
 
@@ -142,3 +147,79 @@ def test_scaling_a_running_world_from_3_to_5_agents(compose):
     for recording in (ROOT / "runs").glob(f"{run_id}-*.rrd"):
         recording.unlink()
     print(f"5 agents active from tick {joined_at}")
+
+
+@pytest.fixture(scope="module")
+def swarm_nodes(compose):
+    """A two-node Docker Swarm of the test's engine (the world's node) and a second one, both with the image."""
+    if (reason := why_no_second_node()) is not None:
+        pytest.skip(f"a second Docker engine cannot be started here: {reason}")
+    if docker("info", "-f", "{{.Swarm.LocalNodeState}}").stdout.strip() != "inactive":
+        pytest.skip("the engine is already part of a swarm; the test needs one it can make and leave")
+    started = time.monotonic()
+    with two_node_swarm("swarm:local") as nodes:
+        print(f"second engine started, swarm made, image copied: {time.monotonic() - started:.0f} s")
+        yield nodes
+
+
+def _logs(service: str) -> str:
+    """What the service's tasks wrote, stdout and stderr (the docker client splits them as they were)."""
+    out = docker("service", "logs", "--raw", service, check=False)
+    return out.stdout + out.stderr
+
+
+def _task_nodes(service: str) -> set[str]:
+    tasks = docker("service", "ps", "-q", service).stdout.split()
+    return set(docker("inspect", "-f", "{{.NodeID}}", *tasks).stdout.split())
+
+
+def _finished(service: str, timeout: float) -> bool:
+    """Whether the service's task completed (exit 0) within `timeout`; False if it failed for good."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        states = docker("service", "ps", "--format", "{{.CurrentState}}", service, check=False).stdout.split("\n")
+        if any(s.startswith("Complete") for s in states):
+            return True
+        time.sleep(1)
+    return False
+
+
+def _stack_down(stack: str, nodes: Nodes) -> None:
+    docker("stack", "rm", stack, check=False)
+    deadline = time.monotonic() + 90
+    while nodes.stack_containers(stack) and time.monotonic() < deadline:
+        time.sleep(1)
+    docker("volume", "rm", f"{stack}_state", check=False)
+
+
+def test_stack_deploy_runs_on_two_nodes_as_compose_does(swarm_nodes, tmp_path):
+    stack, run_id = f"swarmstack{uuid.uuid4().hex[:6]}", f"stack{uuid.uuid4().hex[:6]}"
+    ports = {name: free_endpoint().rsplit(":", 1)[1] for name in ("ROUTER_PORT", "VIEWER_PORT", "GRPC_PORT")}
+    env = {**os.environ, **ports, "IMAGE": "swarm:local", "RUN_ID": run_id, "SCENARIO": "open", "SEED": "1",
+           "AGENTS": "3", "MAX_AGENTS": "3", "RUNS": str(tmp_path)}  # fmt: skip
+    started = time.monotonic()
+    try:
+        docker("stack", "deploy", "--detach=true", "--resolve-image", "never", "-c", "stack.yaml", stack, cwd=ROOT,
+               env=env)  # fmt: skip
+        done = _finished(f"{stack}_swarm", timeout=300)
+        took = time.monotonic() - started
+        log = _logs(f"{stack}_swarm")
+        if not done:
+            for service in ("router", "world", "agent"):
+                print(_logs(f"{stack}_{service}")[-3000:])
+        assert done, f"the monitor did not finish: {log[-3000:]}"
+        assert "open: cmarking x3, seed 1: finished after 2367 iterations" in log, log  # = swarm run, = compose
+        assert "delivered 6000/6000" in log and "agents joined 3 (at most 3 at once), lost 0" in log, log
+        assert _task_nodes(f"{stack}_router") == {swarm_nodes.manager, swarm_nodes.worker}  # global: one each
+        assert _task_nodes(f"{stack}_world") == {swarm_nodes.manager}  # the labelled node
+        assert _task_nodes(f"{stack}_agent") == {swarm_nodes.manager, swarm_nodes.worker}
+        routers = _logs(f"{stack}_router")
+        assert "linked to tcp/" in routers, routers  # the later router found the earlier one by name
+        (recording,) = tmp_path.glob(f"{run_id}-*.rrd")
+        from swarm.review.report import read_recording, summary_from
+
+        summary = summary_from(read_recording(recording))
+        assert (summary["iterations"], summary["delivered"], summary["agents_peak"]) == (2367, 6000, 3)
+        print(f"docker stack deploy on two nodes, to the summary: {took:.1f} s")
+    finally:
+        _stack_down(stack, swarm_nodes)

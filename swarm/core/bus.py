@@ -64,10 +64,12 @@ def _said(exc: Exception) -> str:
     return re.sub(r" at /\S+\.rs:\d+\.?", "", str(exc))
 
 
-def open_router(listen: str = DEFAULT_ENDPOINT, identity: Identity | None = None) -> zenoh.Session:
-    """A session in router mode: the embedded router every other process joins."""
+def open_router(listen: str = DEFAULT_ENDPOINT, identity: Identity | None = None,
+                connect: list[str] | None = None) -> zenoh.Session:  # fmt: skip
+    """A session in router mode: the embedded router every other process joins; linked to the
+    routers at `connect` (zenoh keeps retrying those that do not answer)."""
     try:
-        return zenoh.open(config("router", listen=[listen], identity=identity))
+        return zenoh.open(config("router", listen=[listen], connect=connect, identity=identity))
     except zenoh.ZError as exc:
         raise ConnectionError(
             f"cannot listen on {listen} ({_said(exc)}); is another world running? pick another --listen"
