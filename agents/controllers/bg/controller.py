@@ -142,7 +142,7 @@ class BgController:
         d, v = self.bg.disinhibition()
         chosen = select_dorsal(d, self.p.dorsal_threshold, self.acting)
         self.acting = chosen
-        direction, strength = select_ventral(v, self.p.ventral_threshold)
+        direction, strength = select_ventral(v, self.p.ventral_threshold, self.p.ventral_min_share)
         reflex = self.reflex(sonar, self.dt) if chosen < 0 else None
         act = chosen + 1  # 0: none
         if chosen >= 0 and self.p.hold_wheels:

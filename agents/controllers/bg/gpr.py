@@ -272,11 +272,11 @@ def _circle(n: int) -> tuple[np.ndarray, np.ndarray]:
     return np.cos(angle), np.sin(angle)
 
 
-def select_ventral(disinhibition: np.ndarray, threshold: float) -> tuple[float, float]:
+def select_ventral(disinhibition: np.ndarray, threshold: float, min_share: float = 0.1) -> tuple[float, float]:
     """(direction, strength): the vector sum of the channels released beyond
     `threshold`, each weighted by how far beyond it (channel i points at
     i * 360/N degrees); strength 0 (direction nan) when none is, or when the
-    released channels point every way (their sum is under a tenth of their weight)."""
+    released channels point every way (their sum is under `min_share` of their weight)."""
     w = np.empty(len(disinhibition))  # each channel's weight: how far beyond the threshold
     total = _released(np.ascontiguousarray(disinhibition, np.float64), float(threshold), w)
     if total == 0.0:  # none beyond it
@@ -284,6 +284,6 @@ def select_ventral(disinhibition: np.ndarray, threshold: float) -> tuple[float, 
     cos, sin = _circle(len(disinhibition))
     x, y = float(w.dot(cos)), float(w.dot(sin))  # w @ cos's BLAS sums, with less of numpy's dispatch
     length = float(np.hypot(x, y))
-    if length < 0.1 * total:
+    if length < min_share * total:
         return float("nan"), 0.0
     return math.atan2(y, x) % (2 * math.pi), length  # libm's atan2, as np.arctan2

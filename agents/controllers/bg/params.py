@@ -58,6 +58,13 @@ class BgParams:
         "rest, above D1's threshold, and a salience of 0.1 selects an act outright, where 0.35 is "
         "needed from rest: the animat would reload at the faintest need (docs/bg.md, The GPR model)",
     )
+    ventral_min_share: float = declared(
+        0.1,
+        source=OURS,
+        reason="the ventral vector sum must be at least this share of its weights to give a direction: "
+        "released channels pointing every way (a sum that nearly cancels) are no choice, and the animat "
+        "holds its heading; the paper's read-out of a direction from 36 channels is not given",
+    )
     hold_wheels: bool = declared(
         False,
         source=PAPER,
