@@ -88,6 +88,49 @@ def test_bad_traffic_is_counted_and_changes_nothing():
     np.testing.assert_array_equal(world.layers[L_MARK], engine.world.layers[L_MARK])
 
 
+def test_a_flood_is_counted_by_reason_and_changes_nothing():
+    """Flooding clients in their own processes for the whole run, forged and repeated actions on the agent
+    process's own key, and a stream of garbage on a key no agent process has: the run ends as in process,
+    none of the agents' answers was dropped, and every message of the stream is counted (world_server.gate)."""
+    import zenoh
+
+    from swarm.bench.flood.clients import Floods
+
+    ticks, stream = 1500, 3000
+    scenario = load_scenario("setup1").with_overrides(agents=2, seed=5)
+    engine = Engine(scenario)
+    engine.step(ticks)
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "flood", endpoint, deadline=10.0, max_iterations=ticks).start()
+    procs = []
+    try:
+        with Floods(endpoint, "flood", "grid", ("forged", "own"), rate=20_000, nice=19) as floods:
+            floods.wait_ready(60)  # listening before the first observation
+            s = open_client(endpoint)
+            try:
+                pub = s.declare_publisher(wire.Keys("flood").mark("intruder"),
+                                          congestion_control=zenoh.CongestionControl.BLOCK)  # fmt: skip
+                for _ in range(stream):
+                    pub.put(b"\x00\xffgarbage")
+            finally:
+                s.close()
+            procs = start_agents(endpoint, "flood", scenario.controller, 1, count=2)
+            summary = world.join(timeout=240)
+        assert all(floods.counts().values()), floods.counts()  # both flooded the agent process's key
+        assert procs[0].wait(timeout=30) == 0
+    finally:
+        stop(procs)
+        world.close()
+    w = world.server.world
+    np.testing.assert_array_equal(w.layers, engine.world.layers)
+    np.testing.assert_array_equal(w.pos, engine.world.pos)
+    assert summary["iterations"] == ticks and summary["missed_ticks"] == 0 and summary["agent_steps"] == 2 * ticks
+    reasons = summary["rejected_by_reason"]
+    assert sum(n for r, n in reasons.items() if r.startswith("mark: ")) == stream  # every one, counted
+    assert reasons.get("mark: over budget", 0) > stream // 2 and reasons.get("act: over budget", 0) > 0
+    assert not any(ch.isdigit() for reason in reasons for ch in reason)  # reasons are a fixed few, no counts
+
+
 def test_the_marks_key_space_can_be_read_by_any_client():
     scenario = load_scenario("maze").with_overrides(agents=2, seed=3, controller="marking")
     endpoint = free_endpoint()

@@ -1,6 +1,7 @@
 """The world process: an authoritative world served over zenoh, ticked in lock-step.
 
-Every zenoh callback only enqueues; one thread (`run`) owns the world.  A tick:
+Every zenoh callback only enqueues, what its sender's budget lets in (world_server.gate: a flood is
+counted and dropped there, before it is decoded); one thread (`run`) owns the world.  A tick:
 publish every active agent's observation, gather their actions until all have
 answered or the deadline passes (a late agent does nothing that tick; after
 `max_misses` misses in a row, or when its liveliness token goes, it is lost and
@@ -31,6 +32,7 @@ from swarm.core import wire
 from swarm.core.bus import open_client, open_router
 from swarm.core.credentials import Identity
 from swarm.core.errors import ScenarioError
+from world_server.gate import Gate, allowances
 
 # JOINING: welcomed, but its observation subscriber may not be routed yet; it is
 # ACTIVE once its liveliness token arrives (declared after the subscriber).
@@ -81,7 +83,8 @@ class WorldKind(Protocol):
 
     def declare(self, put: Callable[[tuple[str, Any]], None]) -> list:
         """The kind's zenoh declarations: how action messages come in, and its shared key spaces.
-        Their events go through `put` as (event, item) and come back to `handle` on the world's thread."""
+        Their events go through `put` as (event, item) and come back to `handle` on the world's thread;
+        the server's `on_put` and `on_query` make their callbacks, which let in what the budgets allow."""
 
     def handle(self, event: str, item: Any) -> None:
         """An event of the kind's declarations: an action message, a shared key space's put or query."""
@@ -198,7 +201,8 @@ class WorldServer:
         self._grouping: tuple[bytes, int, dict] | None = None  # (active agents, joins, their groups) of the last tick
         self.stats = Stats()
         self.tick = 0
-        self.events: queue.SimpleQueue = queue.SimpleQueue()
+        self.events: queue.SimpleQueue = queue.SimpleQueue()  # bounded by the gate's budgets
+        self.gate = Gate(allowances(self.scenario.agents), self.group_index, self.window())
         self.started = 0.0
 
     def _open_session(self, listen: str | None, connect: str | None, identity: Identity | None) -> None:
@@ -209,8 +213,8 @@ class WorldServer:
         put = self.events.put
         k = self.keys
         self._decls = [
-            self.session.declare_queryable(k.join, lambda q: put(("join", q))),
-            self.session.declare_queryable(k.info, lambda q: put(("info", q))),
+            self.session.declare_queryable(k.join, self.on_query("join", "join", put)),
+            self.session.declare_queryable(k.info, self.on_query("info", "info", put)),
             # history: tokens declared before this subscriber (agents back before a restarted world) count too
             self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s)), history=True),
             *self.kind.declare(put),
@@ -219,6 +223,24 @@ class WorldServer:
         self._next_state = 0.0  # when progress goes out on the state key next
 
     # --------------------------------------------------- what a world kind uses
+
+    def on_put(self, space: str, event: str, put: Callable[[tuple[str, Any]], None]) -> Callable[[Any], None]:
+        """A subscriber's callback for the gate's key space `space`: a put its sender's budget lets in
+        goes to the world's thread as (event, (bytes, sender)); the rest is counted and dropped."""
+        take = self.gate.take
+
+        def callback(sample) -> None:
+            if (got := take(space, sample)) is not None:
+                put((event, got))
+
+        return callback
+
+    def on_query(self, space: str, event: str, put: Callable[[tuple[str, Any]], None],
+                 item: Callable[[Any], Any] = lambda query: query) -> Callable[[Any], None]:  # fmt: skip
+        """A queryable's callback: a query the budget of `space` lets in goes to the world's thread as
+        (event, item(query)); the rest is dropped unanswered and counted."""
+        let_in = self.gate.let_in
+        return lambda query: put((event, item(query))) if let_in(space, query) else None
 
     @property
     def world(self):
@@ -240,6 +262,7 @@ class WorldServer:
         """A saved run's tick, slots and counts: the agents that were in come back when their
         liveliness token reappears (a newcomer takes over one that does not)."""
         self.tick = tick
+        self.gate.window = self.window()
         self.slots[:] = np.where((slots == ACTIVE) | (slots == JOINING), JOINING, slots)
         self.returning[:] = self.slots == JOINING
         self.stats.joins = int(stats.get("joins", 0))
@@ -358,15 +381,15 @@ class WorldServer:
         except ValueError:
             return None
 
-    def receive(self, sample, parse, what: str):
-        """(message, sending group), or None after counting a rejection."""
-        raw = sample.payload.to_bytes()
+    def receive(self, item: tuple[bytes, str], parse, what: str):
+        """(message, sending group) of a put the gate let in (`on_put`), or None after counting a rejection."""
+        raw, group = item
         self.bytes_in += len(raw)
         msg = parse(raw)
         if isinstance(msg, wire.Rejected):
             self.stats.reject(f"{what}: {msg.reason}")
             return None
-        return msg, str(sample.key_expr).rsplit("/", 1)[1]
+        return msg, group
 
     def acting(self, a: int, group: str, tick: int) -> bool:
         """May agent `a` of process `group` act for `tick` now?  Counts why not."""
@@ -464,9 +487,11 @@ class WorldServer:
                     self._lose(a)
         self.kind.resolve(tick, np.array(missed, np.int64))
         self.tick += 1
+        self.gate.window = self.window()  # the budgets' tick, and the ticks an answer may be for now
         if self.persist_every and self.tick % self.persist_every == 0:
             self.kind.save()
         self.tick_seconds.append(time.perf_counter() - started)
+        self._count_dropped()
         present = self.slots == ACTIVE
         self.agents_peak = max(self.agents_peak, int(present.sum()))
         if self.recorder is not None:
@@ -475,6 +500,11 @@ class WorldServer:
         if (now := time.monotonic()) >= self._next_state:  # progress for people: ten times a second is plenty
             self._next_state = now + STATE_PERIOD
             self._state_publisher.put(wire.pack({"type": "state", **self.progress()}))
+
+    def _count_dropped(self) -> None:
+        """What the gate dropped since the last count, into the run's rejections (on the world's thread)."""
+        for reason, count in self.gate.take_dropped().items():
+            self.stats.reject(reason, count)
 
     def grouped(self, agents: np.ndarray) -> dict[str, np.ndarray]:
         """The active agents by agent process, worked out again only when
@@ -539,6 +569,7 @@ class WorldServer:
                 "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0}  # fmt: skip
 
     def summary(self) -> dict:
+        self._count_dropped()
         elapsed = time.monotonic() - self.started if self.started else 0.0
         return {
             **self.kind.summary(), "run_id": self.keys.run, "mode": self.mode,

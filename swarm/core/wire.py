@@ -86,6 +86,25 @@ class Rejected:
     reason: str
 
 
+TICK_KEY = b"\xa4tick"  # msgpack's "tick": every agent message has it among its first fields (v, type, family)
+UINT_WIDTHS = {0xCC: 1, 0xCD: 2, 0xCE: 4, 0xCF: 8}  # msgpack's uint 8, 16, 32, 64
+
+
+def peek_tick(data: bytes) -> int | None:
+    """The tick an agent message says it is for, read from its first bytes without decoding it (the
+    world sorts a flood by it before deciding what to decode), or None.  Only a hint: the message is
+    checked whole when it is decoded."""
+    at = data.find(TICK_KEY, 0, 64)
+    if at < 0 or (at := at + len(TICK_KEY)) >= len(data):
+        return None
+    if (tag := data[at]) < 0x80:
+        return tag
+    width = UINT_WIDTHS.get(tag, 0)
+    if not width or at + 1 + width > len(data):
+        return None
+    return int.from_bytes(data[at + 1 : at + 1 + width], "big")
+
+
 def pack(message: dict) -> bytes:
     return msgpack.packb({"v": VERSION, **message}, use_bin_type=True)
 

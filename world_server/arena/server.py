@@ -98,15 +98,15 @@ class ArenaKind:
     def declare(self, put) -> list:
         """Action messages, the plans and records agents send for the recording, and the controllers'
         shared key spaces."""
-        session, k = self.server.session, self.server.keys
-        out = [session.declare_subscriber(k.acts, lambda s: put(("act", s))),
-               session.declare_subscriber(k.plans, lambda s: put(("plan", s)))]  # fmt: skip
-        if self.server.recorder is not None:
-            out.append(session.declare_subscriber(k.records, lambda s: put(("record", s))))
+        s, k = self.server, self.server.keys
+        out = [s.session.declare_subscriber(k.acts, s.on_put("act", "act", put)),
+               s.session.declare_subscriber(k.plans, s.on_put("plan", "plan", put))]  # fmt: skip
+        if s.recorder is not None:
+            out.append(s.session.declare_subscriber(k.records, s.on_put("record", "record", put)))
         shares = {self.scenario.share_of(c) for c in set(self.controllers.tolist())} - {None}
         for share in sorted(shares):
-            out.append(session.declare_queryable(f"{k.prefix}/{share}/**",
-                                                 lambda q, share=share: put(("shared?", (share, q)))))  # fmt: skip
+            asked = s.on_query("shared query", "shared?", put, lambda q, share=share: (share, q))
+            out.append(s.session.declare_queryable(f"{k.prefix}/{share}/**", asked))
         return out
 
     def handle(self, event: str, item) -> None:
@@ -119,11 +119,11 @@ class ArenaKind:
         elif event == "record":
             self._on_recorded(item, arena_proto.parse_record, "record", self._log_record)
 
-    def _on_recorded(self, sample, parse, what: str, log) -> None:
+    def _on_recorded(self, item: tuple[bytes, str], parse, what: str, log) -> None:
         """A plan or a record() an agent process sends for the recording, logged when it names one of the
         process's own agents."""
         s = self.server
-        received = s.receive(sample, parse, what)
+        received = s.receive(item, parse, what)
         if received is None:
             return
         message, group = received
@@ -227,9 +227,9 @@ class ArenaKind:
     def barrier_passed(self) -> None:
         pass
 
-    def _on_act(self, sample) -> None:
+    def _on_act(self, item: tuple[bytes, str]) -> None:
         s = self.server
-        received = s.receive(sample, arena_proto.parse_acts, "act")
+        received = s.receive(item, arena_proto.parse_acts, "act")
         if received is None:
             return
         msg, group = received

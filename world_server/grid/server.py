@@ -69,10 +69,10 @@ class GridKind:
 
     def declare(self, put) -> list:
         """Action messages (`_act_callback`) and the marks key space."""
-        session, k = self.server.session, self.server.keys
-        return [session.declare_subscriber(k.acts, self._act_callback(put)),
-                session.declare_queryable(k.marks, lambda q: put(("marks?", q))),
-                session.declare_subscriber(k.marks, lambda s: put(("mark", s)))]  # fmt: skip
+        s, k = self.server, self.server.keys
+        return [s.session.declare_subscriber(k.acts, self._act_callback(put)),
+                s.session.declare_queryable(k.marks, s.on_query("marks query", "marks?", put)),
+                s.session.declare_subscriber(k.marks, s.on_put("mark", "mark", put))]  # fmt: skip
 
     def handle(self, event: str, item) -> None:
         if event == "mark":
@@ -175,17 +175,18 @@ class GridKind:
         messages are all in (or the barrier's end needs them applied): zenoh's
         thread adds it there and wakes the world only for the tick's last
         message, not for each of a hundred (on two cores each wake of the
-        world's thread costs as much as the message's own work).
+        world's thread costs as much as the message's own work).  Only what
+        the sender's budget lets in gets there (world_server.gate).
         Then one compiled call reads and applies every plain message where its
         bytes lie (`grid_wire.accept_messages`), and the parser takes the
         rest, counts them and says why it refuses them."""
-        arriving, wake = self._arriving, ("wake", None)
+        arriving, wake, take = self._arriving, ("wake", None), self.server.gate.take
 
         def on_act(sample) -> None:
-            raw = sample.payload.to_bytes()
-            group = str(sample.key_expr).rsplit("/", 1)[1]
+            if (got := take("act", sample)) is None:
+                return
             with arriving:
-                self.arrived.append((raw, group))
+                self.arrived.append(got)
                 self.expected -= 1
                 last = self.expected <= 0
             if last:
@@ -234,9 +235,9 @@ class GridKind:
                     self.server.stats.reject(reason, count)
             self.refused[:] = 0
 
-    def _on_mark(self, sample) -> None:
+    def _on_mark(self, item: tuple[bytes, str]) -> None:
         """Agents' mark writes ride their action rows: a put on the marks key space is counted and refused."""
-        self.server.bytes_in += len(sample.payload)
+        self.server.bytes_in += len(item[0])
         self.server.stats.reject("mark: mark writes go in the action rows (swarm/<run>/act/<group>), not on marks/")
 
     def _on_marks_query(self, query) -> None:
