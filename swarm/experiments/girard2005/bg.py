@@ -52,8 +52,9 @@ REPS = {"bg-survival": 10, "bg-choice": 15, "bg-forget": 15, "bg-fear": 20, "bg-
 # What a floor's [bg] table may set: the paper's per-experiment changes (eqs. 15-20's variant, 3.1's F) and the
 # colony's shared map; every other number is the declared animat's (agents/controllers/bg/params.py).
 FLOOR_BG_KEYS = ("saliences", "fear", "share")
+# the paper's experiments' saliences (a colony, ours, lives on any floor's)
 VARIANT = {"bg-survival": "survival", "bg-choice": "survival", "bg-forget": "survival", "bg-fear": "fear",
-           "bg-tmaze": "tmaze", "bg-colony": "survival"}  # fmt: skip
+           "bg-tmaze": "tmaze"}  # fmt: skip
 MAPPING_SECONDS = 7200.0  # the mapping phase of experiments 2 and 3: at most two hours of the animat's life ...
 MAPPING_LEVELS = (0.5, 0.5)  # E, Ep during mapping: needs enough to seek both resources and reload there ...
 MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping animat must live to map
