@@ -110,7 +110,7 @@ def test_every_experiment_declares_a_scenario_option_its_run_takes(name):
     assert "scenario" in inspect.signature(resolve(spec.run)).parameters
 
 
-@pytest.mark.timeout(60)
+@pytest.mark.timeout(180)  # the first run compiles the grid kernels: minutes on a loaded machine
 @pytest.mark.parametrize("name", GRID)
 def test_a_grid_experiment_runs_its_conditions_on_the_users_floor_without_the_papers_numbers(name, tmp_path):
     floor = _floor(tmp_path, "tiny", TINY)
