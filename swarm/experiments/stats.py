@@ -294,13 +294,11 @@ def spearman(x: Sequence[float], y: Sequence[float]) -> Comparison:
     """A monotone trend of y with x: Spearman's rank correlation (the effect, from -1 to 1) and its p-value."""
     from scipy.stats import spearmanr
 
-    u, v = np.asarray(x, float), np.asarray(y, float)
-    keep = np.isfinite(u) & np.isfinite(v)
-    if keep.sum() < 3:
-        return Comparison("Spearman", math.nan, math.nan, math.nan, "rho", int(keep.sum()))
-    res = spearmanr(u[keep], v[keep])
-    return Comparison("Spearman", float(res.statistic), float(res.pvalue), float(res.statistic), "rho",
-                      int(keep.sum()))  # fmt: skip
+    u, v = _paired_finite(x, y)
+    if len(u) < 3:
+        return Comparison("Spearman", math.nan, math.nan, math.nan, "rho", len(u))
+    res = spearmanr(u, v)
+    return Comparison("Spearman", float(res.statistic), float(res.pvalue), float(res.statistic), "rho", len(u))
 
 
 def cochrans_q(outcomes: Sequence[Sequence[bool]]) -> Comparison:
