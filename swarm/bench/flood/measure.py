@@ -31,7 +31,7 @@ QUICK = {
 }  # fmt: skip
 RUNTIME = ("run_id", "rejected_messages", "rejected_by_reason", "ticks_per_second", "wall_seconds", "tick_ms_p50",
            "tick_ms_p99", "tick_ms_max", "payload_bytes_in", "recording", "agent_process_rss_mb")  # fmt: skip
-RATE = 173_000  # messages a second: the flood that stalled ticks to 4.6 s before the world had budgets
+RATE = 173_000  # messages a second the flooding clients are asked for together (--rate)
 NICE = 19
 TARGET = 2.0  # tick p99 under the flood at most this many times the unflooded run's
 
