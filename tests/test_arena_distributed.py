@@ -94,6 +94,33 @@ def test_bad_arena_traffic_is_counted_and_never_acted_on():
     assert reasons.get("act: memory: names an agent the message does not act for") == 1
 
 
+def test_copies_of_an_agent_process_own_answers_change_nothing():
+    """A client floods an agent process's key with copies of its answers, map publications and all, and
+    garbage between them: the run, each robot's publications included, ends as in process."""
+    from swarm.bench.flood.clients import Floods
+
+    scenario = load_scenario("office").with_overrides(agents=2, seed=3, max_ticks=300, controller="fingerprint")
+    engine = ArenaEngine(scenario)
+    expected = engine.run()
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "arena-copies", endpoint, deadline=20.0).start()
+    procs = []
+    try:
+        with Floods(endpoint, "arena-copies", "arena", ("own",), rate=20_000, nice=19) as floods:
+            floods.wait_ready(60)  # listening before the first answer
+            procs = start_agents(endpoint, "arena-copies", "fingerprint", 2)
+            summary = world.join(timeout=240)
+        assert floods.counts()["own"] > 0
+    finally:
+        stop(procs)
+        world.close()
+    np.testing.assert_array_equal(world.server.world.pose, engine.world.pose)
+    for got, want in zip(summary["robots"], expected["robots"], strict=True):
+        assert got.get("shared") == want.get("shared") and got["path_length"] == want["path_length"]
+    assert summary["missed_ticks"] == 0
+    assert summary["rejected_by_reason"].get("act: second action in one tick", 0) > 0  # copies reached the world
+
+
 def test_nan_and_huge_wheel_speeds_from_an_agent_are_refused():
     """A hand-made agent process sends NaN, then 50 m/s: both are counted and the robot never moves."""
     import threading

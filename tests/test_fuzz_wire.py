@@ -234,5 +234,5 @@ def test_a_valid_message_of_every_kind_decodes():
 def test_the_reasons_are_those_the_decoders_name():
     """The check's patterns come from the source: a new reason is known without editing the test."""
     assert len(REASONS) > 40
-    assert any(p.fullmatch("wheels: expected 3x2 binary float64") for p in REASONS)
+    assert any(p.fullmatch("wheels: expected 2 binary float64 per agent") for p in REASONS)
     assert not any(p.fullmatch("KeyError: 'agent'") for p in REASONS)

@@ -73,13 +73,20 @@ class Bucket:
     """One sender's tokens for one key space and class, and the messages it dropped (an atomic counter,
     stepped without the lock)."""
 
-    __slots__ = ("allowance", "at", "closed_at", "counted", "drops", "reads", "reason", "reopens", "tick", "tokens")
+    __slots__ = ("all", "allowance", "at", "closed_at", "counted", "drops", "reads", "reason", "reopens", "tick",
+                 "tokens")  # fmt: skip
 
-    def __init__(self, allowance: Allowance, reason: str, tick: int, at: float):
+    def __init__(self, allowance: Allowance, reason: str, tick: int, at: float, drops_of_all):
         self.allowance, self.reason = allowance, reason
         self.tokens, self.tick, self.at = float(allowance.burst), tick, at
         self.closed_at, self.reopens = -1, 0.0  # empty at this tick, until this time (`closed`)
         self.drops, self.reads, self.counted = itertools.count(), 0, 0
+        self.all = drops_of_all  # the gate's count of every bucket's drops, so the world looks at one when none
+
+    def drop(self) -> None:
+        """Count a message dropped (each `next` is one step, whatever thread takes it)."""
+        next(self.drops)
+        next(self.all)
 
     def closed(self, tick: int, clock: Callable[[], float]) -> bool:
         """Surely empty, read without the lock: found empty at this tick, and its next token not due yet."""
@@ -106,7 +113,7 @@ class Bucket:
     def spend(self, tick: int, clock: Callable[[], float]) -> bool:
         """Take a token; False, counted, when there is none."""
         if self.empty(tick, clock):
-            next(self.drops)
+            self.drop()
             return False
         self.tokens -= 1.0
         return True
@@ -130,13 +137,14 @@ class Gate:
         self.window = window  # (first, last): the ticks an action may be for now; the world sets it each tick
         self.clock = clock
         self._lock = threading.Lock()
+        self._all, self._looked, self._seen = itertools.count(), 0, 0  # every drop; looks at it; drops seen
         self._strangers = {space: self._bucket(space, STRANGERS) for space in PUTS}
         self._asking = {(s, kind): self._bucket(s, self.budgets.get((s, kind), ASKING)) for s in QUERIES
                         for kind in (NOW, OTHER)}  # fmt: skip
         self._senders: dict[str, tuple[Bucket, Bucket, int]] = {}  # a member's key -> its (now, other) buckets, lag
 
     def _bucket(self, space: str, allowance: Allowance) -> Bucket:
-        return Bucket(allowance, f"{space}: over budget", self.window[1], self.clock())
+        return Bucket(allowance, f"{space}: over budget", self.window[1], self.clock(), self._all)
 
     def _member(self, key: str, space: str) -> tuple[Bucket, Bucket, int]:
         """A member's buckets for its key (made once: two of zenoh's threads may ask at once)."""
@@ -155,18 +163,18 @@ class Gate:
             else:  # a stranger's put is not even copied unless let in
                 bucket = self._strangers[space]
                 if bucket.closed(tick, clock):
-                    next(bucket.drops)
+                    bucket.drop()
                     return None
                 return (sample.payload.to_bytes(), sender) if self._spend(bucket) else None
         now, other, lag = mine
         if other.closed(tick, clock) and now.closed(tick, clock):  # the usual flood, once the answer is in
-            next(other.drops)
+            other.drop()
             return None
         raw = sample.payload.to_bytes()
         said, (first, last) = wire.peek_tick(raw), self.window
         bucket = now if said is not None and first - lag <= said <= last else other
         if bucket.closed(tick, clock):
-            next(bucket.drops)
+            bucket.drop()
             return None
         return (raw, sender) if self._spend(bucket) else None
 
@@ -177,7 +185,7 @@ class Gate:
             kind = NOW if JOIN_HEAD in payload.to_bytes()[:24] else OTHER
         bucket = self._asking[space, kind]
         if bucket.closed(self.window[1], self.clock):
-            next(bucket.drops)
+            bucket.drop()
         elif self._spend(bucket):
             return True
         query.drop()
@@ -188,7 +196,12 @@ class Gate:
             return bucket.spend(self.window[1], self.clock)
 
     def take_dropped(self) -> dict[str, int]:
-        """The messages dropped since the last call, by reason."""
+        """The messages dropped since the last call, by reason (each tick: one look when there are none)."""
+        total = next(self._all) - self._looked
+        self._looked += 1
+        if total == self._seen:
+            return {}
+        self._seen = total
         dropped: dict[str, int] = {}
         senders = list(self._senders.values())  # in one step: zenoh's threads may add to it meanwhile
         for bucket in [*self._strangers.values(), *self._asking.values(), *(b for s in senders for b in s[:2])]:

@@ -233,10 +233,11 @@ class ArenaKind:
         if received is None:
             return
         msg, group = received
-        taken = set()  # the agents whose action this message gave
+        taken, answered = set(), set()  # the agents whose action this message gave; those it answered for
         for a, wheels in zip(msg.agents.tolist(), msg.wheels, strict=True):
             if not s.acting(a, group, msg.tick):
                 continue
+            answered.add(a)
             if (reason := self.world.judge(a, wheels)) is not None:
                 s.stats.reject(f"act: {reason}")
                 s.acted[a] = True  # an answer, refused: its robot holds still this tick, as in process
@@ -247,7 +248,7 @@ class ArenaKind:
                 s.acted[a] = True
                 taken.add(a)
         if msg.shared:
-            self._take_shared(msg, group)
+            self._take_shared(msg, group, answered)
         self.world.broadcast([(a, data) for a, data in msg.rab if a in taken])  # heard next tick, as in-process
         for a, blob in msg.memory:
             if a in taken and s.group_of.get(a) == group and s.saves_after(msg.tick):
@@ -255,8 +256,10 @@ class ArenaKind:
             else:
                 s.stats.reject("memory: not with an accepted action before a save")
 
-    def _take_shared(self, msg, group: str) -> None:
-        """Publications of agents whose action this tick was taken; the rest is counted and dropped."""
+    def _take_shared(self, msg, group: str, answered: set[int]) -> None:
+        """Publications of the agents this message answered for this tick (a late or second message's,
+        say a copy of an earlier one, would overwrite the publication of the answer taken); the rest is
+        counted and dropped."""
         s = self.server
         named = set(msg.agents.tolist())
         for a, share, payload in msg.shared:
@@ -264,7 +267,7 @@ class ArenaKind:
                 s.stats.reject("shared: names an agent of another process")
             elif share != self.scenario.share_of(str(self.controllers[a])):
                 s.stats.reject("shared: not this controller's key space")
-            elif not s.acted[a]:
+            elif a not in answered:
                 s.stats.reject("shared: its agent's action was refused")
             else:
                 self.pending_shared[a] = (share, payload)

@@ -273,14 +273,14 @@ def parse_acts(data: bytes) -> ArenaActs | Rejected:
         return agents
     raw = m.get("wheels")
     if not isinstance(raw, bytes) or len(raw) != 16 * len(agents):
-        return Rejected(f"wheels: expected {len(agents)}x2 binary float64")
+        return Rejected("wheels: expected 2 binary float64 per agent")  # no count: reasons are a fixed few
     if bad := first_rejection(shared := parse_shared(m.get("shared"))):
         return bad
     wheels = np.frombuffer(raw, dtype="<f8").reshape(len(agents), 2).astype(np.float64)
     if "acts" in m:
         acts = m["acts"]
         if not isinstance(acts, bytes) or len(acts) != 8 * len(agents):
-            return Rejected(f"acts: expected {len(agents)} binary float64")
+            return Rejected("acts: expected 1 binary float64 per agent")
         wheels = np.column_stack([wheels, np.frombuffer(acts, dtype="<f8").astype(np.float64)])
     if bad := first_rejection(memory := parse_memory(m.get("memory"), agents), rab := parse_rab(m.get("rab"), agents)):
         return bad
