@@ -68,21 +68,23 @@ def parameter_classes(controllers: Sequence[str]) -> list[type]:
     return list(seen.values())
 
 
-def parameters_page(title: str, controllers: Sequence[str]) -> str:
-    """parameters.md: every parameter the report's runs use, with its value and provenance."""
+def parameters_page(title: str, controllers: Sequence[str], protocol: Sequence[type] = ()) -> str:
+    """parameters.md: every parameter the report's runs use, with its value and provenance: the controllers'
+    classes, then the `protocol`'s (an experiment's own declared numbers, such as how a map is made)."""
     parts = [f"# {title}: the declared parameters", "",
              "Every value the report's runs use unless an experiment says otherwise, with its provenance: "
              "the paper's (where it gives it), the original code's, or ours with the reason "
              "(swarm/core/params.py).", ""]  # fmt: skip
-    for cls in parameter_classes(controllers):
+    for cls in (*parameter_classes(controllers), *protocol):
         doc = " ".join((cls.__doc__ or "").strip().split("\n\n")[0].split())  # its first paragraph
         parts += [f"## {cls.__name__} ({cls.__module__})", "", doc, "", provenance_table(cls), ""]
     return "\n".join(parts)
 
 
-def parameters_section(controllers: Sequence[str]) -> tuple[str, str]:
+def parameters_section(controllers: Sequence[str], protocol: Sequence[type] = ()) -> tuple[str, str]:
     """The report's section on its parameters: how many come from where, and a link to parameters.md."""
-    counts = Counter(p.source or "undeclared" for cls in parameter_classes(controllers) for p in provenance(cls))
+    classes = (*parameter_classes(controllers), *protocol)
+    counts = Counter(p.source or "undeclared" for cls in classes for p in provenance(cls))
     said = ", ".join(f"{counts[s]} {s}" for s in (*SOURCES, "undeclared") if counts[s])
     return "Parameters", (f"{sum(counts.values())} parameters ({said}; controllers: {', '.join(controllers)}), "
                           "one declared set for every experiment: [parameters.md](parameters.md).")  # fmt: skip

@@ -11,10 +11,14 @@ Each condition changes one thing of the declared animat (agents/controllers/bg/p
   drawn once per animat and run instead of every tick, so that the odometric position drifts.
 
 Experiment 1 runs condition A (taxon + map) only: every change concerns the loops or the map, and A is
-where both act.  Experiment 3.2 runs every ratio on maps made by the declared animat (so a change is
-measured in the test, where the choice is made), test k of every condition on map k with seed + k: the
+where both act.  Experiment 3.2 runs every ratio on maps made by the declared animat (so a change to the
+loops is measured in the test, where the choice is made), except biased odometry and compass, whose
+maps are made with the bias too: drift acts while the map is made, and map and test are one animat
+(the same seed, so the same bias).  Test k of every condition runs on map k with seed + k: the
 conditions are paired with the declared animat test by test (McNemar), and survival is compared by
-log-rank with runs alive at 4 h censored.
+log-rank with runs alive at 4 h censored.  Beside survival, the table counts the control periods spent in
+an act (ReloadE, ReloadEp) and the share of them in which the animat moved (bg.MOVING): with the wheels
+left to the loops, eq. 10 is what stops it.
 """
 
 from __future__ import annotations
@@ -49,16 +53,30 @@ REPS = 10  # survival runs and T-maze tests per condition (and ratio)
 CAP = 4 * 3600.0
 
 
-def jobs_for(reps: int, seed: int, maps: dict[str, list[dict]], cap: int | None,
+def jobs_for(reps: int, seed: int, maps: dict[str, dict[str, list[dict]]], cap: int | None,
              floor: str | None = None) -> tuple[list[tuple], list[tuple]]:  # fmt: skip
     """(survival jobs, T-maze test jobs), each (condition, the experiment's job): run k of every condition with
-    seed + k, test k on map k mod the maps; survival on `floor` (default experiment 1's)."""
+    seed + k, test k on map k mod the maps of its condition (`maps[condition]`, by map set); survival on `floor`
+    (default experiment 1's)."""
     floor = floor or bg.SCENARIO["bg-survival"]
     survival = [(label, ("A", k, seed + k, changes, cap, floor, sensors))
                 for label, (changes, sensors) in ABLATIONS.items() for k in range(reps)]  # fmt: skip
     tests = [(label, (*job, sensors)) for label, (changes, sensors) in ABLATIONS.items()
-             for job in bg.test_jobs("bg-tmaze", reps, seed, maps, changes)]  # fmt: skip
+             for job in bg.test_jobs("bg-tmaze", reps, seed, maps[label], changes)]  # fmt: skip
     return survival, tests
+
+
+def maps_for(count: int, seed: int, floors: tuple[str, ...], jobs: int | None, progress: bool,
+             seconds: float) -> dict[str, dict[str, list[dict]]]:  # fmt: skip
+    """Each condition's T-maze maps: the declared animat's, or for a condition that changes the sensors, maps
+    made with that change (one set per distinct change)."""
+    made: dict[str, dict[str, list[dict]]] = {}
+    for _, sensors in ABLATIONS.values():
+        key = repr(sorted(sensors.items()))
+        if key not in made:
+            made[key] = bg.make_maps("bg-tmaze", count, seed, floors, jobs, progress, seconds=seconds,
+                                     sensors=sensors or None)  # fmt: skip
+    return {label: made[repr(sorted(sensors.items()))] for label, (_, sensors) in ABLATIONS.items()}
 
 
 def run_survival(job: tuple) -> dict:
@@ -91,12 +109,12 @@ def run_ablations(experiment: str, reps: int | None, jobs: int | None, seed: int
         raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
     floors = bg.check_floors("bg-ablations" if scenario else "bg-tmaze", scenario, ratios, {})
     out_ = Outputs(out, experiment)
-    made = bg.make_maps("bg-tmaze", maps, seed, floors, jobs, progress, seconds=mapping_seconds)
+    made = maps_for(maps, seed, floors, jobs, progress, mapping_seconds)
     survival, tests = jobs_for(reps, seed, made, max_ticks, scenario)
     rows = batch_run(run_survival, survival, jobs=jobs, desc=f"{experiment} survival", progress=progress)
     rows += batch_run(run_test, tests, jobs=jobs, desc=f"{experiment} T-maze", progress=progress)
     fields = ["ablation", "experiment", "condition", "run", "seed", "map", "survival_seconds", "died", "branch",
-              "chose", "seconds", "distance", "idle_acts", "wall_seconds"]  # fmt: skip
+              "chose", "seconds", "distance", "idle_acts", "act_ticks", "act_ticks_moving", "wall_seconds"]  # fmt: skip
     out_.runs([{k: r.get(k, "") for k in fields} for r in rows], fields)
     cap = CAP if max_ticks is None else max_ticks * 0.25
     summary, text = _tables(rows, cap, paper=scenario is None)
@@ -104,8 +122,9 @@ def run_ablations(experiment: str, reps: int | None, jobs: int | None, seed: int
                                          "the paper's numbers are not shown.")  # fmt: skip
     head = (f"# Ablations of the bg animat (experiments 1 and 3.2)\n\n{reps} runs per condition (experiment 1, "
             f"condition A, at most {cap / 3600:.3g} h) and {reps} tests per condition and ratio (experiment 3.2, "
-            f"test k on map k of the declared animat); seed {seed}.  Each condition changes one thing of the "
-            f"declared animat (swarm/experiments/girard2005/ablations.py says what).{where}\n\n")  # fmt: skip
+            f"test k on map k of the declared animat, or of an animat with the condition's sensors); seed {seed}.  "
+            "Each condition changes one thing of the declared animat (swarm/experiments/girard2005/ablations.py "
+            f"says what).{where}\n\n")  # fmt: skip
     result = out_.finish(summary, head + text)
     _plot(rows, out_ / "plot.png")
     return result
@@ -126,6 +145,13 @@ def _tables(rows: list[dict], cap: float, paper: bool = True) -> tuple[list[dict
         cells = [a, str(len(t[a])), km.text(5), f"{row['alive_at_cap']}/{len(t[a])}",
                  S.number(row["restricted_mean_s"], 5), "–" if vs is None else S.number(vs.p, 2)]  # fmt: skip
         row["logrank_p"] = None if vs is None else vs.p
+        acts = np.array([r.get("act_ticks") or 0 for r in live[a]], float)
+        moving = np.array([r.get("act_ticks_moving") or 0 for r in live[a]], float)
+        share = S.mean_ci(np.divide(moving, acts, out=np.full(len(acts), np.nan), where=acts > 0))
+        row |= {"act_periods": int(acts.sum()), "act_periods_moving": int(moving.sum()),
+                "moving_share": share.value}  # fmt: skip
+        percent = S.Estimate(100 * share.value, 100 * share.low, 100 * share.high, share.n).text(3)
+        cells.append(f"{int(acts.sum()):,}: {percent}" + ("%" if share.n else ""))
         for ratio in ratios:
             right = _branch(rows, a, ratio)
             base = _branch(rows, MODEL, ratio)
@@ -134,18 +160,22 @@ def _tables(rows: list[dict], cap: float, paper: bool = True) -> tuple[list[dict
             paired = S.mcnemar(right == 1, base == 1) if a != MODEL else None
             row[f"right_{ratio}"] = n_right
             row[f"entered_{ratio}"] = entered
-            cells.append(f"{n_right}/{entered}" + ("" if paired is None else f" (p {S.number(paired.p, 2)})"))
+            wilson = S.proportion_ci(n_right, entered)
+            interval = "" if entered == 0 else f" [{S.number(wilson.low, 2)}, {S.number(wilson.high, 2)}]"
+            cells.append(f"{n_right}/{entered}{interval}" + ("" if paired is None else f" (p {S.number(paired.p, 2)})"))
         summary.append(row)
         lines.append(cells)
     headers = ["condition", "exp. 1 runs", "KM median survival (s)", "alive at cap", "restricted mean (s)",
-               "log-rank p vs declared"]  # fmt: skip
-    headers += [f"3.2 {_ratio(r)}: right first / entered (McNemar p)" for r in ratios]
+               "log-rank p vs declared", "exp. 1 act periods: moving (mean share a run, 95% CI)"]  # fmt: skip
+    headers += [f"3.2 {_ratio(r)}: right first / entered (Wilson 95% CI; McNemar p)" for r in ratios]
     right = ", ".join(f"{r} of {TMAZE_TESTS} at ratio {ratio:g}" for ratio, (_, r) in PAPER_TMAZE.items())
     said = (f"The paper: experiment 1's A lived a median of {PAPER_SURVIVAL['A'][0]:,} s (beyond its own 4 h "
             f"cap); in experiment 3.2 the animat entered the right branch (E and Ep) first in {right}.  ")  # fmt: skip
     note = (f"\n{said if paper else ''}A p value compares a condition with the declared animat (log-rank "
             "on survival, McNemar on the right branch test by test); none of these is a claim of the "
-            "paper.\n")  # fmt: skip
+            "paper.  Act periods: the control periods of experiment 1's runs spent in ReloadE or "
+            f"ReloadEp, and the share of them in which the animat moved more than {bg.MOVING * 100:g} cm, "
+            "measured on the world's pose (the paper's animat stops to eat and digest).\n")  # fmt: skip
     return summary, R.markdown_table(headers, lines) + note
 
 

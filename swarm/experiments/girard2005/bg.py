@@ -41,6 +41,7 @@ import numpy as np
 
 from swarm.core.errors import ScenarioError
 from swarm.core.plots import pyplot, save_figure
+from swarm.experiments.girard2005.mapping import MAPPING_PARAMS
 from swarm.experiments.girard2005.paper import PAPER_CHOICE, PAPER_FEAR, PAPER_FORGET, PAPER_SURVIVAL, PAPER_TMAZE
 from swarm.experiments.runner import Outputs, batch_run
 from swarm.scenario import load_scenario
@@ -55,9 +56,7 @@ FLOOR_BG_KEYS = ("saliences", "fear", "share")
 # the paper's experiments' saliences (a colony, ours, lives on any floor's)
 VARIANT = {"bg-survival": "survival", "bg-choice": "survival", "bg-forget": "survival", "bg-fear": "fear",
            "bg-tmaze": "tmaze"}  # fmt: skip
-MAPPING_SECONDS = 7200.0  # the mapping phase of experiments 2 and 3: at most two hours of the animat's life ...
-MAPPING_LEVELS = (0.5, 0.5)  # E, Ep during mapping: needs enough to seek both resources and reload there ...
-MAPPING_LIFETIME = 4 * 3600.0  # ... and E lasting 4 h, not 33 min: the mapping animat must live to map
+MAPPING_SECONDS = MAPPING_PARAMS.seconds  # the mapping phase's budget (mapping.py declares its numbers)
 
 
 # How a mapping animat maps (docs/bg.md, Experiments).  The paper gives its animat "a previously built map" and
@@ -75,7 +74,11 @@ class MappingMode:
 
 MAPPING_MODES = {
     "hungry": MappingMode({}, 0.0, ", planning back to what it found)"),
-    "explore": MappingMode({"w_plan": 0.0}, 1800.0, ", W_plan 0: exploring, not planning, for at least 30 min)"),
+    "explore": MappingMode(
+        {"w_plan": 0.0},
+        MAPPING_PARAMS.least_seconds,
+        f", W_plan 0: exploring, not planning, for at least {MAPPING_PARAMS.least_seconds / 60:.0f} min)",
+    ),
 }
 MAPPING = "explore"  # every experiment's mapping: one procedure for all
 # The resources an experiment names, by name, and the walls that mark the T-maze's junction (the stem's sides):
@@ -141,34 +144,56 @@ def run_survival(job: tuple) -> dict:
     sensors = rest[2] if len(rest) > 2 else None
     s = _with(load_scenario(floor), bg=_merged(changes, {"planning": condition == "A"}), seed=seed,
               max_ticks=cap, sensors=sensors)  # fmt: skip
-    summary = ArenaEngine(s).run()
+    engine = ArenaEngine(s)
+    act_ticks, act_ticks_moving = _run_counting_acts(engine)
+    summary = engine.summary()
     r = summary["robots"][0]
     return {"condition": condition, "run": run, "seed": seed, "survival_seconds": r["survival_seconds"],
             "died": not r["alive"], "reload_e_seconds": r["reloads"]["ReloadE"] * s.control_period,
             "reload_ep_seconds": r["reloads"]["ReloadEp"] * s.control_period, "idle_acts": r["idle_acts"],
+            "act_ticks": act_ticks, "act_ticks_moving": act_ticks_moving,
             "distance": r["distance"], "nodes": (r.get("map") or {}).get("nodes"),
             "wall_seconds": summary["wall_seconds"]}  # fmt: skip
 
 
+MOVING = (
+    0.01  # m in a control period (4 cm/s at the bg floors' 0.25 s): an animat that moved less during an act stood still
+)
+
+
+def _run_counting_acts(engine) -> tuple[int, int]:
+    """Run the one-animat `engine` to its end; (control periods it spent in a dorsal act, those of them in
+    which it moved more than MOVING).  Measured on the world's pose for the tables, not sensed by the
+    animat: it says whether the loops (eq. 10) stop the animat while it eats or digests."""
+    acts = moving = 0
+    before = engine.world.pose[0, :2].copy()
+    while not engine.done():
+        engine.step(1)
+        after = engine.world.pose[0, :2].copy()
+        if engine.controllers[0].last.get("act", 0) > 0:
+            acts += 1
+            moving += math.hypot(after[0] - before[0], after[1] - before[1]) > MOVING
+        before = after
+    return acts, moving
+
+
 def build_map(name: str, seed: int, absent: tuple[str, ...], bg: dict[str, Any] | None = None,
-              mode: str = MAPPING, seconds: float = MAPPING_SECONDS) -> dict:  # fmt: skip
+              mode: str = MAPPING, seconds: float = MAPPING_SECONDS,
+              sensors: dict[str, dict[str, float]] | None = None) -> dict:  # fmt: skip
     """The mapping phase: the animat lives in `name` (as MAPPING_MODES[mode] says) until its own map holds every
     kind of resource on the floor (a node that learned it), or `seconds` pass; its map as plain data, with
-    the resources it came within reach of (recorded, not used)."""
+    the resources it came within reach of (recorded, not used).  `sensors`: changes to its sensors (_with)."""
     from swarm.engines.arena import ArenaEngine
 
     s = load_scenario(name)
     ticks = int(seconds / s.control_period)
-    levels = {
-        "energy": MAPPING_LEVELS[0],
-        "potential": MAPPING_LEVELS[1],
-        "lifetime": MAPPING_LIFETIME,
-        "danger_rate": 0.0,
-    }  # mapping is learning the floor, not surviving it
+    p = MAPPING_PARAMS
+    levels = {"energy": p.energy, "potential": p.potential, "lifetime": p.lifetime, "danger_rate": p.danger_rate}
     # mapping explores as in exp. 1 (exp. 3's saliences barely explore), and maps (a test may not)
     how = MAPPING_MODES[mode]
     bg = _merged(bg or {}, {"saliences": "survival", "learn_map": True, **how.changes})
-    s = _with(s, bg=bg, metabolism={**levels, "stop_at": "death"}, seed=seed, absent=absent, max_ticks=ticks)
+    s = _with(s, bg=bg, metabolism={**levels, "stop_at": "death"}, seed=seed, absent=absent, max_ticks=ticks,
+              sensors=sensors)  # fmt: skip
     kinds = {"ingesting": "Ep", "digesting": "E", "dangerous": "DA"}
     present = [o for o in s.obstacles if o.zone is not None and o.name not in absent]
     engine = ArenaEngine(s)
@@ -493,17 +518,19 @@ def mapped_floors(experiment: str, floors: tuple[str, ...]) -> dict[str, tuple[s
 
 
 def build_map_job(job: tuple) -> dict:
-    """(map set, map index, seed, floor, resources absent, [bg] changes, mapping mode[, seconds])."""
-    name, k, seed, floor, absent, changes, mode, *seconds = job
-    return {"scenario": name, "index": k, "data": build_map(floor, seed, absent, changes, mode, *seconds)}
+    """(map set, map index, seed, floor, resources absent, [bg] changes, mapping mode[, seconds[, sensor
+    changes]])."""
+    name, k, seed, floor, absent, changes, mode, *rest = job
+    return {"scenario": name, "index": k, "data": build_map(floor, seed, absent, changes, mode, *rest)}
 
 
 def make_maps(experiment: str, count: int, seed: int, floors: tuple[str, ...], jobs: int | None, progress: bool,
-          changes: dict[str, Any] | None = None, mode: str = MAPPING,
-          seconds: float = MAPPING_SECONDS) -> dict[str, list[dict]]:  # fmt: skip
-    """`count` maps per map set, map k from a mapping run with seed + k (in parallel), each at most `seconds`."""
+          changes: dict[str, Any] | None = None, mode: str = MAPPING, seconds: float = MAPPING_SECONDS,
+          sensors: dict[str, dict[str, float]] | None = None) -> dict[str, list[dict]]:  # fmt: skip
+    """`count` maps per map set, map k from a mapping run with seed + k (in parallel), each at most `seconds`,
+    by an animat with `sensors` changed (_with)."""
     mapped = mapped_floors(experiment, floors)
-    work = [(name, k, seed + k, floor, absent, changes or {}, mode, seconds)
+    work = [(name, k, seed + k, floor, absent, changes or {}, mode, seconds, sensors)
             for name, (floor, absent) in mapped.items() for k in range(count)]  # fmt: skip
     rows = batch_run(build_map_job, work, jobs=jobs, desc=f"{experiment} mapping", progress=progress)
     made = {(m["scenario"], m["index"]): m["data"] for m in rows}
@@ -574,6 +601,7 @@ def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int, maps:
     floor = floor_of(next(iter(maps)))
     held = "; ".join(f"{name}: {_maps_line(made)}" for name, made in maps.items())
     n = len(next(iter(maps.values())))
+    p = MAPPING_PARAMS
     head = (
         f"{reps} tests per condition; seed {seed}; "
         + (
@@ -583,8 +611,9 @@ def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int, maps:
             if n == reps
             else f"test k of every condition on the map of mapping run k mod {n} (seed + k mod {n})"
         )
-        + f" ({held}).  A mapping animat lives in the scenario (E = Ep = {MAPPING_LEVELS[0]} at the start, a full "
-        f"E lasting 4 h, the saliences of exp. 1) until its own map holds every kind of resource on the floor, or "
+        + f" ({held}).  A mapping animat lives in the scenario (E = {p.energy}, Ep = {p.potential} at the "
+        f"start, a full E lasting {p.lifetime / 3600:g} h, the saliences of exp. 1; girard2005/mapping.py) "
+        "until its own map holds every kind of resource on the floor, or "
         f'{MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}"{MAPPING_MODES[mapping].text}.  A test is the same '
         f"animat: it goes on mapping from the map it loads.\n\n"
     )

@@ -21,9 +21,11 @@ from swarm.experiments import protocol as P
 from swarm.experiments import report as R
 from swarm.experiments import stats as S
 from swarm.experiments.girard2005 import bg, paper
+from swarm.experiments.girard2005.mapping import MappingParams
 from swarm.experiments.runner import Outputs, batch_run
 
 TITLE = "Girard, Filliat, Meyer, Berthoz & Guillot (2005)"
+PROTOCOL = (MappingParams,)  # the experiments' own declared numbers: how the maps of experiments 2 and 3 are made
 CONTROLLERS = ("bg",)
 # tests (runs) per condition: the paper's n everywhere (the full report costs about 11 min on 2 cores); --quick
 # checks that everything runs and is not evidence
@@ -120,8 +122,8 @@ def reproduce(quick: bool = False, jobs: int | None = None, out: Path | None = N
     _plot(rows, out_ / "girard2005.png")
     parts = [(title, table) for title, table, _ in sections]
     parts.append(("Known differences", "\n".join(f"- {line}" for line in KNOWN_DIFFERENCES) + "\n"))
-    parts.append(R.parameters_section(CONTROLLERS))
-    (out_ / "parameters.md").write_text(R.parameters_page(TITLE, CONTROLLERS))
+    parts.append(R.parameters_section(CONTROLLERS, PROTOCOL))
+    (out_ / "parameters.md").write_text(R.parameters_page(TITLE, CONTROLLERS, PROTOCOL))
     design = DESIGN + (f"  This quick run also ends survival and mapping runs at {QUICK_SECONDS / 60:.0f} min "
                        "(the paper: 4 h and a full mapping phase)." if quick else "")  # fmt: skip
     text = R.report_text(TITLE, design, claims, parts, reps, quick)
