@@ -21,7 +21,7 @@ from swarm.experiments.girard2005 import bg, paper
 
 
 def select(rows: list[dict], experiment: str, condition) -> list[dict]:
-    """One condition's runs in run order (run k of every condition shares map k and seed 10000 + k)."""
+    """One condition's runs in run order (run k of every condition shares map k and its seed)."""
     return sorted((r for r in rows if r["experiment"] == experiment and r["condition"] == condition),
                   key=lambda r: r["run"])  # fmt: skip
 
