@@ -688,14 +688,19 @@ def test_with_learn_map_off_an_animat_localizes_on_a_loaded_map_and_leaves_it_as
 
 
 def test_bg_tmaze_experiment_maps_then_tests_and_writes_its_table(tmp_path):
-    from swarm.experiments.girard2005.bg import run_bg_experiment
+    from swarm.experiments.girard2005.standalone import run_bg_experiment
 
     result = run_bg_experiment("bg-tmaze", None, 2, 2, 0, tmp_path, ratios=(1.0,), progress=False)
     assert result["runs"] == 2
     for name in ("runs.csv", "summary.csv", "table.md", "plot.png", "maps.json"):
         assert (tmp_path / name).exists(), name
     text = (tmp_path / "table.md").read_text()
-    assert "| 1.0 |" in text and "paper left" in text and "2 maps" in text
+    assert "| 1 | 2 (15) |" in text and "| 3 : 12 |" in text and "2 maps" in text  # the paper beside ours
+    assert "exp. 3.2, ratio 1: the right branch" in text and "the longer the right branch" not in text  # one ratio
+    assert "Seeds 0..1, from the development range: not evidence" in text
+    with open(tmp_path / "summary.csv") as f:
+        summary = list(csv.DictReader(f))
+    assert [r["row"] for r in summary] == ["claim", "table"] and summary[0]["verdict"]
     maps = json.loads((tmp_path / "maps.json").read_text())
     assert len(maps["tmaze-1"]) == 2 and all(len(m["map"]["nodes"]) >= 3 for m in maps["tmaze-1"])
     assert maps["tmaze-1"][0]["map"] != maps["tmaze-1"][1]["map"]  # a map per test: mapping runs with seed + k
@@ -742,44 +747,98 @@ def test_bg_choice_runs_the_papers_control_of_ten_tests_without_ep2():
     assert all(j[4] == "bg-exp2" for j in jobs)  # the floor the map set was made on
 
 
-def test_a_control_table_counts_each_choice_and_the_time_to_reload():
-    from swarm.experiments.girard2005.bg import _control_summary, direct_seconds
+def test_a_choice_table_gives_wilson_shares_and_tests_conditions_on_the_same_maps_pairwise():
+    """bg-choice's table: each W_plan's Ep1 share with its interval beside the paper's counts; W_plan 0.65
+    against 0.45 on the same maps and seeds is McNemar's test, the three together Cochran's Q; the control
+    against the paper's 10/10 is Fisher's."""
+    from swarm.experiments import stats as S
+    from swarm.experiments.girard2005 import sections
 
-    tests = [("Ep1", 40.0), ("Ep1", 60.0), ("Ep2", 90.0), ("none", None)]
-    rows = [{"condition": "0.1, no DA", "chose": c, "seconds": t} for c, t in tests]
-    summary, md = _control_summary(rows, ["0.1, no DA"], "Ep at start", "the paper's words", 14.0)
-    assert summary[0] == {"condition": "0.1, no DA", "control": True, "runs": 4, "Ep1": 2, "Ep2": 1,
-                               "neither": 1, "median_s": 60.0, "direct_s": 14.0}  # fmt: skip
-    assert "| 0.1, no DA | 2 | 1 | 1 | 60 |" in md and "the paper's words" in md and "takes 14 s" in md
+    chose = {
+        0.65: ["Ep1", "Ep1", "Ep1", "Ep2"],
+        0.55: ["Ep1", "Ep2", "Ep1", "none"],
+        0.45: ["Ep2", "Ep2", "Ep1", "Ep2"],
+    }
+    rows = [{"experiment": "bg-choice", "condition": w, "run": k, "chose": c} for w, cs in chose.items()
+            for k, c in enumerate(cs)]  # fmt: skip
+    rows += [
+        {"experiment": "bg-choice", "condition": "no Ep2", "run": k, "chose": c} for k, c in enumerate(["Ep1", "none"])
+    ]
+    _, table, claims = sections.choice(rows)
+    assert "| 0.55 | 4 (15) | 2 | 1 | 1 | 2/4: " + S.proportion_ci(2, 4).text(2) + " | 7 : 8 |" in table
+    assert "| no Ep2 (W_plan 0.65) | 2 (10) | 1 | – | 1 |" in table
+    ep1 = {w: [c == "Ep1" for c in cs] for w, cs in chose.items()}
+    assert claims[0].test == S.mcnemar(ep1[0.65], ep1[0.45]) and claims[0].ours == "3/4 vs 1/4"
+    assert claims[1].test == S.cochrans_q([ep1[w] for w in (0.65, 0.55, 0.45)])
+    assert claims[2].test == S.fisher(1, 2, 10, 10) and claims[2].expected == 0
     # the most direct paths: bg-forget's by Ep2 is longer than straight to Ep1
+    from swarm.experiments.girard2005.bg import direct_seconds
+
     assert direct_seconds("bg-exp2") > direct_seconds("bg-exp2", ("Ep1",)) > 5.0
 
 
-def test_the_fear_table_says_what_fear_takes_away_from_ep1_at_each_level():
-    from swarm.experiments.girard2005.bg import _fear_effect
+def test_the_fear_table_counts_who_died_and_tests_fear_paired_and_against_its_control():
+    from swarm.experiments import stats as S
+    from swarm.experiments.girard2005 import sections
 
-    rows = [{"condition": 0.1, "chose": c} for c in ("Ep1", "Ep1", "Ep2")]
-    rows += [{"condition": 0.5, "chose": c} for c in ("Ep2", "none", "Ep1")]
-    rows += [{"condition": "0.1, no DA", "chose": c} for c in ("Ep1", "Ep1", "Ep1")]
-    rows += [{"condition": "0.5, no DA", "chose": c} for c in ("Ep1", "Ep1", "none")]
-    md = _fear_effect(rows)
-    assert "Ep 0.1: 2 / 3; Ep 0.5: 1 / 2." in md and "2 of 20 at 0.5" in md
+    tests = {
+        0.1: [("Ep1", False), ("none", True), ("none", False)],
+        0.5: [("Ep2", False), ("Ep1", False), ("Ep2", False)],
+        "0.1, no DA": [("Ep1", False)] * 3,
+        "0.5, no DA": [("Ep1", False), ("Ep1", False), ("none", False)],
+    }
+    rows = [{"experiment": "bg-fear", "condition": ep, "run": k, "chose": c, "died": d} for ep, ts in tests.items()
+            for k, (c, d) in enumerate(ts)]  # fmt: skip
+    _, table, claims = sections.fear(rows)
+    assert "| 0.1 | 3 (20) | 1 | 0 | 2 (1 died) |" in table and "| 0.5 | 3 (20) | 1 | 2 | 0 |" in table
+    assert "| 0.5, no DA | 3 (–) | 2 | 0 | 1 | 2/3: " in table and 'Ep1 "systematically"' in table
+    assert claims[0].test == S.fisher(1, 1, 1, 3)  # the paper's test, on (Ep1, Ep2)
+    assert claims[1].test == S.mcnemar([True, False, False], [False, True, False])  # the same maps and seeds
+    assert claims[2].test == S.fisher(2, 3, 1, 3) and claims[2].ours == "2/3 vs 1/3"  # the control's own maps
 
 
-def test_a_choice_table_says_how_many_of_neither_died():
-    from swarm.experiments.girard2005.bg import PAPER_FEAR, _choice_summary
+def test_a_t_maze_ratio_the_paper_did_not_run_shows_a_dash_and_makes_no_claim():
+    from swarm.experiments.girard2005 import sections
 
-    rows = [{"condition": 0.1, "chose": c, "died": d} for c, d in [("Ep1", False), ("none", True), ("none", False)]]
-    rows += [{"condition": 0.5, "chose": "Ep2", "died": False}]
-    summary, md = _choice_summary(rows, PAPER_FEAR, "Ep at start", ("Ep1", "Ep2"), fisher=True)
-    assert "| 0.1 | 1 | 0 | 2 (1 died) | 13 | 7 |" in md and "| 0.5 | 0 | 1 | 0 | 2 | 18 |" in md
-    assert [s.get("neither_died") for s in summary[:2]] == [1, 0] and "Died: E ran out" in md
-    # Fisher's test on the paper's two columns, and on Ep1 against the rest (neither counts there)
-    from scipy.stats import fisher_exact
+    branches = {1.0: ["right", "right", "left"], 3.0: ["left", "left", ""]}
+    rows = [{"experiment": "bg-tmaze", "condition": r, "run": k, "branch": b} for r, bs in branches.items()
+            for k, b in enumerate(bs)]  # fmt: skip
+    _, table, claims = sections.tmaze(rows)
+    assert "| 1 | 3 (15) | 1 | 2 | 0 |" in table and "| 3 | 3 (–) | 2 | 0 | 1 | 0/2: " in table
+    assert table.split("| 3 | 3 (–) |")[1].splitlines()[0].endswith("| – | – |")
+    assert [c.text.split(":")[0] for c in claims] == ["exp. 3.2, ratio 1", "exp. 3.2"]
+    assert claims[1].paper == "3 → – of 15" and claims[1].ours == "1/3 → 2/2"
+    _, _, named = sections.tmaze([{**r, "condition": "my-tmaze"} for r in rows if r["condition"] == 3.0])
+    assert named == []  # a floor of the user's, not a ratio: nothing of the paper's to claim
 
-    assert summary[-1]["p"] == fisher_exact([[1, 0], [0, 1]]).pvalue
-    assert summary[-1]["p_Ep1_or_not"] == fisher_exact([[1, 2], [0, 1]]).pvalue
-    assert "on (Ep1, Ep2), the paper's" in md and "on (Ep1, not Ep1)" in md
+
+def test_a_bg_forget_table_censors_a_test_that_never_reached_ep1_on_the_users_floor(tmp_path):
+    """bg-forget's smoke run on a floor of the user's (bg-exp2 with the start 0.3 m up the corridor): a test
+    that has not reloaded at Ep1 by its end counts in the table, censored at its end, not dropped; the
+    direct path is that floor's."""
+    from swarm.experiments import stats as S
+    from swarm.experiments.girard2005 import bg
+    from swarm.experiments.girard2005.standalone import run_bg_experiment
+    from swarm.scenario import BUNDLED_DIR as BUNDLED
+
+    floor = tmp_path / "my-exp2.toml"
+    floor.write_text((BUNDLED / "bg-exp2.toml").read_text().replace('name = "bg-exp2"', 'name = "my-exp2"')
+                     .replace("start = [3.0, 0.5,", "start = [3.0, 0.8,"))  # fmt: skip
+    result = run_bg_experiment("bg-forget", str(floor), 2, 1, 0, tmp_path / "out", maps=1, mapping_seconds=120.0,
+                               progress=False)  # fmt: skip
+    with open(tmp_path / "out" / "runs.csv") as f:
+        rows = list(csv.DictReader(f))
+    reached = np.array([r["chose"] == "Ep1" and r["seconds"] != "" for r in rows])
+    assert len(rows) == 2 and not reached.all(), "the smoke's tests should not all reload at Ep1 in time"
+    t = [float(r["seconds"]) if ok else bg.TEST_SECONDS for r, ok in zip(rows, reached, strict=True)]
+    direct = bg.direct_seconds(str(floor))
+    assert round(direct) != round(bg.direct_seconds("bg-exp2"))
+    row = next(line for line in result["markdown"].splitlines() if line.startswith("| 2 (15) |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[1].startswith(f"{reached.sum()}/2: ")  # every test counted, the censored ones too
+    assert cells[3].split(" [")[0] == f"{S.restricted_mean(t, reached, bg.TEST_SECONDS) - direct:.0f}"
+    assert cells[5] == f"{direct:.0f}" and "censored at 900 s" in result["markdown"]
+    assert "2 min (mapping" in result["markdown"]
 
 
 def test_an_exploring_mapping_run_maps_half_an_hour_and_knows_both_ep_where_they_are():
@@ -804,7 +863,7 @@ def test_an_exploring_mapping_run_maps_half_an_hour_and_knows_both_ep_where_they
 def test_a_bg_experiment_runs_on_a_floor_given_as_a_file_and_says_what_a_floor_lacks(tmp_path):
     """--scenario FILE: a T-maze of the user's (here tmaze-2's floor under another name) runs as the bundled
     ones do, labelled by its name; a floor without the resources an experiment names is one clear line."""
-    from swarm.experiments.girard2005.bg import run_bg_experiment
+    from swarm.experiments.girard2005.standalone import run_bg_experiment
     from swarm.scenario import BUNDLED_DIR as BUNDLED
 
     floor = tmp_path / "my-tmaze.toml"
@@ -814,6 +873,7 @@ def test_a_bg_experiment_runs_on_a_floor_given_as_a_file_and_says_what_a_floor_l
     with open(tmp_path / "out" / "runs.csv") as f:
         rows = list(csv.DictReader(f))
     assert {r["condition"] for r in rows} == {"my-tmaze"} and all(r["branch"] in ("left", "right", "") for r in rows)
+    assert "| my-tmaze | 2 (–) |" in result["markdown"] and "No claim of the paper applies" in result["markdown"]
     lacking = tmp_path / "no-ep2.toml"
     lacking.write_text(floor.read_text().replace('name = "Ep2"', 'name = "Ep3"'))
     with pytest.raises(ScenarioError, match="bg-tmaze needs Ep2") as e:
@@ -832,7 +892,7 @@ def test_a_bg_experiment_runs_on_a_floor_given_as_a_file_and_says_what_a_floor_l
 
 def test_bg_experiment_maps_option_is_checked():
     from swarm.core.errors import ScenarioError
-    from swarm.experiments.girard2005.bg import run_bg_experiment
+    from swarm.experiments.girard2005.standalone import run_bg_experiment
 
     with pytest.raises(ScenarioError, match="--maps"):
         run_bg_experiment("bg-tmaze", None, 2, 1, 0, None, maps=3, progress=False)
@@ -847,9 +907,10 @@ def test_bg_experiment_maps_option_is_checked():
 def test_bg_experiments_take_bg_settings_to_every_run_and_refuse_unknown_ones():
     import argparse
 
-    from swarm.experiments.girard2005.bg import _with, run_bg_experiment, test_jobs
+    from swarm.experiments.girard2005.bg import _with, test_jobs
     from swarm.experiments.girard2005.options import bg_setting as _bg_setting
     from swarm.experiments.girard2005.options import bg_table as _bg_table
+    from swarm.experiments.girard2005.standalone import run_bg_experiment
 
     table = _bg_table([_bg_setting("dorsal_threshold=0.8"), _bg_setting("navigation.anchor=0.2")])
     assert table == {"dorsal_threshold": 0.8, "navigation": {"anchor": 0.2}}

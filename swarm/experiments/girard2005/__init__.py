@@ -25,7 +25,7 @@ _RATIOS = Option("--ratios", "right / left branch length ratios to run (default 
                  type=f"{_OPTIONS}:ratios", metavar="R,R,...")  # fmt: skip
 _SIZES = Option("--sizes", "colony sizes to run (default 1,2,4,8)", type=f"{_OPTIONS}:sizes",
                 metavar="N,N,...")  # fmt: skip
-_RUN = "swarm.experiments.girard2005.bg:run_bg_experiment"
+_RUN = "swarm.experiments.girard2005.standalone:run_bg_experiment"
 # Smoke runs: reps 2, the least run_bg_experiment takes ("at least 2 runs per condition"), one map for every test,
 # mapping runs of 2 minutes and survival runs cut short: every file is written in seconds.
 EXPERIMENTS = (

@@ -1,19 +1,19 @@
-"""`swarm experiment bg-survival | bg-choice | bg-forget | bg-fear | bg-tmaze`:
-the experiments of Girard et al. (2005) with the bg animat.
+"""The runs of `swarm experiment bg-survival | bg-choice | bg-forget | bg-fear | bg-tmaze` and of
+`swarm reproduce girard2005`: the experiments of Girard et al. (2005) with the bg animat, their floors and
+their maps (standalone.py runs one experiment; sections.py makes its tables).
 
 - bg-survival (exp. 1, Table 1): condition A (taxon + topological) against B
-  (taxon only) in bg-exp1, each run until death or 4 h; medians, ranges and a
-  Mann-Whitney U test (the paper's Table 1 caption swaps A and B; its text
-  is right: A uses the map).
+  (taxon only) in bg-exp1, each run until death or 4 h (the paper's Table 1
+  caption swaps A and B; its text is right: A uses the map).
 - bg-choice (exp. 2.1, Table 2): a map built without Ep2, then Ep2 appears;
   which Ep the animat reloads at first, for W_plan 0.65 / 0.55 / 0.45; and
   the paper's control, ten tests in which Ep2 does not appear.
 - bg-forget (exp. 2.2): a map built with Ep2, then Ep2 is gone; the time to
   forget it (the time to reload at Ep1 less the most direct path's).
 - bg-fear (exp. 3.1, Table 3): F = 0.2 and Ep 0.1 or 0.5; Ep1 behind the
-  dangerous area or the far Ep2; Fisher's exact test; and the paper's
-  control, the dangerous area absent (where "the animat systematically
-  chooses the closest resource").
+  dangerous area or the far Ep2; and the paper's control, the dangerous
+  area absent (where "the animat systematically chooses the closest
+  resource").
 - bg-tmaze (exp. 3.2, Table 4): the T-maze with branch ratios 1, 1.5, 2;
   which branch the animat enters first.
 
@@ -32,18 +32,13 @@ resources it names (`FLOOR_NEEDS`).  docs/bg.md says every choice.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from swarm.core.errors import ScenarioError
-from swarm.core.plots import pyplot, save_figure
 from swarm.experiments.girard2005.mapping import MAPPING_PARAMS
-from swarm.experiments.girard2005.paper import PAPER_CHOICE, PAPER_FEAR, PAPER_FORGET, PAPER_SURVIVAL, PAPER_TMAZE
-from swarm.experiments.runner import Outputs, batch_run
+from swarm.experiments.runner import batch_run
 from swarm.scenario import load_scenario
 
 EXPERIMENTS = ("bg-survival", "bg-choice", "bg-forget", "bg-fear", "bg-tmaze")
@@ -91,14 +86,9 @@ TEST_SECONDS = 900.0  # a test of experiments 2 and 3 that has not reloaded Ep b
 W_PLANS = (0.65, 0.55, 0.45)
 FEAR_EP = (0.1, 0.5)
 RATIOS = (1.0, 1.5, 2.0)
-# The paper's controls (no numbers given, only what happened): their conditions, tests and words.
+# The paper's controls (no numbers given, only what happened): their conditions and tests.
 CHOICE_CONTROL, CHOICE_CONTROL_TESTS = "no Ep2", 10
-CHOICE_CONTROL_TEXT = ("ten tests in which Ep2 is not added: \"it goes directly to Ep1 and activates the ReloadEp "
-                       "action\"; W_plan 0.65")  # fmt: skip
 FEAR_CONTROL = {ep: f"{ep}, no DA" for ep in FEAR_EP}
-FEAR_CONTROL_TEXT = ("\"When the Dangerous Area is absent, the animat systematically chooses the closest resource "
-                     "(Ep1)\"; here the dangerous area is absent from the floor, while mapping and in the test, and "
-                     "nothing else changes (F = 0.2 still)")  # fmt: skip
 WITHOUT = " without "  # a map set's name: its floor, and " without " the resources absent while mapping
 
 
@@ -240,114 +230,6 @@ def run_test(job: tuple) -> dict:
             "wall_seconds": engine.wall_seconds}  # fmt: skip
 
 
-# --------------------------------------------------------------- summaries
-
-
-def _survival_summary(rows: list[dict]) -> tuple[list[dict], str]:
-    from scipy.stats import mannwhitneyu
-
-    a = np.array([r["survival_seconds"] for r in rows if r["condition"] == "A"])
-    b = np.array([r["survival_seconds"] for r in rows if r["condition"] == "B"])
-    summary, lines = [], []
-    for cond, x in (("A", a), ("B", b)):
-        paper = PAPER_SURVIVAL[cond]
-        summary.append({"condition": cond, "runs": len(x), "median_s": float(np.median(x)), "min_s": float(x.min()),
-                        "max_s": float(x.max()), "alive_at_cap": int(sum(not r["died"] for r in rows
-                                                                          if r["condition"] == cond)),
-                        "paper_median_s": paper[0], "paper_min_s": paper[1], "paper_max_s": paper[2]})  # fmt: skip
-        lines.append(f"| {cond} | {len(x)} | {np.median(x):.1f} | {x.min():.0f} : {x.max():.0f} | {paper[0]} | "
-                     f"{paper[1]} : {paper[2]} | {np.median(x) / paper[0]:.2f} |")  # fmt: skip
-    test = mannwhitneyu(a, b, alternative="two-sided")
-    u = min(test.statistic, len(a) * len(b) - test.statistic)
-    md = ("| condition | runs | median (s) | range (s) | paper median | paper range | ours / paper |\n"
-          "|---|---|---|---|---|---|---|\n" + "\n".join(lines) +
-          f"\n\nMann-Whitney U = {u:.1f}, p = {test.pvalue:.3g} (two-sided); the paper: U = {PAPER_SURVIVAL['U']}, "
-          f"p < 0.01.  A is taxon + topological navigation, B taxon only (the paper's text; its Table 1 caption "
-          f"swaps them).\n")  # fmt: skip
-    summary.append({"condition": "U test", "u": u, "p": test.pvalue, "paper_u": PAPER_SURVIVAL["U"]})
-    return summary, md
-
-
-def _tally(rows: list[dict], options: tuple[str, str], field: str = "chose") -> tuple[int, int, int]:
-    """How many tests chose each of the two options, and how many neither."""
-    n1 = sum(r[field] == options[0] for r in rows)
-    n2 = sum(r[field] == options[1] for r in rows)
-    return n1, n2, len(rows) - n1 - n2
-
-
-def _choice_summary(rows: list[dict], paper: dict, header: str, options: tuple[str, str], field: str = "chose",
-                    fisher: bool = False) -> tuple[list[dict], str]:  # fmt: skip
-    summary, lines, counts = [], [], []
-    for cond, (p1, p2) in paper.items():
-        sel = [r for r in rows if r["condition"] == cond]
-        n1, n2, other = _tally(sel, options, field)
-        died = sum(bool(r.get("died")) for r in sel if r[field] not in options)  # the dangerous area's drain
-        counts.append((n1, n2, other))
-        summary.append({"condition": cond, "runs": len(sel), options[0]: n1, options[1]: n2, "neither": other,
-                        "neither_died": died, f"paper_{options[0]}": p1, f"paper_{options[1]}": p2})  # fmt: skip
-        lines.append(f"| {cond} | {n1} | {n2} | {other}{f' ({died} died)' if died else ''} | {p1} | {p2} |")
-    md = (f"| {header} | {options[0]} | {options[1]} | neither | paper {options[0]} | paper {options[1]} |\n"
-          "|---|---|---|---|---|---|\n" + "\n".join(lines) + "\n")  # fmt: skip
-    if any(s["neither_died"] for s in summary):
-        md += "\nDied: E ran out before any reload (the dangerous area drains E: docs/bg.md, Metabolism).\n"
-    if fisher:
-        from scipy.stats import fisher_exact
-
-        p = fisher_exact([[n1, n2] for n1, n2, _ in counts]).pvalue
-        p_not = fisher_exact([[n1, n2 + other] for n1, n2, other in counts]).pvalue
-        md += (f"\nFisher's exact test: p = {p:.3g} on ({options[0]}, {options[1]}), the paper's (p < 0.01); "
-               f"p = {p_not:.3g} on ({options[0]}, not {options[0]}).\n")  # fmt: skip
-        summary.append({"condition": "Fisher", "p": p, f"p_{options[0]}_or_not": p_not})
-    return summary, md
-
-
-def _control_summary(rows: list[dict], conditions: list[str], header: str, paper: str,
-                     direct: float) -> tuple[list[dict], str]:  # fmt: skip
-    """The paper's control tests beside its words (it gives no numbers): Ep1, Ep2, neither and the median
-    time to reload, against `direct`, the seconds the most direct path to Ep1 takes."""
-    summary, lines = [], []
-    for cond in conditions:
-        sel = [r for r in rows if r["condition"] == cond]
-        n1, n2, other = _tally(sel, ("Ep1", "Ep2"))
-        times = [r["seconds"] for r in sel if r["seconds"] is not None]
-        median = float(np.median(times)) if times else math.nan
-        summary.append({"condition": cond, "control": True, "runs": len(sel), "Ep1": n1, "Ep2": n2,
-                        "neither": other, "median_s": median, "direct_s": direct})  # fmt: skip
-        lines.append(f"| {cond} | {n1} | {n2} | {other} | {median:.0f} |")
-    md = (f"\nControl (the paper: {paper}):\n\n| {header} | Ep1 | Ep2 | neither | median time to reload (s) |\n"
-          "|---|---|---|---|---|\n" + "\n".join(lines) +
-          f"\n\nThe most direct path to Ep1 takes {direct:.0f} s (A* from the start into its reach, "
-          "at 0.4 m/s).\n")  # fmt: skip
-    return summary, md
-
-
-def _fear_effect(rows: list[dict]) -> str:
-    """Ep1 with the dangerous area against without it, per level of Ep, with the same seeds: what fear
-    takes away (the paper: much at Ep 0.5, where its animat chose Ep1 in 2 of 20; little at 0.1, 13 of 20)."""
-
-    def ep1(condition) -> int:
-        return _tally([r for r in rows if r["condition"] == condition], ("Ep1", "Ep2"))[0]
-
-    parts = [f"Ep {ep}: {ep1(ep)} / {ep1(control)}" for ep, control in FEAR_CONTROL.items()]
-    return ("\nWhat fear takes away: tests at Ep1 with the dangerous area / without it (the same seeds): "
-            + "; ".join(parts) + ".  The paper's animat chose Ep1 in 13 of 20 at Ep 0.1 and 2 of 20 at 0.5, and "
-            "\"systematically\" without the dangerous area.\n")  # fmt: skip
-
-
-def _forget_summary(rows: list[dict], direct: float) -> tuple[list[dict], str]:
-    times = np.array([r["seconds"] - direct for r in rows if r["chose"] == "Ep1" and r["seconds"] is not None])
-    n = len(rows)
-    mean, sd, top = (float(times.mean()), float(times.std(ddof=1)) if len(times) > 1 else 0.0, float(times.max())) \
-        if len(times) else (math.nan, math.nan, math.nan)  # fmt: skip
-    pm, ps, px = PAPER_FORGET
-    md = (f"| tests | reached Ep1 | mean (s) | sd (s) | max (s) | paper mean | paper sd | paper max |\n"
-          f"|---|---|---|---|---|---|---|---|\n| {n} | {len(times)} | {mean:.0f} | {sd:.0f} | {top:.0f} | {pm:.0f} | "
-          f"{ps:.0f} | {px:.0f} |\n\nTime to forget = time to reload at Ep1 less the most direct path's "
-          f"({direct:.0f} s here: start, Ep2's reach, Ep1's reach at 0.4 m/s; the paper's was 46 s).\n")  # fmt: skip
-    return [{"tests": n, "reached_ep1": len(times), "mean_s": mean, "sd_s": sd, "max_s": top, "direct_s": direct,
-             "paper_mean_s": pm, "paper_sd_s": ps, "paper_max_s": px}], md  # fmt: skip
-
-
 def junction(s) -> tuple[float, float, float]:
     """A T-maze's junction from the walls beside its stem (`below_left`, `below_right`): the animat has entered
     the left branch once north of them (y above their tops) and west of the left one's east side; the right,
@@ -371,95 +253,6 @@ def direct_seconds(name: str, stops: tuple[str, ...] = ("Ep2", "Ep1")) -> float:
         metres += leg + (res[stop].reach if k < len(stops) - 1 else 0.0)
         here = res[stop].centre
     return metres / s.groups[0].robot.max_speed
-
-
-# ------------------------------------------------------------------ plots
-
-
-def plot_experiment(experiment: str, rows: list[dict], summary: list[dict], path: Path) -> None:
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4))
-    if experiment == "bg-survival":
-        for k, cond in enumerate(("A", "B")):
-            x = [r["survival_seconds"] / 3600 for r in rows if r["condition"] == cond]
-            ax.scatter(np.full(len(x), k) + np.linspace(-0.15, 0.15, len(x)), x, alpha=0.7)
-            ax.plot([k - 0.3, k + 0.3], [np.median(x)] * 2, "k-")
-            ax.plot([k - 0.3, k + 0.3], [PAPER_SURVIVAL[cond][0] / 3600] * 2, "r--")
-        ax.set_xticks([0, 1], ["A: taxon + map", "B: taxon only"])
-        ax.set_ylabel("survival (h); black: our median, red: the paper's")
-    elif experiment == "bg-forget":
-        x = [r["seconds"] for r in rows if r["seconds"] is not None]
-        ax.hist(x, bins=10)
-        ax.set_xlabel("seconds to reload at Ep1")
-    else:
-        rows_ = [r for r in summary if isinstance(r.get("runs"), int) and not r.get("control")]
-        controls = [r for r in summary if r.get("control")]  # the paper's controls, on the right (no numbers)
-        keys = [k for k in rows_[0] if k not in ("condition", "runs", "neither", "neither_died")
-                and not k.startswith("paper")]  # fmt: skip
-        x = np.arange(len(rows_) + len(controls))
-        for k, key in enumerate(keys):
-            bars = ax.bar(x + (k - 0.5) * 0.35, [r[key] for r in rows_ + controls], 0.35, label=f"ours: {key}")
-            for bar in bars[len(rows_) :]:
-                bar.set_hatch("//")
-            ax.plot(x[: len(rows_)] + (k - 0.5) * 0.35, [r[f"paper_{key}"] for r in rows_], "k_", markersize=20)
-        ax.set_xticks(x, [str(r["condition"]) for r in rows_ + controls])
-        ax.set_ylabel("tests (bars ours, black ticks the paper;\nhatched: the control)")
-        ax.legend()
-    ax.set_title(experiment)
-    save_figure(fig, path)
-
-
-# ------------------------------------------------------------------ entry
-
-
-def run_bg_experiment(experiment: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
-                      out: Path | None, ratios: tuple[float, ...] | None = None, maps: int | None = None,
-                      progress: bool = True, bg: dict[str, Any] | None = None,
-                      mapping: str | None = None, max_ticks: int | None = None,
-                      mapping_seconds: float = MAPPING_SECONDS) -> dict:  # fmt: skip
-    """Run one experiment on its floor (or `scenario`, a file with the resources FLOOR_NEEDS names); `maps`
-    mapping runs per floor for experiments 2 and 3 (default: one per test), made as `mapping` says
-    (MAPPING_MODES; default MAPPING), each at most `mapping_seconds`; `bg` changes the [bg] table of every run
-    (mapping runs included); `max_ticks` cuts survival runs short (a smoke run)."""
-    changes = dict(bg or {})
-    floors = check_floors(experiment, scenario, ratios, changes)
-    reps = REPS[experiment] if reps is None else reps
-    if reps < 2:
-        raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
-    maps = reps if maps is None else maps
-    if experiment == "bg-survival" and maps != reps:
-        raise ScenarioError("command line", "--maps", "bg-survival has no mapping phase (condition A maps as it lives)")
-    if not 1 <= maps <= reps:
-        raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
-    if experiment == "bg-survival" and mapping is not None:
-        raise ScenarioError("command line", "--mapping", "bg-survival has no mapping phase (A maps as it lives)")
-    mapping = MAPPING if mapping is None else mapping
-    if mapping not in MAPPING_MODES:
-        raise ScenarioError("command line", "--mapping", f"one of {', '.join(MAPPING_MODES)}, not {mapping!r}")
-    out = Outputs(out, experiment)
-    if experiment == "bg-survival":
-        work = [(c, k, seed + k, changes, max_ticks, floors[0]) for c in ("A", "B") for k in range(reps)]
-        rows = batch_run(run_survival, work, jobs=jobs, desc=experiment, progress=progress)
-        rows.sort(key=lambda r: (r["condition"], r["run"]))
-        out.runs(rows, list(rows[0]))
-        summary, md = _survival_summary(rows)
-        title = (
-            f"# Experiment 1 (Girard et al. 2005): survival with and without the map\n\n{reps} runs per "
-            f"condition on {floors[0]}, at most 4 h; seed {seed}.\n\n"
-        )
-    else:
-        made = make_maps(experiment, maps, seed, floors, jobs, progress, changes, mapping, mapping_seconds)
-        (out / "maps.json").write_text(json.dumps(made))
-        work = test_jobs(experiment, reps, seed, made, changes)
-        rows = batch_run(run_test, work, jobs=jobs, desc=experiment, progress=progress)
-        rows.sort(key=lambda r: (str(r["condition"]), r["run"]))
-        out.runs(rows, list(rows[0]))
-        summary, md, title = _test_summary(experiment, rows, reps, seed, made, mapping)
-    if changes:
-        title += f"[bg] changed in every run: {json.dumps(changes)}.\n\n"
-    result = out.finish(summary, title + md)
-    plot_experiment(experiment, rows, summary, out / "plot.png")
-    return result
 
 
 def check_floors(experiment: str, scenario: str | None, ratios, changes: dict[str, Any]) -> tuple[str, ...]:
@@ -578,64 +371,3 @@ def tmaze_label(floor: str) -> float | str:
         return float(tail) if tail != name else name
     except ValueError:
         return name
-
-
-def _maps_line(made: list[dict]) -> str:
-    """What the maps of one scenario hold: nodes, mapping time, resources been at, nodes holding each kind."""
-
-    def spread(values) -> str:
-        lo, mid, hi = min(values), float(np.median(values)), max(values)
-        return f"{lo:.0f}" if lo == hi else f"median {mid:.0f} ({lo:.0f} : {hi:.0f})"
-
-    visited = sorted({v for m in made for v in m["visited"]})
-    kinds = sorted({r for m in made for r in m["assoc"]})
-    holding = {r: spread([sum(w > 0.5 for w in m["assoc"].get(r, [])) for m in made]) for r in kinds}
-    return (f"{len(made)} map{'s' if len(made) > 1 else ''}, {spread([len(m['map']['nodes']) for m in made])} nodes "
-            f"after {spread([m['mapped_seconds'] / 60 for m in made])} min; been at "
-            + ", ".join(f"{v} {sum(v in m['visited'] for m in made)}" for v in visited)
-            + "; nodes holding " + ", ".join(f"{r} {h}" for r, h in holding.items()))  # fmt: skip
-
-
-def _test_summary(experiment: str, rows: list[dict], reps: int, seed: int, maps: dict[str, list[dict]],
-                  mapping: str = MAPPING) -> tuple[list[dict], str, str]:  # fmt: skip
-    floor = floor_of(next(iter(maps)))
-    held = "; ".join(f"{name}: {_maps_line(made)}" for name, made in maps.items())
-    n = len(next(iter(maps.values())))
-    p = MAPPING_PARAMS
-    head = (
-        f"{reps} tests per condition; seed {seed}; "
-        + (
-            "every test on the map of one mapping run"
-            if n == 1
-            else "test k of every condition on the map of mapping run k (seed + k)"
-            if n == reps
-            else f"test k of every condition on the map of mapping run k mod {n} (seed + k mod {n})"
-        )
-        + f" ({held}).  A mapping animat lives in the scenario (E = {p.energy}, Ep = {p.potential} at the "
-        f"start, a full E lasting {p.lifetime / 3600:g} h, the saliences of exp. 1; girard2005/mapping.py) "
-        "until its own map holds every kind of resource on the floor, or "
-        f'{MAPPING_SECONDS / 60:.0f} min (mapping "{mapping}"{MAPPING_MODES[mapping].text}.  A test is the same '
-        f"animat: it goes on mapping from the map it loads.\n\n"
-    )
-    if experiment == "bg-choice":
-        summary, md = _choice_summary(rows, PAPER_CHOICE, "W_plan", ("Ep1", "Ep2"))
-        control, md_control = _control_summary(
-            rows, [CHOICE_CONTROL], "test", CHOICE_CONTROL_TEXT, direct_seconds(floor, ("Ep1",))
-        )
-        summary, md = summary + control, md + md_control
-        title = "# Experiment 2.1 (Girard et al. 2005): a new resource, planning against taxon\n\n" + head
-    elif experiment == "bg-forget":
-        summary, md = _forget_summary(rows, direct_seconds(floor))
-        title = "# Experiment 2.2 (Girard et al. 2005): forgetting an exhausted resource\n\n" + head
-    elif experiment == "bg-fear":
-        summary, md = _choice_summary(rows, PAPER_FEAR, "Ep at start", ("Ep1", "Ep2"), fisher=True)
-        control, md_control = _control_summary(
-            rows, list(FEAR_CONTROL.values()), "Ep at start", FEAR_CONTROL_TEXT, direct_seconds(floor, ("Ep1",))
-        )
-        summary, md = summary + control, md + md_control + _fear_effect(rows)
-        title = "# Experiment 3.1 (Girard et al. 2005): fear against the need for Ep (F = 0.2)\n\n" + head
-    else:
-        paper = {r: PAPER_TMAZE.get(r, ("-", "-")) for r in sorted({row["condition"] for row in rows}, key=str)}
-        summary, md = _choice_summary(rows, paper, "ratio", ("left", "right"), field="branch")
-        title = "# Experiment 3.2 (Girard et al. 2005): the T-maze, first branch entered\n\n" + head
-    return summary, md, title
