@@ -20,6 +20,7 @@ from statistics import median
 
 import numpy as np
 
+from swarm.bench.arena.brute import time_passes
 from world_server.arena.face.robots import ANIMAT, EPUCK, RobotModel
 from world_server.arena.face.sensors import Sensors
 from world_server.arena.face.sensors.laser import Laser
@@ -105,7 +106,7 @@ def bench_arena(quick: bool = False) -> dict:
     sizes = (1, 10, 100, 1000)
     suites = {"animat": replace(ANIMAT, radius=0.2), "laser64": LASER_BOT}
     jobs = [(name, n) for name in suites for n in sizes]
-    rows, bar = [], tqdm(total=len(jobs) + 4 + 1, desc="bench arena", unit="world", leave=False)
+    rows, bar = [], tqdm(total=len(jobs) + 4 + 3, desc="bench arena", unit="world", leave=False)
     for name, n in jobs:
         rows.append({"suite": name, **_measure(bench_world(n, suites[name]), _ticks_for(n, quick))})
         bar.update()
@@ -118,9 +119,11 @@ def bench_arena(quick: bool = False) -> dict:
     bar.update()
     cores = _cores(quick)
     bar.update()
+    reference = time_passes(bench_world(1000, LASER_BOT), 3 if quick else 7)
+    bar.update()
     bar.close()
     return {"world": f"{SIDE:g} x {SIDE:g} m, 100 obstacles 0.3-1.5 m, robots r = 0.2 m (e-pucks 37 mm)",
-            "rows": rows, "walls": walls, "epuck100": epuck, "cores": cores}  # fmt: skip
+            "rows": rows, "walls": walls, "epuck100": epuck, "cores": cores, "reference": reference}  # fmt: skip
 
 
 def _cores(quick: bool) -> list[dict]:
@@ -161,6 +164,20 @@ def format_arena_bench(result: dict) -> str:
     for r in result["cores"]:
         lines.append(f"| {r['robots']:,} | {r['threads']} | {r['sense_ms']} | {one[r['robots']] / r['sense_ms']:.2f} | "
                      f"{r['physics_ms']} | {r['ticks_per_second']} | {r['rays_per_second']:,} |")  # fmt: skip
+    lines += _reference_lines(result["reference"], result["cores"])
     lines += ["", f"targets: 1000 robots x 64-beam laser sensing {laser['sense_ms']} ms/tick (target <= 10 ms); "
               f"100 e-pucks whole tick {e['ticks_per_second']} ticks/s (target >= 500)"]  # fmt: skip
     return "\n".join(lines)
+
+
+def _reference_lines(ref: dict, cores: list[dict]) -> list[str]:
+    """The brute-force reference against the ray pass and against the whole sensing (noise and
+    read-outs included) of the cores table's 1000 robots."""
+    out = ["", f"Brute force (every ray against every segment and disc, compiled, one core) over the "
+           f"{ref['rays']:,} rays of 1000 laser robots: {ref['brute_ms']} ms; the grid's ray pass, timed in turns "
+           f"with it: {ref['pass_ms']} ms ({ref['brute_ms'] / ref['pass_ms']:.1f}x; "
+           f"{ref['agree']:,} rays at the same distance)"]  # fmt: skip
+    for r in (r for r in cores if r["robots"] == 1000):
+        out.append(f"- sensing on {r['threads']} thread(s), {r['sense_ms']} ms: {ref['brute_ms'] / r['sense_ms']:.1f}x "
+                   "the brute force")  # fmt: skip
+    return out
