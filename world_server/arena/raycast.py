@@ -6,6 +6,10 @@ obstacles are in it too, switched by a flag) and the robots' discs every tick
 order (Amanatides & Woo), tests only what those cells hold, and stops at the
 first cell that contains its nearest hit: the cost follows the rays' actual
 paths, not the size of the world.  A ray never sees its own robot's disc.
+The rays come robot by robot: one compiled loop per run of a robot's rays
+takes its heading's cosine and sine once and walks each ray with the hit tests
+inlined; the parallel pass hands whole runs to the cores, so every ray is
+still computed alone and any thread count reads the same bits.
 
 Segments belong to layers: SOLID (walls, boxes: every sensor sees them) and
 MARK (coloured marks that only cameras see, like the BG paper's dangerous
