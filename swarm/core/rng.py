@@ -60,20 +60,26 @@ def draw_normal(seed, agent, tick, draw):
     return np.sqrt(-2.0 * np.log(u1)) * np.cos(2.0 * np.pi * u2)
 
 
+@njit(cache=True, inline="always")
+def normal_row(seed, agent, tick, stream, row):
+    """Row of `agent` for fill_normal: its counters (stream << 24) + j at tick."""
+    for j in range(0, row.shape[0], 2):
+        base = 2 * ((stream << 24) + j)
+        u1 = 1.0 - draw_unit(seed, agent, tick, base)
+        u2 = draw_unit(seed, agent, tick, base + 1)
+        radius = np.sqrt(-2.0 * np.log(u1))
+        row[j] = radius * np.cos(2.0 * np.pi * u2)
+        if j + 1 < row.shape[0]:
+            row[j + 1] = radius * np.sin(2.0 * np.pi * u2)
+
+
 @njit(cache=True)
 def fill_normal(seed, agents, tick, stream, out):
     """The noise of one sensor for every robot in one call: row i from agents[i]'s
     counters (stream << 24) + j at tick (streams never overlap).  Box-Muller
     gives two normals per pair of uniforms; both are used."""
     for i in range(out.shape[0]):
-        for j in range(0, out.shape[1], 2):
-            base = 2 * ((stream << 24) + j)
-            u1 = 1.0 - draw_unit(seed, agents[i], tick, base)
-            u2 = draw_unit(seed, agents[i], tick, base + 1)
-            radius = np.sqrt(-2.0 * np.log(u1))
-            out[i, j] = radius * np.cos(2.0 * np.pi * u2)
-            if j + 1 < out.shape[1]:
-                out[i, j + 1] = radius * np.sin(2.0 * np.pi * u2)
+        normal_row(seed, agents[i], tick, stream, out[i])
 
 
 @exported("rng_fill_uniform", "void(int64, int64[:], int64, int64, float64[:, :])")

@@ -6,6 +6,10 @@ obstacles are in it too, switched by a flag) and the robots' discs every tick
 order (Amanatides & Woo), tests only what those cells hold, and stops at the
 first cell that contains its nearest hit: the cost follows the rays' actual
 paths, not the size of the world.  A ray never sees its own robot's disc.
+The rays come robot by robot: one compiled loop per run of a robot's rays
+takes its heading's cosine and sine once and walks each ray with the hit tests
+inlined; the parallel pass hands whole runs to the cores, so every ray is
+still computed alone and any thread count reads the same bits.
 
 Segments belong to layers: SOLID (walls, boxes: every sensor sees them) and
 MARK (coloured marks that only cameras see, like the BG paper's dangerous
@@ -19,6 +23,7 @@ Hits: `hit >= 0` is a segment index, `hit <= -2` is robot `-2 - hit`,
 from __future__ import annotations
 
 import math
+import os
 
 import numba
 import numpy as np
@@ -35,6 +40,10 @@ def set_threads(threads: int) -> int:
     global _threads
     _threads = numba.config.NUMBA_NUM_THREADS if threads == 0 else min(threads, numba.config.NUMBA_NUM_THREADS)
     if _threads > 1:
+        # OpenMP's idle threads spin by default: on a host whose cores are busy with other processes
+        # each parallel pass then waits out a scheduler slice (10-20 ms) for a spinning thread; asleep,
+        # they wake in microseconds.  Read once, when numba first starts its threads (just below).
+        os.environ.setdefault("OMP_WAIT_POLICY", "passive")
         numba.set_num_threads(_threads)
     return _threads
 
@@ -116,8 +125,10 @@ def build_disc_index(xy, radius, present, x0, y0, cell, nx, ny, start, items, xy
     return total
 
 
-@njit(cache=True, inline="always")
-def _hit_segment(ox, oy, dx, dy, ax, ay, bx, by):
+# error_model="numpy": a float division needs no zero test (every divisor is checked or nonzero), so
+# the loops compile without the branches that would raise ZeroDivisionError; the arithmetic is the same.
+@njit(cache=True, inline="always", error_model="numpy")
+def hit_segment(ox, oy, dx, dy, ax, ay, bx, by):
     ex, ey = bx - ax, by - ay
     den = dx * ey - dy * ex
     if abs(den) < 1e-15:
@@ -130,8 +141,8 @@ def _hit_segment(ox, oy, dx, dy, ax, ay, bx, by):
     return np.inf
 
 
-@njit(cache=True, inline="always")
-def _hit_disc(ox, oy, dx, dy, cx, cy, r):
+@njit(cache=True, inline="always", error_model="numpy")
+def hit_disc(ox, oy, dx, dy, cx, cy, r):
     wx, wy = cx - ox, cy - oy
     b = wx * dx + wy * dy
     c = wx * wx + wy * wy - r * r
@@ -144,7 +155,7 @@ def _hit_disc(ox, oy, dx, dy, cx, cy, r):
     return t
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def cast_one(ox, oy, dx, dy, rmax, me, mask, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids, d_start,
              x0, y0, cell, nx, ny):  # fmt: skip
     """Nearest hit of one ray: (distance, what).  The cells' contents are kept
@@ -169,13 +180,13 @@ def cast_one(ox, oy, dx, dy, rmax, me, mask, s_coords, s_ids, seg_on, s_start, d
         c = cy * nx + cx
         for k in range(s_start[c], s_start[c + 1]):
             if seg_on[s_ids[k]] & mask:
-                t = _hit_segment(ox, oy, dx, dy, s_coords[k, 0], s_coords[k, 1], s_coords[k, 2], s_coords[k, 3])
+                t = hit_segment(ox, oy, dx, dy, s_coords[k, 0], s_coords[k, 1], s_coords[k, 2], s_coords[k, 3])
                 if t < best:
                     best, what = t, s_ids[k]
         for k in range(d_start[c], d_start[c + 1]):
             r = d_ids[k]
             if r != me:
-                t = _hit_disc(ox, oy, dx, dy, d_xyr[k, 0], d_xyr[k, 1], d_xyr[k, 2])
+                t = hit_disc(ox, oy, dx, dy, d_xyr[k, 0], d_xyr[k, 1], d_xyr[k, 2])
                 if t < best:
                     best, what = t, -2 - r
         t_exit = min(t_x, t_y)
@@ -196,44 +207,60 @@ def cast_one(ox, oy, dx, dy, rmax, me, mask, s_coords, s_ids, seg_on, s_start, d
     return best, what
 
 
-@njit(cache=True, inline="always")
-def _cast_ray(k, r, ch, sh, pose, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids,
-              d_start, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
-    """Ray k of robot r, whose heading has cosine ch and sine sh."""
-    dx = ch * ray_cos[k] - sh * ray_sin[k]
-    dy = sh * ray_cos[k] + ch * ray_sin[k]
-    d, w = cast_one(pose[r, 0], pose[r, 1], dx, dy, ray_range[k], r, ray_mask[k], s_coords, s_ids, seg_on, s_start,
-                    d_xyr, d_ids, d_start, x0, y0, cell, nx, ny)  # fmt: skip
-    out_range[k] = d
-    out_hit[k] = w
+@njit(cache=True, error_model="numpy")
+def robot_runs(ray_robot):
+    """Where each run of consecutive rays of one robot starts, and the end: the rays come robot by robot,
+    so each run shares its robot's heading."""
+    n = ray_robot.shape[0]
+    count = 1 if n else 0
+    for k in range(1, n):
+        if ray_robot[k] != ray_robot[k - 1]:
+            count += 1
+    runs = np.empty(count + 1, np.int64)
+    j = 0
+    for k in range(n):
+        if k == 0 or ray_robot[k] != ray_robot[k - 1]:
+            runs[j] = k
+            j += 1
+    runs[count] = n
+    return runs
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
+def _cast_run(first, end, pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start,
+              d_xyr, d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
+    """Rays first..end-1, all of one robot: its heading's cosine and sine are computed once."""
+    r = ray_robot[first]
+    ox, oy = pose[r, 0], pose[r, 1]
+    ch, sh = math.cos(pose[r, 2]), math.sin(pose[r, 2])
+    for k in range(first, end):
+        dx = ch * ray_cos[k] - sh * ray_sin[k]
+        dy = sh * ray_cos[k] + ch * ray_sin[k]
+        out_range[k], out_hit[k] = cast_one(ox, oy, dx, dy, ray_range[k], r, ray_mask[k], s_coords, s_ids, seg_on,
+                                            s_start, d_xyr, d_ids, d_start, x0, y0, cell, nx, ny)  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
 def cast_rays(pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr, d_ids,
               d_start, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
     """Cast every ray: ray k leaves the centre of robot ray_robot[k] at the
     bearing whose cosine and sine are ray_cos[k], ray_sin[k] (from its heading)
-    and reaches at most ray_range[k], seeing the layers of ray_mask[k].  Rays come robot by robot, so the
-    heading's cosine and sine are computed once per robot."""
-    last, ch, sh = -1, 1.0, 0.0
-    for k in range(ray_robot.shape[0]):
-        r = ray_robot[k]
-        if r != last:
-            last, ch, sh = r, math.cos(pose[r, 2]), math.sin(pose[r, 2])
-        _cast_ray(k, r, ch, sh, pose, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr,
-                  d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit)  # fmt: skip
+    and reaches at most ray_range[k], seeing the layers of ray_mask[k]."""
+    runs = robot_runs(ray_robot)
+    for j in range(runs.shape[0] - 1):
+        _cast_run(runs[j], runs[j + 1], pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids,
+                  seg_on, s_start, d_xyr, d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit)  # fmt: skip
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def cast_rays_parallel(pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr,
                        d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit):  # fmt: skip
-    """`cast_rays` over the cores, ray by ray: each ray takes its robot's heading afresh (the same
-    cosine and sine the serial pass computes once per robot), so the readings are the same."""
-    for k in prange(ray_robot.shape[0]):
-        r = ray_robot[k]
-        ch, sh = math.cos(pose[r, 2]), math.sin(pose[r, 2])
-        _cast_ray(k, r, ch, sh, pose, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids, seg_on, s_start, d_xyr,
-                  d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit)  # fmt: skip
+    """`cast_rays` over the cores, run by run of one robot's rays: every ray is cast alone, from the
+    same heading cosine and sine, so the readings are the serial pass's, bit for bit."""
+    runs = robot_runs(ray_robot)
+    for j in prange(runs.shape[0] - 1):
+        _cast_run(runs[j], runs[j + 1], pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s_coords, s_ids,
+                  seg_on, s_start, d_xyr, d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit)  # fmt: skip
 
 
 def brute_force(

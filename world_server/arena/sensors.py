@@ -18,8 +18,10 @@ from functools import partial
 import numpy as np
 
 from swarm.core.rng import fill_normal, fill_uniform
+from world_server.arena import raycast
 from world_server.arena.face.robots import RobotModel
 from world_server.arena.face.sensors import Reading, Sensor
+from world_server.arena.noise import fill_normal_parallel
 from world_server.arena.raycast import MARK, SOLID
 
 NOISE_LEVELS = ("none", "low", "high")
@@ -116,7 +118,8 @@ class Suite:
 
     def _normal(self, stream: int, k: int, tick: int) -> np.ndarray:
         out = np.empty((len(self.robots), k))
-        fill_normal(np.int64(self.seed), self.robots, np.int64(tick), np.int64(stream), out)
+        fill = fill_normal_parallel if raycast.threads() > 1 else fill_normal  # the same numbers either way
+        fill(np.int64(self.seed), self.robots, np.int64(tick), np.int64(stream), out)
         return out
 
     # --------------------------------------------------------------- reading
