@@ -289,10 +289,10 @@ def _check_controller(s: Scenario, source: str) -> None:
     if s.controller not in CONTROLLER_NAMES:
         try:
             s.known_controllers[s.controller]
-        except (KeyError, ValueError) as exc:  # the registry's UnknownPart is a ValueError saying why in one line
+        except (KeyError, ValueError) as exc:  # a "module:NAME" that cannot load: the registry says why in one line
             known = ", ".join(dict.fromkeys((*CONTROLLER_NAMES, *s.known_controllers)))
             reason = f"unknown {s.controller!r}; expected one of {known} or module:NAME"
-            raise ScenarioError(source, "controller", str(exc) if type(exc) is not KeyError else reason) from None
+            raise ScenarioError(source, "controller", str(exc) if ":" in s.controller else reason) from None
     for name, table in s.tables.items():
         try:
             s.known_controllers[name].check_table(dict(table))

@@ -8,8 +8,9 @@ agent.  Everything here is plain data the world process, the engine and the agen
 alike; docs/controllers.md shows a whole controller.
 
 Every random choice of a step must come from (seed, agent, tick): `draw_below`, `draw_unit` and
-`draw_normal` (swarm.core.rng, re-exported here) are the counter-based draws the bundled
-controllers use, so an agent process makes exactly the in-process run's choices.
+`draw_normal` (swarm.core.rng, re-exported here when asked for: reading a spec imports no numba)
+are the counter-based draws the bundled controllers use, so an agent process makes exactly the
+in-process run's choices.
 """
 
 from __future__ import annotations
@@ -21,7 +22,6 @@ from typing import Any, ClassVar
 import numpy as np
 
 from swarm.core.errors import one_line
-from swarm.core.rng import draw_below, draw_normal, draw_unit
 from world_server.grid.face.layout import (
     ACT_LEN,
     CONTROLLERS,
@@ -33,7 +33,19 @@ from world_server.grid.face.layout import (
     new_memory,
 )
 
-__all__ = ["GridController", "draw_below", "draw_normal", "draw_unit", "own_controller", "run_memory", "run_params"]
+__all__ = ["GridController", "own_controller", "run_memory", "run_params"]
+
+DRAWS = ("draw_below", "draw_normal", "draw_unit")
+
+
+def __getattr__(name: str) -> Any:
+    """The draws of swarm.core.rng, imported when a step's module asks for them."""
+    if name in DRAWS:
+        from swarm.core import rng
+
+        return getattr(rng, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 STEP_ARGS = ("perception", "float_perception", "memory", "action", "params", "seed", "agent", "tick")
 MAX_PARAMS = 64  # fields of a controller's table (the welcome carries them as a list of floats)
