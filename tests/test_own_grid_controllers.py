@@ -25,6 +25,7 @@ from swarm.scenario import load_scenario, parse_scenario_text
 from tests.distributed import ServerThread, free_endpoint, start_agents, stop
 from world_server import persist
 from world_server.grid.face.own import GridController, run_params
+from world_server.grid.scenario import check_until
 
 OUTSIDE = Path(__file__).parent / "outside"
 TIMING = {"wall_seconds", "agent_steps_per_second", "ticks_per_second"}
@@ -53,6 +54,8 @@ def test_an_installed_packages_grid_controller_is_an_entry_and_so_is_its_module_
     own = spec.make()
     assert own.slot("detour") == 2 and own.start().tolist() == [-1, 0, 0, 0, 0, 0, 0, 0]
     assert run_params(walk()).tolist() == [0.8, 8.0]
+    with pytest.raises(ScenarioError, match=r"until: walk writes no marks"):
+        check_until(walk(), "converged")
 
 
 @njit
