@@ -24,7 +24,7 @@ PHYSICS_SECONDS_PER_ROBOT = 1.46e-6  # swarm bench arena: 1.458 ms a tick for 10
 WORLD_SECONDS_PER_ROBOT_MESSAGE = 0.67e-6  # swarm bench distributed: 0.31 + 0.36 ms for 1000 packed agents
 WORLD_SECONDS_PER_PROCESS_MESSAGE = 29e-6  # swarm bench distributed: the world's zenoh thread, 100 processes
 AGENT_PARSE_SECONDS = 46e-6  # docs/distributed.md: one robot's arena observation parsed (8 readings)
-BEAMS = {"laser64": 64, "animat": 204, "epuck": 8}  # rays per robot and tick (swarm bench arena's suites)
+BEAMS = {"laser64": 64, "animat": 60, "epuck": 8}  # rays per robot and tick (swarm bench arena's suites)
 BYTES_PER_BEAM = 4  # float32 readings on the wire
 MESSAGE_OVERHEAD_BYTES = 120  # pose, tick, ids and msgpack framing per robot, each way
 
