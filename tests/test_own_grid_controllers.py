@@ -77,6 +77,12 @@ def test_a_bad_spec_is_refused_in_one_line():
         GridController(step=_stay, memory=(("a", 5), ("b", 4)))
     with pytest.raises(ValueError, match=r"expected distinct names"):
         GridController(step=_stay, memory=(("a", 1), ("a", 1)))
+    for memory in ((["a", 1],), (("a", 1, "z"),), (("a", 0),)):  # a list, a start that is not whole, no words
+        with pytest.raises(ValueError, match=r"expected a tuple of \(name, words\)"):
+            GridController(step=_stay, memory=memory)
+    for parameters in (("speed", 1.0), (("speed", "x"),), (("speed", float("nan")),)):
+        with pytest.raises(ValueError, match=r"expected a tuple of \(name, default\) pairs"):
+            GridController(step=_stay, parameters=parameters)
     bad = swarm_cli("run", "setup2", "--controller", "grid_jumper:NOT_A_GRID_CONTROLLER")
     assert bad.returncode == 2 and "Traceback" not in bad.stderr, bad.stderr[-2000:]
     assert "grid_jumper:NOT_A_GRID_CONTROLLER is not a class" in bad.stderr.strip().splitlines()[-1]

@@ -1,5 +1,5 @@
-"""The sensing pass's readings, bit for bit, against digests of what the straightforward pass (one
-call per ray, every division checked) read: a faster kernel must not move a single bit."""
+"""The sensing pass's readings, bit for bit, against fixed digests: a faster kernel must not move a
+single bit.  The digests depend on the platform's maths library (cos, sin, log)."""
 
 import hashlib
 import math

@@ -292,7 +292,11 @@ def _check_controller(s: Scenario, source: str) -> None:
         except (KeyError, ValueError) as exc:  # a "module:NAME" that cannot load: the registry says why in one line
             known = ", ".join(dict.fromkeys((*CONTROLLER_NAMES, *s.known_controllers)))
             reason = f"unknown {s.controller!r}; expected one of {known} or module:NAME"
-            raise ScenarioError(source, "controller", str(exc) if ":" in s.controller else reason) from None
+            if ":" in s.controller:  # it loaded, or the registry says why not
+                reason = (str(exc) if isinstance(exc, ValueError) else f"{s.controller} is not a grid controller "
+                          "(a grid scenario needs a GridController, world_server.grid.face.own; an arena "
+                          "controller runs on an arena floor)")  # fmt: skip
+            raise ScenarioError(source, "controller", reason) from None
     for name, table in s.tables.items():
         try:
             s.known_controllers[name].check_table(dict(table))

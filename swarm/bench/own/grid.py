@@ -55,7 +55,7 @@ def _timed(controller: str, ticks: int):
     engine.step(5)  # kernels compiled or loaded, first-tick work done
     t0 = time.perf_counter()
     ran = engine.step(ticks, until="both")
-    return (time.perf_counter() - t0) / ran, engine
+    return (time.perf_counter() - t0) / max(ran, 1), engine
 
 
 def bench_grid(quick: bool = False) -> dict:

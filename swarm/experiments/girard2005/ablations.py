@@ -14,7 +14,8 @@ Experiment 1 runs condition A (taxon + map) only: every change concerns the loop
 where both act.  Experiment 3.2 runs every ratio on maps made by the declared animat (so a change to the
 loops is measured in the test, where the choice is made), except biased odometry and compass, whose
 maps are made with the bias too: drift acts while the map is made, and map and test are one animat
-(the same seed, so the same bias).  Test k of every condition runs on map k with seed + k: the
+(the same seed, so the same bias; with `--maps` fewer than `--reps`, test k loads map k mod maps, drawn
+with another seed's bias).  Test k of every condition runs on map k with seed + k: the
 conditions are paired with the declared animat test by test (McNemar), and survival is compared by
 log-rank with runs alive at 4 h censored.  Beside survival, the table counts the control periods spent in
 an act (ReloadE, ReloadEp) and the share of them in which the animat moved (bg.MOVING): with the wheels

@@ -87,16 +87,8 @@ class GridController:
         if len(args) != len(STEP_ARGS):
             raise ValueError(f"step {self.step.py_func.__name__}({', '.join(args)}) takes {len(args)} arguments; "
                              f"a grid step takes {len(STEP_ARGS)}: {', '.join(STEP_ARGS)}")  # fmt: skip
-        names = [slot[0] if isinstance(slot, tuple) and slot else slot for slot in self.memory]
-        if len(set(names)) != len(names) or not all(isinstance(n, str) for n in names):
-            raise ValueError(f"memory slots {names}: expected distinct names")
-        if any(len(s) not in (2, 3) or not isinstance(s[1], int) or s[1] < 1 for s in self.memory):
-            raise ValueError("memory slots: expected (name, words) or (name, words, start), words >= 1")
-        if (used := sum(s[1] for s in self.memory)) > MEM_LEN:
-            raise ValueError(f"memory layout of {used} words is over the memory row's {MEM_LEN}")
-        fields = [p[0] for p in self.parameters]
-        if len(fields) > MAX_PARAMS or len(set(fields)) != len(fields):
-            raise ValueError(f"parameters {fields}: expected at most {MAX_PARAMS} distinct names")
+        _check_memory(self.memory)
+        _check_parameters(self.parameters)
 
     def slot(self, name: str) -> int:
         """The index of memory slot `name` in the memory row."""
@@ -128,6 +120,41 @@ class GridController:
         """The float vector `params` the step gets: its table's values over the defaults."""
         self.check_table(table)
         return np.array([float(table.get(name, default)) for name, default in self.parameters], dtype=np.float64)
+
+
+def _whole(x: Any) -> bool:
+    return isinstance(x, int | np.integer) and not isinstance(x, bool)
+
+
+def _check_memory(memory: Any) -> None:
+    """Memory slots: a tuple of (name, words) or (name, words, start value), distinct names, at most
+    MEM_LEN words in all; anything else refused in one line before it is used."""
+    shaped = isinstance(memory, tuple | list) and all(
+        isinstance(s, tuple) and len(s) in (2, 3) and isinstance(s[0], str) and _whole(s[1]) and s[1] >= 1
+        and (len(s) == 2 or _whole(s[2])) for s in memory
+    )  # fmt: skip
+    if not shaped:
+        raise ValueError(f"memory {memory!r}: expected a tuple of (name, words) or (name, words, start) with "
+                         "words >= 1 and whole-number starts")  # fmt: skip
+    names = [s[0] for s in memory]
+    if len(set(names)) != len(names):
+        raise ValueError(f"memory slots {names}: expected distinct names")
+    if (used := sum(s[1] for s in memory)) > MEM_LEN:
+        raise ValueError(f"memory layout of {used} words is over the memory row's {MEM_LEN}")
+
+
+def _check_parameters(parameters: Any) -> None:
+    """The table's fields: a tuple of (name, finite number default) pairs, at most MAX_PARAMS distinct names."""
+    shaped = isinstance(parameters, tuple | list) and all(
+        isinstance(p, tuple) and len(p) == 2 and isinstance(p[0], str) and isinstance(p[1], int | float)
+        and not isinstance(p[1], bool) and np.isfinite(p[1]) for p in parameters
+    )  # fmt: skip
+    if not shaped:
+        raise ValueError(f"parameters {parameters!r}: expected a tuple of (name, default) pairs, each default a "
+                         "finite number")  # fmt: skip
+    fields = [p[0] for p in parameters]
+    if len(fields) > MAX_PARAMS or len(set(fields)) != len(fields):
+        raise ValueError(f"parameters {fields}: expected at most {MAX_PARAMS} distinct names")
 
 
 def own_controller(scenario) -> GridController | None:
