@@ -38,11 +38,14 @@ def test_missing_ticks_are_those_of_the_played_run_the_recording_lacks():
     assert checks.missing_ticks(np.arange(599), 600) == [599]
 
 
-def test_every_kill_must_be_a_death_a_replacement_and_its_agents_lost():
+def test_every_kill_must_be_counted_as_a_death_a_replacement_and_its_agents_lost():
     counted = {"agent_processes_died": 3, "agent_processes_replaced": 3, "agents_lost": 6}
     assert checks.losses(counted, kills=3, per_process=2)["all_counted"]
     assert not checks.losses({**counted, "agent_processes_replaced": 2}, kills=3, per_process=2)["all_counted"]
     assert not checks.losses({**counted, "agents_lost": 5}, kills=3, per_process=2)["all_counted"]
+    # a live process's agents dropped for missed real-time ticks are losses too, beside the kills'
+    beyond = checks.losses({**counted, "agents_lost": 8}, kills=3, per_process=2)
+    assert beyond["all_counted"] and beyond["beyond_kills"] == 2
     assert not checks.losses({}, kills=1, per_process=1)["all_counted"]
 
 

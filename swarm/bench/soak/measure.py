@@ -70,8 +70,8 @@ def soak(kind: str, minutes: float, kill_every: float, interval: float, folder: 
             "per_process": run["per_process"], "seconds": round(lasted, 1),
             "played": played, "recorded": len(recorded), "missing_ticks": checks.missing_ticks(recorded, played),
             "losses": checks.losses(summary, len(watch.kill_times), run["per_process"]), "memory": memory,
-            "span_s": [round(t) for t in checks.span(lasted)],
-            "missed_ticks": summary.get("missed_ticks"), "samples": watch.samples}  # fmt: skip
+            "span_s": [round(t) for t in checks.span(lasted)], "missed_ticks": summary.get("missed_ticks"),
+            "kill_times": watch.kill_times, "samples": watch.samples}  # fmt: skip
 
 
 def _recorded_ticks(path: Path):

@@ -22,10 +22,11 @@ def format_soak_bench(r: dict) -> str:
         f"{'kills (SIGKILL)':<28}{lo['kills']}",
         f"{'agent processes died':<28}{lo['died']}",
         f"{'agent processes replaced':<28}{lo['replaced']}",
-        f"{'agents lost (world)':<28}{lo['agents_lost']} (kills x {r['per_process']} agents a process)",
+        f"{'agents lost (world)':<28}{lo['agents_lost']} (kills x {r['per_process']} agents a process: "
+        f"{lo['kills'] * r['per_process']}; beyond the kills: {lo['beyond_kills']})",
         f"{'ticks played / recorded':<28}{r['played']} / {r['recorded']}",
         f"{'ticks missing':<28}{len(missing)}{'' if not missing else ' (first ' + str(missing[:5]) + ')'}",
-        f"{'ticks late (world)':<28}{r['missed_ticks']}",
+        f"{'missed agent-ticks (world)':<28}{r['missed_ticks']} (an agent's answer not in by its tick's end)",
         "",
         f"Resident memory (MB, median of the samples near each moment), growth over {start / 60:.1f}..{end / 60:.1f}"
         " min",
@@ -36,10 +37,16 @@ def format_soak_bench(r: dict) -> str:
         pct = "-" if g["growth_pct"] is None else f"{g['growth_pct']:+.1f}%"
         target = f"<= {TARGET_GROWTH:g}%" if g["verdict"] else "(replaced by the kills: not judged)"
         lines.append(f"{LABELS[role]:<16}{_mb(g['start_kb']):>13}{_mb(g['end_kb']):>12}{pct:>9}  {target}")
-    lines += ["", "The world's process holds its router; an agent process: the mean of those alive.", ""]
+    lines += [
+        "",
+        "The world's process holds its router; an agent process: the mean of those alive.",
+        "Agents lost beyond the kills: a live agent process's agents that missed 3 real-time ticks in a row",
+        "(the world drops them and counts them lost; the process joins again).",
+        "",
+    ]
     if r.get("files"):
         lines += [f"files: {', '.join(r['files'])}", ""]
-    counted = "every loss counted" if lo["all_counted"] else "NOT every loss counted"
+    counted = "every kill counted" if lo["all_counted"] else "NOT every kill counted"
     lines.append(f"verdict: {'met' if r['met'] else 'NOT met'} (memory growth <= {TARGET_GROWTH:g}% for the world and "
                  f"the launcher, {len(missing)} ticks missing, {counted})")  # fmt: skip
     return "\n".join(lines)
