@@ -426,7 +426,8 @@ def _connect(listen: str, world: subprocess.Popen, identity: Identity | None = N
     return None
 
 
-def _rss_kb(pid: int) -> int:
+def rss_kb(pid: int) -> int:
+    """A process's resident memory in kB (0 once it is gone)."""
     try:
         with open(f"/proc/{pid}/status") as f:
             for line in f:
@@ -470,7 +471,7 @@ def _follow(session, keys: wire.Keys, children: _Children, agents: int, progress
                 losses.ticking = True  # state messages come from ticks
                 losses.check(say)
                 for p in procs[1:]:
-                    rss[p.pid] = max(rss.get(p.pid, 0), _rss_kb(p.pid))
+                    rss[p.pid] = max(rss.get(p.pid, 0), rss_kb(p.pid))
             done, total = progress_keys(msg)
             bar.total = msg.get(total)
             bar.n = msg.get(done, 0)
