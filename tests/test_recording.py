@@ -224,3 +224,19 @@ def test_the_live_viewer_stream_carries_the_same_run(tmp_path):
     read = summary_from(read_recording(live))
     for key in SHARED_KEYS:
         assert read[key] == printed[key], key
+
+
+def test_a_viewer_that_does_not_answer_is_left_out_and_the_file_is_whole(tmp_path):
+    """A viewer address that takes no connection would fill rerun's queue and hang every flush: the run
+    says so in one line, records to its file alone and ends."""
+    port = int(free_endpoint().rsplit(":", 1)[1])  # nothing listens there
+    rrd = tmp_path / "file.rrd"
+    ran = _swarm("run", "maze", "--agents", "3", "--seed", "4", "--record", str(rrd),
+                 "--viewer", f"rerun+http://127.0.0.1:{port}/proxy", "--json", timeout=180)  # fmt: skip
+    assert ran.returncode == 0, ran.stderr[-2000:]
+    assert f"the rerun viewer at rerun+http://127.0.0.1:{port}/proxy does not answer" in ran.stderr
+    assert "Traceback" not in ran.stderr
+    printed = json.loads(ran.stdout)
+    read = summary_from(read_recording(rrd))
+    for key in SHARED_KEYS:
+        assert read[key] == printed[key], key

@@ -39,6 +39,7 @@ from agents.controllers.arena import record_of
 from swarm.core.registry import resolve
 from swarm.engines.goals import ArenaGoals, optimum_planner
 from swarm.recording.grid import FORMAT_VERSION, software_versions
+from swarm.recording.sinks import sinks
 
 RECORD_LOG = "swarm.recording.records:RecordLog"
 
@@ -112,11 +113,9 @@ class ArenaRecorder:
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self.rec = rr.RecordingStream("swarm", recording_id=str(meta.get("run_id", "run")))
-        sinks = [rr.FileSink(str(self.path))]
-        if viewer:
-            sinks.append(rr.GrpcSink(viewer))
         self._records_of = records_of(world.scenario)
-        self.rec.set_sinks(*sinks, default_blueprint=blueprint(rrb, world.scenario, self._records_of))
+        self.rec.set_sinks(*sinks(rr, str(self.path), viewer),
+                           default_blueprint=blueprint(rrb, world.scenario, self._records_of))  # fmt: skip
         self._meta_given = meta
         self.meta: dict = {}
         n = world.n

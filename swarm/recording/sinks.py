@@ -1,0 +1,45 @@
+"""Where a recording goes: its file, and a live viewer only if one answers.
+
+rerun streams to a viewer through a bounded queue: when the viewer's address takes no connection,
+the queue fills and every flush of the recording (the file's included) waits on it for ever, so
+the run would hang.  A viewer that does not answer when the run starts is therefore left out, in
+one line, and the run records to its file alone, as it does when no viewer can be spawned.
+"""
+
+from __future__ import annotations
+
+import socket
+import sys
+from typing import Any
+from urllib.parse import urlsplit
+
+ANSWER_SECONDS = 3.0  # a viewer on another host of the run answers well within this
+
+
+def answers(url: str, timeout: float = ANSWER_SECONDS) -> str | None:
+    """None if the viewer at `url` (rerun+http://HOST:PORT/proxy) takes a connection, else why not."""
+    try:
+        parts = urlsplit(url)
+        host, port = parts.hostname, parts.port or 9876
+    except ValueError as exc:
+        return f"not a viewer URL ({exc})"
+    if not host:
+        return "not a viewer URL (expected rerun+http://HOST:PORT/proxy)"
+    try:
+        with socket.create_connection((host, port), timeout=timeout):
+            return None
+    except OSError as exc:
+        return exc.strerror or str(exc) or type(exc).__name__
+
+
+def sinks(rr: Any, path: str, viewer: str | None) -> list:
+    """The file sink, and the viewer's gRPC sink when the viewer answers (one line on stderr if not)."""
+    out = [rr.FileSink(path)]
+    if viewer:
+        why = answers(viewer)
+        if why is None:
+            out.append(rr.GrpcSink(viewer))
+        else:
+            print(f"swarm: the rerun viewer at {viewer} does not answer ({why}); recording to {path} only",
+                  file=sys.stderr)  # fmt: skip
+    return out
