@@ -236,8 +236,11 @@ def test_ctrl_c_ends_the_worker_processes():
         "from tests.test_executors import _sleepy\n"
         "batch_run(_sleepy, list(range(4)), jobs=2, progress=False)\n"
     )
+    # SIGINT as a terminal's: a shell starts background jobs (a suite run with `&`) with it ignored, the
+    # ignoring is inherited, and Python then never raises KeyboardInterrupt
     python = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stderr=subprocess.PIPE, text=True,
-                              start_new_session=True)  # fmt: skip
+                              start_new_session=True,
+                              preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # fmt: skip
     deadline = time.monotonic() + 60
     while len([p for p, cmd in _in_session(python.pid)(_processes()) if "spawn_main" in cmd]) < 2:
         assert time.monotonic() < deadline and python.poll() is None, "the two workers did not start"
