@@ -5,8 +5,7 @@ from swarm.core.registry import BenchmarkSpec
 
 BENCHMARKS = BenchmarkSpec(
     name="own",
-    description="wander and the grid's marking step copied out of the package and loaded from outside, beside "
-    "the registered ones",
+    description="wander copied out of the package and loaded as module:Class, beside the registered wander",
     run="swarm.bench.own.measure:bench_own",
     report="swarm.bench.own.measure:format_own_bench",
 )
