@@ -38,6 +38,12 @@ class Estimate:
             return number(self.value, digits)
         return f"{number(self.value, digits)} [{number(self.low, digits)}, {number(self.high, digits)}]"
 
+    def percent(self, unit: str = "%", digits: int = 3) -> str:
+        """A share (or a difference of shares) as percentages (points), 'value [low, high]' and `unit`;
+        "n/a" alone where there is no value."""
+        scaled = Estimate(100 * self.value, 100 * self.low, 100 * self.high, self.n, self.what)
+        return scaled.text(digits) + ("" if math.isnan(self.value) else unit)
+
 
 def number(x: float, digits: int = 3) -> str:
     """x to `digits` significant digits, or as a whole number with thousands separated once it has more."""

@@ -71,13 +71,13 @@ def maps_for(count: int, seed: int, floors: tuple[str, ...], jobs: int | None, p
              seconds: float) -> dict[str, dict[str, list[dict]]]:  # fmt: skip
     """Each condition's T-maze maps: the declared animat's, or for a condition that changes the sensors, maps
     made with that change (one set per distinct change)."""
+    keys = {label: repr(sorted(sensors.items())) for label, (_, sensors) in ABLATIONS.items()}
     made: dict[str, dict[str, list[dict]]] = {}
-    for _, sensors in ABLATIONS.values():
-        key = repr(sorted(sensors.items()))
-        if key not in made:
-            made[key] = bg.make_maps("bg-tmaze", count, seed, floors, jobs, progress, seconds=seconds,
-                                     sensors=sensors or None)  # fmt: skip
-    return {label: made[repr(sorted(sensors.items()))] for label, (_, sensors) in ABLATIONS.items()}
+    for label, (_, sensors) in ABLATIONS.items():
+        if keys[label] not in made:
+            made[keys[label]] = bg.make_maps("bg-tmaze", count, seed, floors, jobs, progress, seconds=seconds,
+                                             sensors=sensors or None)  # fmt: skip
+    return {label: made[key] for label, key in keys.items()}
 
 
 def run_survival(job: tuple) -> dict:
@@ -151,8 +151,7 @@ def _tables(rows: list[dict], cap: float, paper: bool = True) -> tuple[list[dict
         share = S.mean_ci(np.divide(moving, acts, out=np.full(len(acts), np.nan), where=acts > 0))
         row |= {"act_periods": int(acts.sum()), "act_periods_moving": int(moving.sum()),
                 "moving_share": share.value}  # fmt: skip
-        percent = S.Estimate(100 * share.value, 100 * share.low, 100 * share.high, share.n).text(3)
-        cells.append(f"{int(acts.sum()):,}: {percent}" + ("%" if share.n else ""))
+        cells.append(f"{int(acts.sum()):,}: {share.percent()}")
         for ratio in ratios:
             right = _branch(rows, a, ratio)
             base = _branch(rows, MODEL, ratio)

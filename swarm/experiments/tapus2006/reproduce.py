@@ -113,8 +113,7 @@ def _col(sel: Sequence[dict], key: str) -> np.ndarray:
 
 def _pct(e: S.Estimate, unit: str = "%") -> str:
     """An estimate of a share as percentages (or of a difference of shares as points), 'value [low, high]'."""
-    scaled = S.Estimate(100 * e.value, 100 * e.low, 100 * e.high, e.n, e.what)
-    return scaled.text(3) + unit
+    return e.percent(unit)
 
 
 def against(values: np.ndarray, target: float) -> S.Comparison:
