@@ -102,12 +102,7 @@ def run_ablations(experiment: str, reps: int | None, jobs: int | None, seed: int
     if scenario is not None and ratios is not None:
         raise ScenarioError("command line", "--ratios", "--ratios chooses the tmaze-R floors; --scenario gives one "
                             "floor for both experiments: give one or the other")  # fmt: skip
-    reps = REPS if reps is None else reps
-    if reps < 2:
-        raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
-    maps = reps if maps is None else maps
-    if not 1 <= maps <= reps:
-        raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
+    reps, maps = bg.reps_and_maps(REPS if reps is None else reps, maps)
     floors = bg.check_floors("bg-ablations" if scenario else "bg-tmaze", scenario, ratios, {})
     out_ = Outputs(out, experiment)
     made = maps_for(maps, seed, floors, jobs, progress, mapping_seconds)

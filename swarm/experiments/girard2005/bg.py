@@ -255,6 +255,19 @@ def direct_seconds(name: str, stops: tuple[str, ...] = ("Ep2", "Ep1")) -> float:
     return metres / s.groups[0].robot.max_speed
 
 
+def reps_and_maps(reps: int, maps: int | None, mapping_phase: bool = True) -> tuple[int, int]:
+    """The command line's runs per condition and mapping runs (default one per test), checked: a ScenarioError
+    naming the option.  Without a `mapping_phase` (bg-survival) there are no maps to choose."""
+    if reps < 2:
+        raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
+    maps = reps if maps is None else maps
+    if not mapping_phase and maps != reps:
+        raise ScenarioError("command line", "--maps", "bg-survival has no mapping phase (condition A maps as it lives)")
+    if not 1 <= maps <= reps:
+        raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
+    return reps, maps
+
+
 def check_floors(experiment: str, scenario: str | None, ratios, changes: dict[str, Any]) -> tuple[str, ...]:
     """The floors an experiment runs on (its own, or `scenario`), each checked for the resources and walls it
     names and for the [bg] changes: a ScenarioError that says what is missing."""

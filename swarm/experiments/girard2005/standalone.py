@@ -27,6 +27,7 @@ from swarm.experiments.girard2005.bg import (
     check_floors,
     direct_seconds,
     make_maps,
+    reps_and_maps,
     run_survival,
     run_test,
     test_jobs,
@@ -88,14 +89,7 @@ def _section(experiment: str, rows: list[dict], cap: float, direct: float) -> tu
 
 def _checked(experiment: str, reps: int | None, maps: int | None, mapping: str | None) -> tuple[int, int, str]:
     """The command line's reps, maps and mapping mode, checked: a ScenarioError naming the option."""
-    reps = REPS[experiment] if reps is None else reps
-    if reps < 2:
-        raise ScenarioError("command line", "--reps", "at least 2 runs per condition")
-    maps = reps if maps is None else maps
-    if experiment == "bg-survival" and maps != reps:
-        raise ScenarioError("command line", "--maps", "bg-survival has no mapping phase (condition A maps as it lives)")
-    if not 1 <= maps <= reps:
-        raise ScenarioError("command line", "--maps", f"between 1 (one map for every test) and --reps ({reps})")
+    reps, maps = reps_and_maps(REPS[experiment] if reps is None else reps, maps, experiment != "bg-survival")
     if experiment == "bg-survival" and mapping is not None:
         raise ScenarioError("command line", "--mapping", "bg-survival has no mapping phase (A maps as it lives)")
     mapping = MAPPING if mapping is None else mapping
