@@ -155,7 +155,7 @@ def test_an_experiments_run_takes_every_option_and_smoke_keyword_it_declares(nam
     assert all(isinstance(k, str) for k, _ in spec.smoke) and spec.writes.strip()
 
 
-@pytest.mark.timeout(300)  # the longest (fingerprint-map: ten mapping tours) takes 75 s alone
+@pytest.mark.timeout(300)  # an experiment's smoke run: its smallest real run, up to about a minute alone
 @pytest.mark.parametrize("name", EXPERIMENTS.names())
 def test_an_experiments_smoke_run_writes_every_file_it_declares(name, tmp_path):
     spec = EXPERIMENTS[name]

@@ -26,7 +26,7 @@ RUNS = {
     "grid": {"scenario_ref": str(HERE / "grid.toml"), "agents": 8, "per_process": 2, "seed": 1},
     "arena": {"scenario_ref": str(HERE / "arena.toml"), "agents": 4, "per_process": 1, "seed": 1},
 }
-QUICK = {"minutes": 0.4, "kill_every": 5.0, "interval": 1.0}
+QUICK = {"minutes": 0.2, "kill_every": 4.0, "interval": 1.0}
 INTERVAL = 5.0  # seconds between memory samples of a full soak
 VERDICT = ("world", "launcher")  # the processes that live the whole run; agent processes are replaced
 LAST_KILL_MARGIN = 15.0  # no kill in the run's last seconds: its replacement must join before the world ends
@@ -82,7 +82,7 @@ def _recorded_ticks(path: Path):
 
 def run(quick: bool = False, minutes: float = 30.0, kill_every: float = 10.0, kind: str = "grid",
         out: str | None = None) -> dict:  # fmt: skip
-    """`swarm bench soak` (--quick: a 24 s run, a kill every 5 s, memory sampled every second)."""
+    """`swarm bench soak` (--quick: a 12 s run, a kill every 4 s, memory sampled every second)."""
     if kind not in RUNS:
         raise ValueError(f"kind: expected one of {', '.join(RUNS)}, got {kind!r}")
     interval = INTERVAL
