@@ -10,13 +10,14 @@ STAMP := $(VENV)/.installed
 
 install: $(STAMP)
 
-$(STAMP): pyproject.toml examples/flocking/pyproject.toml
+$(STAMP): pyproject.toml examples/flocking/pyproject.toml examples/grid_walk/pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "swarm needs Python 3.11 or newer"'
 	@echo "swarm: installing into $(VENV) (a few minutes the first time; errors, if any, are shown)"
 	@$(PYTHON) -m venv $(VENV)
 	@$(BIN)/pip install -qq --upgrade pip
 	@$(BIN)/pip install -qq -e '.[dev]'
 	@$(BIN)/pip install -qq -e examples/flocking  # a controller package of a user's, tested with the rest
+	@$(BIN)/pip install -qq -e examples/grid_walk  # a grid controller package of a user's, tested with the rest
 	@touch $(STAMP)
 	@echo "swarm: installed: $(BIN)/swarm --help"
 

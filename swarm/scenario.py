@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import re
 import tomllib
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -50,7 +50,8 @@ def _preset(ref: str) -> Scenario | None:
     size = int(m.group(2)) if m.group(2) else None
     if size is not None and not 5 <= size <= 4096:
         raise ScenarioError(f"preset {ref}", "size", "expected a size from 5 to 4096")
-    return paper_setup(number, size)
+    # a preset may be run with any grid controller the registry knows (a user's "module:NAME" too)
+    return replace(paper_setup(number, size), known_controllers=CONTROLLERS.where("world", "grid"))
 
 
 def scenario_path(ref: str) -> Path:

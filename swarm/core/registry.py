@@ -47,7 +47,8 @@ class ControllerSpec:
     """Everything the project needs to know of one controller, in its own folder.
 
     `factory`: an arena controller's class ("module:Class", made with no arguments: the face in
-    agents/controllers/arena.py), or a grid controller's compiled kind code ("module:CONSTANT").
+    agents/controllers/arena.py), a bundled grid controller's compiled kind code ("module:CONSTANT"),
+    or a user's grid controller (world_server.grid.face.own.GridController, "module:NAME").
     `table`: a callable that raises ValueError in one line for a bad [name] table of a scenario.
     `requires`: the sensors its robot must carry.  `shares`: the key space it writes
     (swarm/<run>/<share>/<agent>), if any.  `kernels`: modules whose `exported` kernels the
@@ -76,16 +77,17 @@ class ControllerSpec:
         """The entry of a user's arena controller class ("module:Class"), from what the class says
         of itself: `description` (default: its docstring's first line), `requires`, `shares`,
         `check_table` (a static or class method raising ValueError for a bad table), `parameters`
-        and `records` ("module:Class" references), `example`.  A grid controller is a compiled kind
-        of the grid's step, not a class: docs/controllers.md says how to add one."""
+        and `records` ("module:Class" references), `example`.  A grid controller is a GridController
+        object instead ("module:NAME"): `of_grid`."""
         target = resolve(reference)
+        if getattr(target, "world", None) == "grid" and not isinstance(target, type):
+            return cls.of_grid(name, reference, target)
         if not isinstance(target, type):
-            raise TypeError(f"{reference} is not a class; expected module:Class of an arena controller")
+            raise TypeError(f"{reference} is not a class; expected module:Class of an arena controller or "
+                            "module:NAME of a grid controller (world_server.grid.face.own.GridController)")  # fmt: skip
         if getattr(target, "world", "arena") != "arena":
-            raise TypeError(
-                f"{reference} says world = {target.world!r}; a controller loaded from outside the "
-                "package drives in the arena (a grid controller is a compiled kind: docs/controllers.md)"
-            )
+            raise TypeError(f"{reference} says world = {target.world!r}; a class drives in the arena (a grid "
+                            "controller is a GridController object: docs/controllers.md)")  # fmt: skip
         face = ("reset", "step", "snapshot", "restore", "record")
         missing = [f"{m}()" for m in face if not callable(getattr(target, m, None))]
         if missing:
@@ -104,6 +106,14 @@ class ControllerSpec:
             parameters=tuple(getattr(target, "parameters", ())),
             example=str(getattr(target, "example", "zmaze")),
         )
+
+    @classmethod
+    def of_grid(cls, name: str, reference: str, target: Any) -> ControllerSpec:
+        """The entry of a user's grid controller ("module:NAME" of a
+        world_server.grid.face.own.GridController, which checked itself when made)."""
+        doc = (target.description or reference).strip().splitlines()
+        return cls(name=name, world="grid", description=doc[0] if doc else reference, factory=reference,
+                   table=f"{reference}.check_table", example="setup2")  # fmt: skip
 
     @classmethod
     def of_plugin(cls, name: str, reference: str) -> ControllerSpec:

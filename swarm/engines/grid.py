@@ -9,14 +9,17 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
 from numba import njit
 
-from agents.controllers.grid.dispatch import step_controller
+from agents.controllers.grid.dispatch import call_step, own_step
+from swarm.core.errors import RunError
 from swarm.recording.layer_classes import K_MARKS, K_RESOURCES, K_TRAILS, class_image
-from world_server.grid.face.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind, controller_params, new_memory
+from world_server.grid.face.layout import A_MODE, PERC_F_LEN, PERC_LEN, controller_kind
+from world_server.grid.face.own import compile_line, own_controller, run_memory, run_params
 from world_server.grid.scenario import Layout, Scenario, check_until
 from world_server.grid.world import (
     C_EXPLORED,
@@ -40,10 +43,19 @@ assert (K_MARKS, K_TRAILS, K_RESOURCES) == (0, 1, 2)
 @njit(cache=True)
 def decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, blocked, mem, acts, cparams, seed, tick,
                pi, pf):  # fmt: skip
-    """Steps 1-2 of the tick: every agent perceives the start-of-tick world and chooses."""
+    """`decide_with` the bundled controllers' step (cached)."""
+    decide_with(None, kind, layers, pher, pher_on, base_r, base_c, pos, payload, blocked, mem, acts, cparams,
+                seed, tick, pi, pf)  # fmt: skip
+
+
+@njit
+def decide_with(step, kind, layers, pher, pher_on, base_r, base_c, pos, payload, blocked, mem, acts, cparams, seed,
+                tick, pi, pf):  # fmt: skip
+    """Steps 1-2 of the tick: every agent perceives the start-of-tick world and chooses (`step(kind, ...)`,
+    None for the bundled step: agents.controllers.grid.dispatch.call_step)."""
     for a in range(pos.shape[0]):
         perceive(layers, pher, pher_on, base_r, base_c, pos[a, 0], pos[a, 1], payload[a], blocked[a], pi, pf)
-        step_controller(kind, pi, pf, mem[a], acts[a], cparams, seed, a, tick)
+        call_step(step, kind, pi, pf, mem[a], acts[a], cparams, seed, a, tick)
 
 
 @njit(cache=True)
@@ -79,14 +91,28 @@ def run_ticks(
     cparams, wparams, counters, pher_on, seed, tick0, n_ticks, until, total, reachable,
     record, rec_pos, rec_mode, rec_payload, rec_counters, rec_last, rec_layers, rec_changed, rec_scales, rec_levels,
 ):  # fmt: skip
+    """`run_ticks_with` the bundled controllers' step (cached)."""
+    return run_ticks_with(
+        None, kind, layers, pher, pher_scratch, base_r, base_c, pos, payload, blocked, mem, acts,
+        cparams, wparams, counters, pher_on, seed, tick0, n_ticks, until, total, reachable,
+        record, rec_pos, rec_mode, rec_payload, rec_counters, rec_last, rec_layers, rec_changed, rec_scales, rec_levels,
+    )  # fmt: skip
+
+
+@njit
+def run_ticks_with(
+    step, kind, layers, pher, pher_scratch, base_r, base_c, pos, payload, blocked, mem, acts,
+    cparams, wparams, counters, pher_on, seed, tick0, n_ticks, until, total, reachable,
+    record, rec_pos, rec_mode, rec_payload, rec_counters, rec_last, rec_layers, rec_changed, rec_scales, rec_levels,
+):  # fmt: skip
     """Run up to n_ticks ticks from tick0; stop early once `until` holds.
     Returns the number of ticks run.  With `record`, tick t of the call is
     copied into the rec_* buffers (see swarm.recording.grid.EngineTap)."""
     pi, pf = np.empty(PERC_LEN, np.int64), np.empty(PERC_F_LEN, np.float64)
     for t in range(n_ticks):
         tick = tick0 + t
-        decide_all(kind, layers, pher, pher_on, base_r, base_c, pos, payload, blocked, mem, acts, cparams, seed, tick,
-                   pi, pf)  # fmt: skip
+        decide_with(step, kind, layers, pher, pher_on, base_r, base_c, pos, payload, blocked, mem, acts, cparams, seed,
+                    tick, pi, pf)  # fmt: skip
         resolve_tick(layers, pher, pher_scratch, base_r, base_c, pos, payload, acts, tick, wparams, counters, pher_on)
         if record:
             record_tick(t, layers, pos, payload, acts, counters, rec_pos, rec_mode, rec_payload, rec_counters,
@@ -119,10 +145,14 @@ class Engine:
 
     def __init__(self, scenario: Scenario, layout: Layout | None = None):
         self.scenario = scenario
-        self.kind = controller_kind(scenario.controller)
+        self.own = own = own_controller(scenario)
+        # the loops of the bundled step (cached), or the same loops compiled around a user's step
+        self.kind = controller_kind(scenario.controller) if own is None else own.step
+        self._run_ticks = run_ticks if own is None else partial(run_ticks_with, own_step)
+        self._decide = decide_all if own is None else partial(decide_with, own_step)
         self.world = GridWorld(scenario, layout)
-        self.mem = new_memory(scenario.agents)
-        self.cparams = controller_params(scenario)
+        self.mem = run_memory(scenario, scenario.agents)
+        self.cparams = run_params(scenario)
         self.tick = 0
         self.wall_seconds = 0.0
 
@@ -131,21 +161,28 @@ class Engine:
         A `tap` (swarm.recording.grid.EngineTap) receives every tick's record."""
         w = self.world
         started = time.perf_counter()
-        if w.bodies.physical:
-            ran = self._step_physical(n, until, tap)
-        else:
-            buffers = tap.buffers(n) if tap is not None else _NO_RECORDING
-            ran = run_ticks(
-                self.kind, w.layers, w.pher, w.pher_scratch, w.base[0], w.base[1], w.pos, w.payload, w.blocked,
-                self.mem, w.acts, self.cparams, w.wparams, w.counters, w.pheromone_on, np.int64(self.scenario.seed),
-                self.tick, n, UNTIL[until], w.total, w.reachable, tap is not None, *buffers,
-            )  # fmt: skip
+        try:
+            ran = self._step_physical(n, until, tap) if w.bodies.physical else self._step_ideal(n, until, tap)
+        except Exception as exc:  # a user's step that does not compile, raises, or answers what the world refuses
+            if self.own is None:
+                raise
+            raise RunError(compile_line(self.scenario.controller, exc)) from None
         elapsed = time.perf_counter() - started
         self.wall_seconds += elapsed
         if tap is not None and not w.bodies.physical:
             tap.take(self.tick, int(ran), elapsed)
         self.tick += int(ran)
         return int(ran)
+
+    def _step_ideal(self, n: int, until: str, tap) -> int:
+        """The compiled loop runs the ticks, the recording's buffers filled in it."""
+        w = self.world
+        buffers = tap.buffers(n) if tap is not None else _NO_RECORDING
+        return self._run_ticks(
+            self.kind, w.layers, w.pher, w.pher_scratch, w.base[0], w.base[1], w.pos, w.payload, w.blocked,
+            self.mem, w.acts, self.cparams, w.wparams, w.counters, w.pheromone_on, np.int64(self.scenario.seed),
+            self.tick, n, UNTIL[until], w.total, w.reachable, tap is not None, *buffers,
+        )  # fmt: skip
 
     def _step_physical(self, n: int, until: str, tap) -> int:
         """Tick by tick: the bodies' simulation (pymunk) sits between deciding and the grid rules."""
@@ -154,7 +191,7 @@ class Engine:
         seed = np.int64(self.scenario.seed)
         for t in range(n):
             started = time.perf_counter()
-            decide_all(self.kind, w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked,
+            self._decide(self.kind, w.layers, w.pher, w.pheromone_on, w.base[0], w.base[1], w.pos, w.payload, w.blocked,
                        self.mem, w.acts, self.cparams, seed, self.tick + t, pi, pf)  # fmt: skip
             w.resolve(self.tick + t)
             if tap is not None:

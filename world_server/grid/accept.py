@@ -12,22 +12,13 @@ import numpy as np
 from numba import njit
 
 from swarm.core.wire import MAX_MESSAGE_BYTES
+from world_server.grid.face.action import action_fault
 from world_server.grid.face.layout import (
-    A_DEPOSIT,
-    A_LOAD,
     A_MARK,
-    A_MODE,
-    A_MOVE,
-    A_TRAIL_ID,
-    A_TRAIL_OP,
-    A_UNLOAD,
     ACT_LEN,
     MARK_NONE,
     MEM_LEN,
-    N_MODES,
     PERC_F_LEN,
-    STAY,
-    TRAIL_ERASE,
 )
 from world_server.grid.face.marks import update_value
 from world_server.grid.face.wire import ACT_ROW, NOT_PLAIN, OBS_INTS, OBS_PERCEPTION, R_ACT, R_AGENT, R_MARKED, R_MEM
@@ -111,14 +102,8 @@ def write_observations(tick, ints, pf, bounds, out, offsets):
 
 @njit(cache=True, inline="always")
 def _valid(row) -> bool:
-    a = R_ACT
-    if not (0 <= row[a + A_MOVE] <= STAY and 0 <= row[a + A_TRAIL_OP] <= TRAIL_ERASE and row[a + A_TRAIL_ID] >= 0):
+    if action_fault(row[R_ACT : R_ACT + ACT_LEN]) >= 0:
         return False
-    if not 0 <= row[a + A_MODE] < N_MODES:
-        return False
-    for k in (A_LOAD, A_UNLOAD, A_DEPOSIT):
-        if row[a + k] != 0 and row[a + k] != 1:
-            return False
     return row[R_MARKED] == 0 or row[R_MARKED] == 1
 
 

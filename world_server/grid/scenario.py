@@ -23,6 +23,7 @@ import numpy as np
 from swarm.core.errors import ScenarioError
 from swarm.core.tables import no_unknown, section_of, typed
 from world_server.grid.face.layout import CONTROLLERS
+from world_server.grid.face.own import own_controller
 from world_server.grid.params import AntParams, CMarkingParams, PhysicsParams
 
 CONTROLLER_NAMES = tuple(CONTROLLERS)  # the grid face's compiled controllers
@@ -83,6 +84,11 @@ class Scenario:
     cmarking: CMarkingParams = field(default_factory=CMarkingParams)
     physics: PhysicsParams = field(default_factory=PhysicsParams)
     map_first_line: int = 0  # file line of the first map row, for messages
+    # The grid controllers the scenario may name besides the bundled ones (a user's "module:NAME" or an
+    # installed package's, world_server.grid.face.own), from the controller registry (the scenario loader's),
+    # and their tables by controller name (the step's `params`).
+    known_controllers: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    tables: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
 
     def with_overrides(
         self,
@@ -127,6 +133,8 @@ class Scenario:
             "q_max": self.q_max,
             "quantity": self.quantity,
         }
+        if self.tables:
+            d["tables"] = {name: dict(table) for name, table in self.tables.items()}
         if self.generator is not None:
             g = self.generator
             d["generator"] = {
@@ -174,13 +182,16 @@ def parse_section(data: dict, text: str, source: str, name: str, controllers: Ma
     """The kind's scenario parser (world_server.WORLD_KINDS): the grid Scenario of a file's tables,
     named `name` unless the file says."""
     data.pop("kind", None)
-    return parse_grid(data, text, source, name)
+    return parse_grid(data, text, source, name, controllers)
 
 
-def parse_grid(data: dict, text: str, source: str, name: str | None = None) -> Scenario:
+def parse_grid(data: dict, text: str, source: str, name: str | None = None, controllers: Mapping = {}) -> Scenario:
     """The grid Scenario of a scenario file's tables (`text` only to point at the map's lines),
-    named `name` (default: the file's stem) unless the file says."""
-    no_unknown(data, _TOP_KEYS, source, "top level")
+    named `name` (default: the file's stem) unless the file says.  `controllers`: the grid
+    controllers of the registry (a user's named "module:NAME" too); a table named after one that is
+    not bundled is its table."""
+    own = [k for k in data if k not in _TOP_KEYS and k in controllers and k not in CONTROLLER_NAMES]
+    no_unknown({k: v for k, v in data.items() if k not in own}, _TOP_KEYS, source, "top level")
     has_map, has_gen = "map" in data, "generator" in data
     if has_map == has_gen:
         raise ScenarioError(source, "map/generator", "give exactly one of [map] (ascii = ...) or [generator]")
@@ -213,7 +224,8 @@ def parse_grid(data: dict, text: str, source: str, name: str | None = None) -> S
             else float(typed(section, k, (int, float), source, f"physics.{k}"))
             for k in section
         })  # fmt: skip
-    scenario = Scenario(**kw)
+    kw["tables"] = {k: section_of(data, k, source) for k in own}
+    scenario = Scenario(**kw, known_controllers=controllers)
     check_scenario(scenario)
     return scenario
 
@@ -265,16 +277,31 @@ def _first_map_line(text: str, lines: list[str]) -> int:
 
 
 def _check_run_fields(s: Scenario, source: str) -> None:
-    if s.controller not in CONTROLLER_NAMES:
-        raise ScenarioError(
-            source,
-            "controller",
-            f"unknown {s.controller!r}; expected one of {', '.join(CONTROLLER_NAMES)}",
-        )
+    _check_controller(s, source)
     if not 1 <= s.agents <= MAX_AGENTS:
         raise ScenarioError(source, "agents", f"expected 1 to {MAX_AGENTS}, got {s.agents}")
     if not 0 <= s.seed < 2**63:
         raise ScenarioError(source, "seed", f"expected 0 to 2**63-1, got {s.seed}")
+
+
+def _check_controller(s: Scenario, source: str) -> None:
+    """A bundled controller, or a user's grid controller the registry loads, whose tables are valid."""
+    if s.controller not in CONTROLLER_NAMES:
+        try:
+            s.known_controllers[s.controller]
+        except (KeyError, ValueError) as exc:  # a "module:NAME" that cannot load: the registry says why in one line
+            known = ", ".join(dict.fromkeys((*CONTROLLER_NAMES, *s.known_controllers)))
+            reason = f"unknown {s.controller!r}; expected one of {known} or module:NAME"
+            if ":" in s.controller:  # it loaded, or the registry says why not
+                reason = (str(exc) if isinstance(exc, ValueError) else f"{s.controller} is not a grid controller "
+                          "(a grid scenario needs a GridController, world_server.grid.face.own; an arena "
+                          "controller runs on an arena floor)")  # fmt: skip
+            raise ScenarioError(source, "controller", reason) from None
+    for name, table in s.tables.items():
+        try:
+            s.known_controllers[name].check_table(dict(table))
+        except ValueError as exc:
+            raise ScenarioError(source, f"[{name}]", str(exc)) from None
 
 
 def _check_physics(p: PhysicsParams, src: str) -> None:
@@ -429,3 +456,7 @@ def check_until(scenario: Scenario, until: str) -> None:
     """A run's end rule must fit its controller: marks converge only where robots write them."""
     if until != "foraged" and scenario.controller in MARKLESS:
         raise ScenarioError("command line", "until", "ants build no marks; only --until foraged applies to them")
+    own = own_controller(scenario)
+    if until != "foraged" and own is not None and not own.marks:
+        raise ScenarioError("command line", "until", f"{scenario.controller} writes no marks (its marks = False); "
+                            "only --until foraged applies to it")  # fmt: skip

@@ -37,9 +37,8 @@ from world_server.grid.face.layout import (
     MARK_NONE,
     PERC_F_LEN,
     STAY,
-    controller_params,
-    new_memory,
 )
+from world_server.grid.face.own import run_memory, run_params
 from world_server.grid.world import C_EXPLORED, C_OPTIMAL, C_REJECTED, L_MARK, UNTIL, GridWorld, is_done
 from world_server.server import ACTIVE, WorldServer
 
@@ -55,10 +54,10 @@ class GridKind:
         self.world = GridWorld(self.scenario)
         self.world.warm_up()
         grid_wire.warm_up(self.world)
-        self.cparams = controller_params(self.scenario)
+        self.cparams = run_params(self.scenario)  # a user's controller's table too (face.own)
         n = self.scenario.agents
         self.mark_floor = np.zeros(n, dtype=np.int64)  # the lowest mark each agent may write on its cell this tick
-        self.memory = new_memory(n)  # every controller's memory after its last step (saved: exact resume)
+        self.memory = run_memory(self.scenario, n)  # every controller's memory after its last step (exact resume)
         self.refused = np.zeros(len(REFUSALS), dtype=np.int64)  # action rows refused since the last count, by reason
         self.accepted = 0  # action rows accepted this tick
         self.arrived: list[tuple[bytes, str]] = []  # action messages not applied yet: (bytes, process)
@@ -115,7 +114,7 @@ class GridKind:
         """A newcomer in a lost agent's slot starts with a fresh body at the base and a fresh memory."""
         if replacing:
             self.world.new_body(agent)
-            self.memory[agent] = new_memory(1)[0]
+            self.memory[agent] = run_memory(self.scenario, 1)[0]
         return {"controller": self.scenario.controller, "params": self.cparams.tolist(),
                 "memory": self.memory[agent].tolist()}  # fmt: skip
 

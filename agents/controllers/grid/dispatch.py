@@ -4,18 +4,32 @@
 in its loop over agents, and an agent process calls it through `answer_rows`
 for the agents of one observation message, so there is exactly one
 implementation of every controller's step.
+
+The loops take the step as an argument (`rows_with(step, kind, ...)` calls
+`step(kind, ...)`): the bundled entry points pass None, which stands for
+`step_controller`, and are cached and built ahead of time; a user's controller (world_server.grid.face.own)
+passes `own_step` with its own `@njit` step as the "kind", and numba compiles
+the same loop once more around it.
 """
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from agents.controllers.grid.ant import ant_step
 from agents.controllers.grid.cmarking import cmarking_step
 from agents.controllers.grid.marking import marking_step
+from agents.controllers.grid.moves import reset_action
+from world_server.grid.face.action import F_MARK, action_fault
 from world_server.grid.face.layout import (
+    A_DEPOSIT,
+    A_LOAD,
     A_MARK,
     A_MODE,
     A_MOVE,
+    A_TRAIL_ID,
+    A_TRAIL_OP,
+    A_UNLOAD,
     ACT_LEN,
     BLOCKED,
     CMARKING,
@@ -27,7 +41,10 @@ from world_server.grid.face.layout import (
     PERC_F_LEN,
     STAY,
 )
+from world_server.grid.face.marks import update_value
 from world_server.grid.face.wire import OBS_INTS, OBS_PERCEPTION, R_ACT, R_AGENT, R_MARKED, R_MEM
+
+FAULT_FIELD = np.array([A_MOVE, A_TRAIL_OP, A_TRAIL_ID, A_LOAD, A_UNLOAD, A_DEPOSIT, A_MODE, A_MARK], np.int64)
 
 
 @njit(cache=True)
@@ -47,8 +64,51 @@ def step_controller(kind, pi, pf, mem, act, params, seed, agent, tick):
     act[A_MODE] = mem[M_MODE]  # reported for the recording
 
 
+def call_step(step, kind, pi, pf, mem, act, params, seed, agent, tick):
+    """`step(kind, ...)`, or the bundled `step_controller(kind, ...)` when `step` is None, chosen when
+    numba compiles the caller (`_call_step`): a loop given None is the bundled loop, cached (passing
+    the bundled dispatcher itself would embed its address and keep numba from caching the loop)."""
+    raise NotImplementedError("call_step runs in compiled code only")
+
+
+@overload(call_step, jit_options={"cache": True})
+def _call_step(step, kind, pi, pf, mem, act, params, seed, agent, tick):
+    if isinstance(step, types.NoneType):
+
+        def bundled(step, kind, pi, pf, mem, act, params, seed, agent, tick):
+            step_controller(kind, pi, pf, mem, act, params, seed, agent, tick)
+
+        return bundled
+
+    def given(step, kind, pi, pf, mem, act, params, seed, agent, tick):
+        step(kind, pi, pf, mem, act, params, seed, agent, tick)
+
+    return given
+
+
+@njit
+def own_step(user, pi, pf, mem, act, params, seed, agent, tick):
+    """A user's step (`user`, a GridController's) on an action reset to "stay, write nothing"; an
+    action the world would refuse raises ValueError("grid action", fault, value, agent, tick),
+    which the runtimes turn into one line naming the controller (own.fault_line)."""
+    reset_action(act)
+    act[A_MODE] = 0
+    user(pi, pf, mem, act, params, seed, agent, tick)
+    fault = action_fault(act)
+    if fault >= 0:
+        raise ValueError("grid action", fault, act[FAULT_FIELD[fault]], agent, tick)
+    if act[A_MARK] != MARK_NONE and act[A_MARK] < update_value(pi):
+        raise ValueError("grid action", F_MARK, act[A_MARK], agent, tick)
+
+
 @njit(cache=True)
 def answer_rows(kind, ints_flat, pf_flat, mems, slot_of, out, params, seed, tick, null):
+    """`rows_with` of the bundled controllers' step (cached, and built ahead of time)."""
+    return rows_with(None, kind, ints_flat, pf_flat, mems, slot_of, out, params, seed, tick, null)
+
+
+@njit
+def rows_with(step, kind, ints_flat, pf_flat, mems, slot_of, out, params, seed, tick, null):
     """An agent process's whole answer to one observation message, in one call.
 
     `ints_flat` / `pf_flat` are the message's blocks as they came (read-only,
@@ -79,7 +139,7 @@ def answer_rows(kind, ints_flat, pf_flat, mems, slot_of, out, params, seed, tick
         if null:
             act[A_MOVE] = STAY
         else:
-            step_controller(kind, ints[i, OBS_PERCEPTION:], pf[i], mem, act, params, seed, agent, tick)
+            call_step(step, kind, ints[i, OBS_PERCEPTION:], pf[i], mem, act, params, seed, agent, tick)
         row[R_AGENT] = agent
         value = act[A_MARK]
         row[R_MARKED] = 1 if value != MARK_NONE and value < ints[i, OBS_PERCEPTION + MARK] else 0

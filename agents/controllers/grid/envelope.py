@@ -12,10 +12,12 @@ Every read is bounds-checked: a short or lying buffer is NOT_PLAIN, never a
 read past its end.
 """
 
+from functools import partial
+
 import numpy as np
 from numba import njit
 
-from agents.controllers.grid.dispatch import answer_rows, step_controller
+from agents.controllers.grid.dispatch import answer_rows, own_step, rows_with, step_controller
 from world_server.grid.face.layout import MARKING, N_PARAMS, new_action, new_memory, new_perception
 from world_server.grid.face.wire import ACT_ROW, ENVELOPE, NOT_PLAIN, OBS_INTS, R_MARKED, observations
 from world_server.grid.face.wire_bytes import (
@@ -38,6 +40,12 @@ from world_server.grid.face.wire_bytes import (
 
 @njit(cache=True)
 def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info):
+    """`message_with` of the bundled controllers' step (cached, and built ahead of time)."""
+    return message_with(None, kind, buf, mems, slot_of, rows, params, seed, null, out, info)
+
+
+@njit
+def message_with(step, kind, buf, mems, slot_of, rows, params, seed, null, out, info):
     """Answer the observation in `buf` (its `bytes`, or a uint8 array) into `out` (the action message's bytes);
     returns their length, -1 for an observation whose blocks are malformed (not
     answered, as `answer_rows` says), or NOT_PLAIN.  `info`: rows written,
@@ -62,7 +70,7 @@ def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info
         return -1
     ints = words(buf, ints_at, ints_len // 8).view(np.int64)
     pf = words(buf, pf_at, pf_len // 8).view(np.float64)
-    got = answer_rows(kind, ints, pf, mems, slot_of, rows, params, seed, tick, null)
+    got = rows_with(step, kind, ints, pf, mems, slot_of, rows, params, seed, tick, null)
     if got < 0:
         return -1
     marked = 0
@@ -79,15 +87,24 @@ def answer_message(kind, buf, mems, slot_of, rows, params, seed, null, out, info
     return write_words(out, at, rows.reshape(-1).view(np.uint64), 0, got * ACT_ROW)
 
 
-def warm_up() -> None:
+def warm_up(user=None) -> None:
     """Compile, or load from the cache, the step kernel now: an agent's first
-    observation must not wait for it (lock-step deadlines are short)."""
+    observation must not wait for it (lock-step deadlines are short).  `user`: a
+    user's step (world_server.grid.face.own.GridController.step), compiled into
+    the same loops instead of the bundled ones, and not run (null: every agent
+    stays), since a made-up perception is no tick of a run."""
+    if user is None:
+        step, kind, rows, message, null = step_controller, MARKING, answer_rows, answer_message, False
+    else:
+        step, kind, null = None, user, True
+        rows, message = partial(rows_with, own_step), partial(message_with, own_step)
     pi, pf = new_perception()
-    step_controller(MARKING, pi, pf, new_memory(1)[0], new_action(), np.zeros(N_PARAMS), np.int64(0), 0, 0)
+    if step is not None:
+        step(kind, pi, pf, new_memory(1)[0], new_action(), np.zeros(N_PARAMS), np.int64(0), 0, 0)
     ints = np.frombuffer(np.zeros(OBS_INTS, np.int64).tobytes(), np.int64)  # read-only, as a message's block
     out = np.zeros((1, ACT_ROW), np.int64)
-    answer_rows(MARKING, ints, np.frombuffer(pf.tobytes(), np.float64), new_memory(1), np.zeros(1, np.int64), out,
-                np.zeros(N_PARAMS), np.int64(0), np.int64(0), False)  # fmt: skip
-    message = observations(0, np.zeros((1, OBS_INTS), np.int64), pf[None])  # bytes, as the runtime passes them
-    answer_message(MARKING, message, new_memory(1), np.zeros(1, np.int64), out, np.zeros(N_PARAMS), np.int64(0), False,
-                   np.zeros(ENVELOPE + ACT_ROW * 8, np.uint8), np.zeros(3, np.int64))  # fmt: skip
+    rows(kind, ints, np.frombuffer(pf.tobytes(), np.float64), new_memory(1), np.zeros(1, np.int64), out,
+         np.zeros(N_PARAMS), np.int64(0), np.int64(0), null)  # fmt: skip
+    observation = observations(0, np.zeros((1, OBS_INTS), np.int64), pf[None])  # bytes, as the runtime passes them
+    message(kind, observation, new_memory(1), np.zeros(1, np.int64), out, np.zeros(N_PARAMS), np.int64(0), null,
+            np.zeros(ENVELOPE + ACT_ROW * 8, np.uint8), np.zeros(3, np.int64))  # fmt: skip

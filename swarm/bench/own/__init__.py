@@ -5,7 +5,8 @@ from swarm.core.registry import BenchmarkSpec
 
 BENCHMARKS = BenchmarkSpec(
     name="own",
-    description="wander copied out of the package and loaded as module:Class, beside the registered wander",
+    description="wander and the grid's marking step copied out of the package and loaded from outside, beside "
+    "the registered ones",
     run="swarm.bench.own.measure:bench_own",
     report="swarm.bench.own.measure:format_own_bench",
 )

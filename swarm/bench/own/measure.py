@@ -1,4 +1,5 @@
-"""`swarm bench own`: what loading a controller by "module:Class" costs a run in process.
+"""`swarm bench own`: what loading a controller by "module:Class" costs a run in process (and, in
+grid.py, a grid controller's step loaded from outside beside the bundled one).
 
 wander's own module is copied into a temporary folder outside the package and run as
 "copied_wander:WanderController" on the Z-maze, beside the registered `wander`, with the same
@@ -12,6 +13,8 @@ import tempfile
 import time
 from pathlib import Path
 from statistics import median
+
+from swarm.bench.own.grid import bench_grid, format_grid, write_copy
 
 SCENARIO = "zmaze"
 COPY = "copied_wander"
@@ -41,6 +44,7 @@ def bench_own(quick: bool = False) -> dict:
     robots, ticks, rounds = (10, 200, 3) if quick else (10, 2000, 7)
     with tempfile.TemporaryDirectory(prefix="swarm-own-") as folder:
         (Path(folder) / f"{COPY}.py").write_text(source.read_text())
+        write_copy(Path(folder))
         sys.path.insert(0, folder)
         try:
             times: dict[str, list[float]] = {"wander": [], f"{COPY}:WanderController": []}
@@ -49,13 +53,14 @@ def bench_own(quick: bool = False) -> dict:
                 for name in times:
                     seconds, poses[name] = _timed(name, robots, ticks)
                     times[name].append(seconds)
+            grid = bench_grid(quick)
         finally:
             sys.path.remove(folder)
     registered, loaded = (median(v) for v in times.values())
     same = all((poses["wander"] == p).all() for p in poses.values())
     return {"scenario": SCENARIO, "robots": robots, "ticks": ticks, "rounds": rounds,
             "registered_ticks_per_s": ticks / registered, "loaded_ticks_per_s": ticks / loaded,
-            "slowdown": loaded / registered - 1.0, "same_poses": bool(same)}  # fmt: skip
+            "slowdown": loaded / registered - 1.0, "same_poses": bool(same), "grid": grid}  # fmt: skip
 
 
 def format_own_bench(r: dict) -> str:
@@ -64,5 +69,5 @@ def format_own_bench(r: dict) -> str:
         f"  registered   wander                           {r['registered_ticks_per_s']:8.1f} ticks/s\n"
         f"  module:Class {COPY}:WanderController  {r['loaded_ticks_per_s']:8.1f} ticks/s\n"
         f"  loaded by module:Class: {100 * r['slowdown']:+.1f}% time (target: at most +5%); "
-        f"poses {'identical' if r['same_poses'] else 'DIFFER'}"
+        f"poses {'identical' if r['same_poses'] else 'DIFFER'}\n" + format_grid(r["grid"])
     )
