@@ -67,11 +67,14 @@ def step_controller(kind, pi, pf, mem, act, params, seed, agent, tick):
 def call_step(step, kind, pi, pf, mem, act, params, seed, agent, tick):
     """`step(kind, ...)`, or the bundled `step_controller(kind, ...)` when `step` is None, chosen when
     numba compiles the caller (`_call_step`): a loop given None is the bundled loop, cached (passing
-    the bundled dispatcher itself would embed its address and keep numba from caching the loop)."""
+    the bundled dispatcher itself would embed its address and keep numba from caching the loop).
+    The overload itself is not cached: its signature for a user's step holds numba Dispatcher types,
+    whose pickled weak references die in the next process that loads the index and make numba's
+    next save of that index raise ReferenceError.  A cached caller caches the bundled path anyway."""
     raise NotImplementedError("call_step runs in compiled code only")
 
 
-@overload(call_step, jit_options={"cache": True})
+@overload(call_step)
 def _call_step(step, kind, pi, pf, mem, act, params, seed, agent, tick):
     if isinstance(step, types.NoneType):
 
