@@ -12,8 +12,10 @@ import signal
 import subprocess
 import sys
 import time
+import tomllib
 from pathlib import Path
 
+import jsonschema
 import numpy as np
 import pytest
 from numba import njit
@@ -21,7 +23,7 @@ from numba import njit
 from agents.controllers import CONTROLLERS
 from swarm.core.errors import RunError, ScenarioError
 from swarm.engines.grid import Engine
-from swarm.scenario import load_scenario, parse_scenario_text
+from swarm.scenario import load_scenario, parse_scenario_text, scenario_schema
 from tests.distributed import ServerThread, free_endpoint, start_agents, stop
 from world_server import persist
 from world_server.grid.face.own import GridController, run_params
@@ -96,6 +98,13 @@ def test_a_scenario_file_gives_the_controller_its_table_and_refuses_a_bad_one():
         parse_scenario_text(text + "[walk]\nspeed = 1\n", "w.toml")
     with pytest.raises(ScenarioError, match=r"w.toml: controller: cannot load controller 'nowhere:X'"):
         parse_scenario_text(text.replace('"walk"', '"nowhere:X"'), "w.toml")
+    # the scenario schema (swarm schema) gives editors the same table: its fields typed, a misspelling refused
+    schema = jsonschema.Draft202012Validator(scenario_schema())
+    assert not list(schema.iter_errors(tomllib.loads(text + "[walk]\npersistence = 0.5\n")))
+    assert list(schema.iter_errors(tomllib.loads(text + "[walk]\nspeed = 1\n")))
+    assert list(schema.iter_errors(tomllib.loads(text + '[walk]\npersistence = "high"\n')))
+    assert not list(schema.iter_errors(tomllib.loads(text.replace('"walk"', '"grid_jumper:JUMPER"')
+                                                     + '["grid_jumper:JUMPER"]\n')))  # fmt: skip
 
 
 def test_a_step_that_answers_what_the_world_refuses_or_does_not_compile_ends_the_run_in_one_line():
