@@ -240,3 +240,39 @@ def test_a_viewer_that_does_not_answer_is_left_out_and_the_file_is_whole(tmp_pat
     read = summary_from(read_recording(rrd))
     for key in SHARED_KEYS:
         assert read[key] == printed[key], key
+
+
+def test_a_viewer_that_goes_away_mid_run_is_left_out_and_the_file_is_whole(tmp_path):
+    """rerun raises at every flush once its viewer is gone: the run says so in one line, goes on to its end
+    and its file holds every tick."""
+    import os
+    import signal
+
+    from swarm.bench.soak.measure import _recorded_ticks
+    from swarm.review.report import rerun_binary
+
+    port, rrd = int(free_endpoint().rsplit(":", 1)[1]), tmp_path / "file.rrd"
+    server = subprocess.Popen([rerun_binary(), "--serve-grpc", "--port", str(port)], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL, start_new_session=True)  # fmt: skip
+    run = None
+    try:
+        time.sleep(2)
+        run = subprocess.Popen([sys.executable, "-m", "swarm", "run", "zmaze", "--agents", "3", "--controller",
+                                "wander", "--max-ticks", "20000", "--record", str(rrd), "--viewer",
+                                f"rerun+http://127.0.0.1:{port}/proxy", "--json"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+        deadline = time.monotonic() + 120
+        while not (rrd.exists() and rrd.stat().st_size > 200_000):  # ticks flushed: the viewer got them too
+            assert run.poll() is None and time.monotonic() < deadline, "the run never got going"
+            time.sleep(0.05)
+        os.killpg(server.pid, signal.SIGKILL)
+        out, err = run.communicate(timeout=180)
+    finally:
+        os.killpg(server.pid, signal.SIGKILL) if server.poll() is None else None
+        if run is not None and run.poll() is None:
+            run.kill()
+    assert run.returncode == 1 and "Traceback" not in err, err[-3000:]  # 1: ended unfinished, as wander does
+    assert f"swarm: the rerun viewer at rerun+http://127.0.0.1:{port}/proxy went away" in err
+    printed = json.loads(out)
+    assert printed["ticks"] == 20000 and not printed["finished"] and summary_from(read_recording(rrd))["ticks"] == 20000
+    assert _recorded_ticks(rrd).tolist() == list(range(20000))

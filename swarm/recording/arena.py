@@ -39,7 +39,7 @@ from agents.controllers.arena import record_of
 from swarm.core.registry import resolve
 from swarm.engines.goals import ArenaGoals, optimum_planner
 from swarm.recording.grid import FORMAT_VERSION, software_versions
-from swarm.recording.sinks import sinks
+from swarm.recording.sinks import Flusher, sinks
 
 RECORD_LOG = "swarm.recording.records:RecordLog"
 
@@ -114,6 +114,7 @@ class ArenaRecorder:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self.rec = rr.RecordingStream("swarm", recording_id=str(meta.get("run_id", "run")))
         self._records_of = records_of(world.scenario)
+        self._flush = Flusher(viewer, str(self.path))
         self.rec.set_sinks(*sinks(rr, str(self.path), viewer),
                            default_blueprint=blueprint(rrb, world.scenario, self._records_of))  # fmt: skip
         self._meta_given = meta
@@ -362,7 +363,7 @@ class ArenaRecorder:
         rec.set_time("tick", sequence=int(ticks[-1]))
         rec.log("world/trajectories", rr.LineStrips2D([flip(p) for p in paths], colors=self.colours, radii=0.002,
                                                       draw_order=4.0))  # fmt: skip
-        rec.flush(timeout_sec=0)  # on disk without waiting: a kill loses at most `flush_every` ticks
+        self._flush(rec, timeout_sec=0)  # on disk without waiting: a kill loses at most `flush_every` ticks
 
     def close(self, summary: dict | None = None) -> None:
         if not self._static_done:
@@ -370,7 +371,7 @@ class ArenaRecorder:
         self.flush()
         if summary is not None:
             self.rec.log("run/summary", self.rr.AnyValues(summary=json.dumps(summary)), static=True)
-        self.rec.flush()
+        self._flush(self.rec)
         self.rec.disconnect()
 
 

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from swarm.recording.layer_classes import K_MARKS, K_TRAILS, class_images, level_range, n_levels
-from swarm.recording.sinks import sinks
+from swarm.recording.sinks import Flusher, sinks
 from world_server.grid.bodies import cell_centres
 from world_server.grid.face.layout import A_MODE, ERASE, RETURN, RETURN_COLOUR, RETURN_MEND, RETURN_REMOVE, SEARCH
 from world_server.grid.world import C_DELIVERED, C_EXPLORED, C_OPTIMAL, L_MARK, L_RES, L_TRAIL, GridWorld
@@ -172,6 +172,7 @@ class Recorder:
         self.world = world
         self.flush_every = flush_every
         self.rec = rr.RecordingStream("swarm", recording_id=str(meta.get("run_id", "run")))
+        self._flush = Flusher(viewer, str(self.path))
         self.rec.set_sinks(*sinks(rr, str(self.path), viewer), default_blueprint=default_blueprint())
         self.meta = {"format": FORMAT_VERSION, **meta, "versions": software_versions()}
         self._blocks: list[Block] = []
@@ -180,7 +181,7 @@ class Recorder:
         # per layer kind (swarm.recording.layer_classes): the value that gets the last class
         self.scales = (max(1, int(world.layout.bfs.max())), 0, max(1, int(world.layers[L_RES].max())))
         self._log_static()
-        self.rec.flush(timeout_sec=0)  # the meta and the map on disk now: a killed run's file still has them
+        self._flush(self.rec, timeout_sec=0)  # the meta and the map on disk now: a killed run's file still has them
 
     # ------------------------------------------------------------------ static
 
@@ -269,14 +270,14 @@ class Recorder:
                 rec.send_columns(f"world/{name}", indexes=[rr.TimeColumn("tick", sequence=ticks_changed)],
                                  columns=rr.SegmentationImage.columns(
                                      buffer=classes.reshape(len(classes), -1).view(np.uint8)))  # fmt: skip
-        rec.flush(timeout_sec=0)  # rerun's batches too, without waiting: a kill loses at most `flush_every` ticks
+        self._flush(rec, timeout_sec=0)  # rerun's batches too, not waited for: a kill loses at most `flush_every` ticks
 
     def close(self, summary: dict | None = None) -> None:
         """Flush what is left, store the printed summary, close the file."""
         self.flush()
         if summary is not None:
             self.rec.log("run/summary", self.rr.AnyValues(summary=json.dumps(summary)), static=True)
-        self.rec.flush()
+        self._flush(self.rec)
         self.rec.disconnect()
 
 

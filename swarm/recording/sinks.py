@@ -3,7 +3,9 @@
 rerun streams to a viewer through a bounded queue: when the viewer's address takes no connection,
 the queue fills and every flush of the recording (the file's included) waits on it for ever, so
 the run would hang.  A viewer that does not answer when the run starts is therefore left out, in
-one line, and the run records to its file alone, as it does when no viewer can be spawned.
+one line, and the run records to its file alone, as it does when no viewer can be spawned.  A viewer
+that goes away during the run makes rerun's flushes raise; `Flusher` says so in one line and the run
+goes on, its file whole (the file sink is written beside the viewer's, not after it).
 """
 
 from __future__ import annotations
@@ -43,3 +45,23 @@ def sinks(rr: Any, path: str, viewer: str | None) -> list:
             print(f"swarm: the rerun viewer at {viewer} does not answer ({why}); recording to {path} only",
                   file=sys.stderr)  # fmt: skip
     return out
+
+
+class Flusher:
+    """The recording's flushes, for a run whose viewer (`viewer`, or None) may go away mid-run: rerun then
+    raises at every flush ("gRPC connection severed", "unable to connect"); the first such error is one
+    line on stderr and the rest are ignored, while any other error (the file's) is raised."""
+
+    def __init__(self, viewer: str | None, path: str):
+        self.viewer, self.path, self.gone = viewer, path, False
+
+    def __call__(self, rec: Any, **kwargs: Any) -> None:
+        try:
+            rec.flush(**kwargs)
+        except RuntimeError as exc:
+            if not self.viewer or "grpc" not in str(exc).lower():
+                raise
+            if not self.gone:
+                self.gone = True
+                print(f"swarm: the rerun viewer at {self.viewer} went away ({str(exc).splitlines()[0]}); "
+                      f"recording to {self.path} only", file=sys.stderr)  # fmt: skip
