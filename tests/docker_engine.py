@@ -15,10 +15,14 @@ import shutil
 import subprocess
 import sys
 import time
+import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 BASE_TAG = "localpy:3.11"
+# the Dockerfile's stages that hold the dependencies, tagged so that removing the app image and
+# `docker image prune` keep them: a build after a source change redoes only the project's install
+CACHED_STAGES = {"build-deps": "swarm-cache:build-deps", "runtime-deps": "swarm-cache:runtime-deps"}
 
 
 def engine_answers() -> bool:
@@ -68,15 +72,40 @@ def docker_engine():
             proc.wait(30)
 
 
+def project_dependencies() -> list[str]:
+    """[project] dependencies of pyproject.toml, as the Dockerfile's requirements stage reads them."""
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        return tomllib.load(f)["project"]["dependencies"]
+
+
 def build_wheelhouse() -> None:
-    """wheels/: the project's wheel, every dependency's, and the build backend (pip's cache makes it quick)."""
+    """wheels/: every dependency's wheel and the build backend's, not the project's own.
+
+    The image installs the project from its sources; its wheel (new bytes on every build)
+    would change wheels/ and so miss the cache of the Dockerfile's deps stage.  The
+    dependencies' wheels are the same bytes from run to run (pip's cache makes it quick).
+    """
     wheels = ROOT / "wheels"
     for old in wheels.glob("*.whl"):
         old.unlink()
     pip = [sys.executable, "-m", "pip", "--disable-pip-version-check"]
-    subprocess.run([*pip, "wheel", "--quiet", "-w", str(wheels), str(ROOT)], check=True, timeout=900)
+    subprocess.run([*pip, "wheel", "--quiet", "-w", str(wheels), *project_dependencies()], check=True, timeout=900)
     subprocess.run([*pip, "download", "--quiet", "-d", str(wheels), "setuptools", "wheel"], check=True, timeout=300)
 
 
 def build_base() -> None:
     subprocess.run(["bash", str(ROOT / "docker" / "local-base.sh"), BASE_TAG], check=True, timeout=900)
+
+
+def build_cached_stages(base: str = BASE_TAG) -> None:
+    """Build (from the cache, if it has them) and tag the dependency stages of the Dockerfile.
+
+    A new tag leaves the layers of the one it replaces dangling, for `docker image prune`.
+    The classic builder, which compose v1 uses, shares its layer cache with these builds.
+    """
+    env = {**os.environ, "DOCKER_BUILDKIT": "0"}
+    for target, tag in CACHED_STAGES.items():
+        out = subprocess.run(["docker", "build", "--build-arg", f"BASE={base}", "--target", target, "-t", tag,
+                              str(ROOT)], env=env, capture_output=True, text=True, timeout=900)  # fmt: skip
+        if out.returncode != 0:
+            raise RuntimeError(f"docker build --target {target} failed:\n{out.stdout[-4000:]}\n{out.stderr[-2000:]}")
