@@ -39,7 +39,7 @@ from agents.controllers.arena import record_of
 from swarm.core.registry import resolve
 from swarm.engines.goals import ArenaGoals, optimum_planner
 from swarm.recording.grid import FORMAT_VERSION, software_versions
-from swarm.recording.sinks import Flusher, sinks
+from swarm.recording.sinks import stream_to
 
 RECORD_LOG = "swarm.recording.records:RecordLog"
 
@@ -114,9 +114,7 @@ class ArenaRecorder:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self.rec = rr.RecordingStream("swarm", recording_id=str(meta.get("run_id", "run")))
         self._records_of = records_of(world.scenario)
-        self._flush = Flusher(viewer, str(self.path))
-        self.rec.set_sinks(*sinks(rr, str(self.path), viewer),
-                           default_blueprint=blueprint(rrb, world.scenario, self._records_of))  # fmt: skip
+        self._flush = stream_to(rr, self.rec, str(self.path), viewer, blueprint(rrb, world.scenario, self._records_of))
         self._meta_given = meta
         self.meta: dict = {}
         n = world.n

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from swarm.recording.layer_classes import K_MARKS, K_TRAILS, class_images, level_range, n_levels
-from swarm.recording.sinks import Flusher, sinks
+from swarm.recording.sinks import stream_to
 from world_server.grid.bodies import cell_centres
 from world_server.grid.face.layout import A_MODE, ERASE, RETURN, RETURN_COLOUR, RETURN_MEND, RETURN_REMOVE, SEARCH
 from world_server.grid.world import C_DELIVERED, C_EXPLORED, C_OPTIMAL, L_MARK, L_RES, L_TRAIL, GridWorld
@@ -172,8 +172,7 @@ class Recorder:
         self.world = world
         self.flush_every = flush_every
         self.rec = rr.RecordingStream("swarm", recording_id=str(meta.get("run_id", "run")))
-        self._flush = Flusher(viewer, str(self.path))
-        self.rec.set_sinks(*sinks(rr, str(self.path), viewer), default_blueprint=default_blueprint())
+        self._flush = stream_to(rr, self.rec, str(self.path), viewer, default_blueprint())
         self.meta = {"format": FORMAT_VERSION, **meta, "versions": software_versions()}
         self._blocks: list[Block] = []
         self._held = 0  # ticks in the blocks not yet flushed

@@ -34,17 +34,18 @@ def answers(url: str, timeout: float = ANSWER_SECONDS) -> str | None:
         return exc.strerror or str(exc) or type(exc).__name__
 
 
-def sinks(rr: Any, path: str, viewer: str | None) -> list:
-    """The file sink, and the viewer's gRPC sink when the viewer answers (one line on stderr if not)."""
+def stream_to(rr: Any, rec: Any, path: str, viewer: str | None, blueprint: Any) -> Flusher:
+    """Point `rec` at its file, and at the viewer when the viewer answers (one line on stderr if not);
+    returns the recording's flush, which knows whether a viewer is streamed to."""
     out = [rr.FileSink(path)]
+    if viewer and (why := answers(viewer)) is not None:
+        print(f"swarm: the rerun viewer at {viewer} does not answer ({why}); recording to {path} only",
+              file=sys.stderr)  # fmt: skip
+        viewer = None
     if viewer:
-        why = answers(viewer)
-        if why is None:
-            out.append(rr.GrpcSink(viewer))
-        else:
-            print(f"swarm: the rerun viewer at {viewer} does not answer ({why}); recording to {path} only",
-                  file=sys.stderr)  # fmt: skip
-    return out
+        out.append(rr.GrpcSink(viewer))
+    rec.set_sinks(*out, default_blueprint=blueprint)
+    return Flusher(viewer, path)
 
 
 class Flusher:
