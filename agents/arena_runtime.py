@@ -19,6 +19,7 @@ from agents.controllers import CONTROLLERS
 from agents.controllers.arena import StepGuard, broadcasts, deliver, make_controller, publications, record_of
 from agents.runtime import AgentRuntime
 from swarm.core import heap, kernels, memory_codec, wire
+from swarm.core.bus import LOSSLESS
 from world_server.arena.face import wire as arena_proto
 
 
@@ -118,7 +119,7 @@ class ArenaAgentRuntime(AgentRuntime):
                 why = why or f"it passed {arena_proto.MAX_RECORD_BYTES} bytes"
                 print(f"swarm: the recording leaves out robot {agent}'s record(): {why}", file=sys.stderr, flush=True)
                 continue
-            self.session.put(self.keys.record(self.group), message)
+            self.session.put(self.keys.record(self.group), message, congestion_control=LOSSLESS)
 
     def _send_plans(self, tick: int, agents: list[int]) -> None:
         """A controller's new plan goes to the world once, for the recording."""
@@ -131,7 +132,8 @@ class ArenaAgentRuntime(AgentRuntime):
             key = (len(path), *np.asarray(path[0]).tolist(), *np.asarray(path[-1]).tolist())
             if self.sent_plans.get(agent) != key:
                 self.sent_plans[agent] = key
-                self.session.put(self.keys.plan(self.group), arena_proto.plan_message(tick, agent, path))
+                plan = arena_proto.plan_message(tick, agent, path)
+                self.session.put(self.keys.plan(self.group), plan, congestion_control=LOSSLESS)
 
 
 def give_back(brain, blob: bytes) -> bool:

@@ -19,7 +19,7 @@ import uuid
 from collections import Counter
 
 from swarm.core import wire
-from swarm.core.bus import DEFAULT_ENDPOINT, open_client
+from swarm.core.bus import DEFAULT_ENDPOINT, LOSSLESS, open_client
 from swarm.core.credentials import Identity, own_group
 from swarm.core.errors import RunError
 from swarm.core.wire import world_info
@@ -50,7 +50,7 @@ class AgentRuntime:
         # Subscribed before joining: the world starts observing an agent as soon as it sees its token.
         # A FIFO channel read by the main thread: no Python callback thread between zenoh and the step.
         self.inbox = self.session.declare_subscriber(self.keys.obs(self.group))
-        self.act_publisher = self.session.declare_publisher(self.keys.act(self.group))
+        self.act_publisher = self.session.declare_publisher(self.keys.act(self.group), congestion_control=LOSSLESS)
         self._decls = [self.inbox, self.act_publisher]
         self._heard = time.monotonic()  # when the last observation came
         self._closed = threading.Event()

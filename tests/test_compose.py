@@ -37,7 +37,7 @@ from tests.docker_engine import (
 )
 from tests.docker_swarm import Nodes, docker, two_node_swarm, why_no_second_node
 
-pytestmark = pytest.mark.timeout(900)
+pytestmark = [pytest.mark.timeout(900), pytest.mark.xdist_group("compose")]  # the module's fixtures: one worker
 
 reason = why_no_engine()
 if reason is not None:

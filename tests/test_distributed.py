@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from swarm.core import wire
-from swarm.core.bus import open_client
+from swarm.core.bus import LOSSLESS, open_client, open_router
 from swarm.engines.grid import Engine
 from swarm.scenario import load_scenario
 from tests.distributed import ServerThread, free_endpoint, run_world, saving_world_cmd, start_agents, stop
@@ -38,6 +38,40 @@ def test_lockstep_equals_the_in_process_engine(ref, controller, agents, seed, ph
     np.testing.assert_array_equal(world.body_xy, engine.world.body_xy)
     assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
     assert summary.get("blocked_moves") == expected.get("blocked_moves")
+
+
+@pytest.mark.parametrize("lossless", [False, True])
+def test_the_runs_own_puts_wait_for_a_slow_reader_where_zenohs_default_drops_them(lossless):
+    """Sixty 400 KB messages (an animat's memory or map is this big) to a reader that takes 10 ms
+    each: zenoh's default drops most of them once the link's queue is full; LOSSLESS loses none."""
+    import threading
+
+    import zenoh
+
+    endpoint = free_endpoint()
+    router, client = open_router(endpoint), open_client(endpoint)
+    try:
+        inbox = router.declare_subscriber("slow/reader", zenoh.handlers.FifoChannel(4))
+        time.sleep(0.5)  # the subscription reaches the client
+        publisher = client.declare_publisher("slow/reader", **({"congestion_control": LOSSLESS} if lossless else {}))
+        got = []
+
+        def read():
+            while (data := inbox.recv().payload.to_bytes()) != b"end":
+                got.append(int.from_bytes(data[:4], "little"))
+                time.sleep(0.01)
+
+        reader = threading.Thread(target=read, daemon=True)
+        reader.start()
+        for i in range(60):
+            publisher.put(i.to_bytes(4, "little") + bytes(400_000))
+        client.put("slow/reader", b"end", congestion_control=LOSSLESS)
+        reader.join(30)
+        assert not reader.is_alive()
+        assert (got == list(range(60))) if lossless else (len(got) < 50), len(got)
+    finally:
+        client.close()
+        router.close()
 
 
 def test_bad_traffic_is_counted_and_changes_nothing():
@@ -129,6 +163,33 @@ def test_a_flood_is_counted_by_reason_and_changes_nothing():
     assert sum(n for r, n in reasons.items() if r.startswith("mark: ")) == stream  # every one, counted
     assert reasons.get("mark: over budget", 0) > stream // 2 and reasons.get("act: over budget", 0) > 0
     assert not any(ch.isdigit() for reason in reasons for ch in reason)  # reasons are a fixed few, no counts
+
+
+def test_a_client_declaring_liveliness_tokens_by_the_hundred_spends_its_own_budget():
+    """Tokens on agents' liveliness keys nobody joined for, declared before and while agents join: the
+    world lets in a stranger's share of them, counts the rest, and the joining agents' tokens still come
+    in, so the run ends as in process."""
+    ticks = 300
+    scenario = load_scenario("setup1").with_overrides(agents=2, seed=5)
+    engine = Engine(scenario)
+    engine.step(ticks)
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "tokens", endpoint, deadline=10.0, max_iterations=ticks).start()
+    intruder, procs = open_client(endpoint), []
+    try:
+        keys = wire.Keys("tokens")
+        tokens = [intruder.liveliness().declare_token(keys.alive(a)) for a in range(2, 400)]
+        procs = start_agents(endpoint, "tokens", scenario.controller, 1, count=2)
+        tokens += [intruder.liveliness().declare_token(keys.alive(a)) for a in range(400, 800)]
+        summary = world.join(timeout=120)
+        assert procs[0].wait(timeout=30) == 0 and len(tokens) == 798
+    finally:
+        intruder.close()
+        stop(procs)
+        world.close()
+    np.testing.assert_array_equal(world.server.world.pos, engine.world.pos)
+    assert summary["iterations"] == ticks and summary["missed_ticks"] == 0 and summary["agent_steps"] == 2 * ticks
+    assert summary["rejected_by_reason"].get("alive: over budget", 0) > 500, summary["rejected_by_reason"]
 
 
 def test_the_marks_key_space_can_be_read_by_any_client():

@@ -15,7 +15,9 @@ access rules (swarm/core/acl.py) keep it off the key.
 
 The budgets are several times what agents send (one action per process and tick, a plan and a record
 per agent and tick, a join per agent), so a run that is not flooded never meets them and stays exactly
-as it was.  Queries cost the world a reply (a summary, the marks), so their budgets are small.
+as it was.  Queries cost the world a reply (a summary, the marks), so their budgets are small.  Liveliness
+tokens (`let_alive`) have a budget of their own, split as joins are: the tokens the world waits for, and
+the rest.
 
 Every message of a flood holds the world's interpreter lock for as long as its callback runs, and the
 world's thread waits for that lock: a sender whose buckets are empty until the next tick (or the next
@@ -36,6 +38,7 @@ from swarm.core import wire
 NOW, OTHER = "now", "other"
 PUTS = ("act", "plan", "record", "mark")  # subscribed key spaces: the sender is the key's last part
 QUERIES = ("join", "info", "marks query", "shared query")  # queryables: every querier is a stranger
+ALIVE = "alive"  # liveliness tokens appearing and going: any client may declare one on any agent's key
 LAG = {"plan": 1, "record": 1}  # a plan comes after its action: the world may be a tick on by then
 JOIN_HEAD = b"\xa4type\xa4join"  # what a join request holds in its first bytes (swarm.core.wire.join_request)
 
@@ -66,6 +69,7 @@ def allowances(agents: int) -> dict[tuple[str, str], Allowance]:
         ("plan", NOW): per_agent, ("plan", OTHER): few, ("record", NOW): per_agent, ("record", OTHER): few,
         ("join", NOW): Allowance(2 * agents + 64, per_second=50),
         ("info", OTHER): Allowance(2 * agents + 16, per_second=agents + 5),
+        (ALIVE, NOW): Allowance(2 * agents + 64, per_second=50), (ALIVE, OTHER): STRANGERS,
     }  # fmt: skip
 
 
@@ -141,6 +145,7 @@ class Gate:
         self._strangers = {space: self._bucket(space, STRANGERS) for space in PUTS}
         self._asking = {(s, kind): self._bucket(s, self.budgets.get((s, kind), ASKING)) for s in QUERIES
                         for kind in (NOW, OTHER)}  # fmt: skip
+        self._alive = {kind: self._bucket(ALIVE, self.budgets.get((ALIVE, kind), STRANGERS)) for kind in (NOW, OTHER)}
         self._senders: dict[str, tuple[Bucket, Bucket, int]] = {}  # a member's key -> its (now, other) buckets, lag
 
     def _bucket(self, space: str, allowance: Allowance) -> Bucket:
@@ -178,6 +183,16 @@ class Gate:
             return None
         return (raw, sender) if self._spend(bucket) else None
 
+    def let_alive(self, awaited: bool) -> bool:
+        """May a liveliness change go to the world's thread?  One the world waits for (the token of an
+        agent joining, the end of one in the run) draws on another bucket than the rest, so a client
+        that declares tokens by the thousand spends its own budget, never a joining agent's."""
+        bucket = self._alive[NOW if awaited else OTHER]
+        if bucket.closed(self.window[1], self.clock):
+            bucket.drop()
+            return False
+        return self._spend(bucket)
+
     def let_in(self, space: str, query) -> bool:
         """Has a query budget left?  One that has not is dropped unanswered (counted)."""
         kind = OTHER
@@ -204,7 +219,8 @@ class Gate:
         self._seen = total
         dropped: dict[str, int] = {}
         senders = list(self._senders.values())  # in one step: zenoh's threads may add to it meanwhile
-        for bucket in [*self._strangers.values(), *self._asking.values(), *(b for s in senders for b in s[:2])]:
+        buckets = [*self._strangers.values(), *self._asking.values(), *self._alive.values()]
+        for bucket in [*buckets, *(b for s in senders for b in s[:2])]:
             if n := bucket.take_dropped():
                 dropped[bucket.reason] = dropped.get(bucket.reason, 0) + n
         return dropped

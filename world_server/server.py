@@ -29,7 +29,7 @@ import numpy as np
 import zenoh
 
 from swarm.core import wire
-from swarm.core.bus import open_client, open_router
+from swarm.core.bus import LOSSLESS, open_client, open_router
 from swarm.core.credentials import Identity
 from swarm.core.errors import ScenarioError
 from world_server.gate import Gate, allowances
@@ -216,7 +216,7 @@ class WorldServer:
             self.session.declare_queryable(k.join, self.on_query("join", "join", put)),
             self.session.declare_queryable(k.info, self.on_query("info", "info", put)),
             # history: tokens declared before this subscriber (agents back before a restarted world) count too
-            self.session.liveliness().declare_subscriber(k.alive_all, lambda s: put(("alive", s)), history=True),
+            self.session.liveliness().declare_subscriber(k.alive_all, self._on_liveliness(put), history=True),
             *self.kind.declare(put),
         ]
         self._state_publisher = self.session.declare_publisher(k.state)
@@ -232,6 +232,23 @@ class WorldServer:
         def callback(sample) -> None:
             if (got := take(space, sample)) is not None:
                 put((event, got))
+
+        return callback
+
+    def _on_liveliness(self, put: Callable[[tuple[str, Any]], None]) -> Callable[[Any], None]:
+        """The liveliness subscriber's callback: a token the world waits for (a joining agent's
+        appearing, a member's going) and, within their own budget, the others go to the world's thread."""
+        let_alive, slots = self.gate.let_alive, self.slots
+
+        def callback(sample) -> None:
+            agent = self._sender(sample)
+            awaited = (
+                agent is not None
+                and 0 <= agent < len(slots)
+                and (slots[agent] == JOINING or (sample.kind == zenoh.SampleKind.DELETE and slots[agent] == ACTIVE))
+            )
+            if let_alive(awaited):
+                put(("alive", sample))
 
         return callback
 
@@ -523,8 +540,16 @@ class WorldServer:
 
     def publisher(self, group: str):
         if (pub := self._publishers.get(group)) is None:
-            pub = self._publishers[group] = self.session.declare_publisher(self.keys.obs(group))
+            # lock-step: every observation arrives; real time: an observation the link has no room for
+            # is dropped, as the next supersedes it and a slow agent must not hold the world's tick
+            lossless = {"congestion_control": LOSSLESS} if self.mode == "lockstep" else {}
+            pub = self._publishers[group] = self.session.declare_publisher(self.keys.obs(group), **lossless)
         return pub
+
+    def hand_back(self, group: str, payload: bytes) -> None:
+        """Controllers' saved memory to an agent process, on its observation key so that it arrives
+        before the next observation, and never dropped (real time's observations may be)."""
+        self.session.put(self.keys.obs(group), payload, congestion_control=LOSSLESS)
 
     def run(self) -> dict:
         if not (self.resumed and self.kind.done()):  # a finished run resumed has nothing left to do

@@ -24,6 +24,13 @@ from swarm.core.credentials import Identity
 
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 
+# zenoh drops a put (by default) when the link's queue has no room within 1 ms, or 50 ms for a message
+# in fragments, and the queue holds two 64 KB batches: a machine busy elsewhere loses an animat's map or
+# memory that way.  A lock-step tick that loses an observation or an answer waits out its deadline and
+# moves robots differently, so the run's own messages wait for room instead; a peer that stops reading
+# for `congestion_control/block/wait_before_close` (5 s) is cut off, and the world counts it lost.
+LOSSLESS = zenoh.CongestionControl.BLOCK
+
 
 def config(mode: str, listen: list[str] | None = None, connect: list[str] | None = None,
            identity: Identity | None = None) -> zenoh.Config:  # fmt: skip

@@ -186,7 +186,7 @@ class ArenaKind:
         for group, agents in s.grouped(np.flatnonzero(s.slots == ACTIVE)).items():
             memory = [(a, self.memory[a]) for a in agents.tolist() if self.memory[a] is not None]
             if memory:
-                s.publisher(group).put(arena_proto.memory_message(memory))
+                s.hand_back(group, arena_proto.memory_message(memory))
 
     def remove(self, agent: int) -> None:
         self.world.remove_agent(agent)

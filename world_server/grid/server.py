@@ -126,7 +126,7 @@ class GridKind:
             return
         s = self.server
         for group, agents in s.grouped(np.flatnonzero(s.slots == ACTIVE)).items():
-            s.publisher(group).put(proto.memory_message(agents, self.memory[agents]))
+            s.hand_back(group, proto.memory_message(agents, self.memory[agents]))
 
     def remove(self, agent: int) -> None:
         self.world.drop_load(agent)
