@@ -37,7 +37,7 @@ from tests.docker_engine import (
 )
 from tests.docker_swarm import Nodes, docker, two_node_swarm, why_no_second_node
 
-pytestmark = [pytest.mark.timeout(900), pytest.mark.xdist_group("compose")]  # the module's fixtures: one worker
+pytestmark = pytest.mark.timeout(900)
 
 reason = why_no_engine()
 if reason is not None:
@@ -133,6 +133,43 @@ def test_compose_runs_an_arena_with_the_carrot_controller(compose):
         assert "zmaze: carrot x2, seed 1, noise low: finished" in log and "reached 2/2" in log, log
     finally:
         compose.env["CONTROLLER"] = "cmarking"
+        for recording in (ROOT / "runs").glob(f"{run_id}-*.rrd"):
+            recording.unlink()
+
+
+def test_compose_runs_a_users_controller_package_from_an_image_built_from_ours(compose, tmp_path):
+    """docs/controllers.md, In containers: an image FROM swarm:local with the flocking example package
+    installed (from its wheel, built on the host: containers here reach no package index) runs the
+    package's controller, by its entry point's name, in the world and in every agent container."""
+    import shutil
+
+    wheels, context = tmp_path / "wheels", tmp_path / "context"
+    package = ROOT / "examples" / "flocking"
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "--no-index",
+                    "-w", str(wheels), str(package)], check=True, capture_output=True, timeout=300)  # fmt: skip
+    (wheel,) = wheels.glob("*.whl")
+    context.mkdir()
+    for file in (wheel, package / "flock.toml"):
+        shutil.copy(file, context / file.name)
+    install = f"pip install --no-cache-dir --no-index --no-deps /src/{wheel.name}"
+    (context / "Dockerfile").write_text(f"FROM swarm:local\nCOPY {wheel.name} flock.toml /src/\nRUN {install}\n")
+    image, run_id = f"swarm-flocking-{uuid.uuid4().hex[:6]}:local", f"flock{uuid.uuid4().hex[:6]}"
+    built = subprocess.run(["docker", "build", "-t", image, str(context)], capture_output=True, text=True, timeout=600)
+    assert built.returncode == 0, built.stderr[-3000:]
+    saved = dict(compose.env)
+    compose.env.update(IMAGE=image, RUN_ID=run_id, SCENARIO="/src/flock.toml", CONTROLLER="flocking", SEED="2",
+                       AGENTS="2", MAX_AGENTS="2")  # fmt: skip
+    try:
+        up = compose("up", "--scale", "agent=2", "swarm", timeout=600, check=False)
+        log = compose("logs", "--no-color", "swarm").stdout
+        assert up.returncode == 0 and compose.exit_code("swarm") == 0, up.stdout[-3000:] + up.stderr[-3000:] + log
+        assert "flock: flocking x2, seed 2, noise low: finished after 1500 ticks" in log, log
+        assert "agents joined 2" in log and "lost 0" in log, log
+    finally:
+        compose("down", "--remove-orphans", "--timeout", "5", check=False, timeout=300)
+        compose.env.clear()
+        compose.env.update(saved)
+        subprocess.run(["docker", "rmi", "-f", image], capture_output=True, timeout=300)
         for recording in (ROOT / "runs").glob(f"{run_id}-*.rrd"):
             recording.unlink()
 

@@ -22,8 +22,6 @@ from swarm.cli import main
 from swarm.experiments.executors import LocalExecutor, RayExecutor, use
 from swarm.experiments.runner import JobFailed, batch_run
 
-pytestmark = pytest.mark.xdist_group("ray")  # the module's fixtures: one worker
-
 ROOT = Path(__file__).resolve().parents[1]
 RAY = Path(sys.executable).with_name("ray")
 SWEEP = """scenarios = ["zmaze"]

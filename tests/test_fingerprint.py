@@ -31,8 +31,6 @@ from agents.controllers.navigation.topomap import Link, TopoMap
 from swarm.core.errors import ScenarioError
 from swarm.scenario import load_scenario
 
-pytestmark = pytest.mark.xdist_group("fingerprint")  # the tours its tests share (cached): one worker
-
 
 def run_cli(*args):
     return subprocess.run([sys.executable, "-m", "swarm", *args], capture_output=True, text=True, timeout=600)

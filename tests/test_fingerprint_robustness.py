@@ -18,8 +18,6 @@ from swarm.experiments.tapus2006.robustness import (
     short_routes,
 )
 
-pytestmark = pytest.mark.xdist_group("fingerprint_robustness")  # the module's fixtures: one worker
-
 WAYPOINTS = 8  # the mapping tour's first stretch, driven twice: seconds, not minutes
 
 

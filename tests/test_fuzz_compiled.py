@@ -19,8 +19,6 @@ from world_server.grid.accept import REFUSALS, accept_message, accept_rows
 from world_server.grid.face import wire as grid
 from world_server.grid.face.layout import ACT_LEN, MEM_LEN, PERC_F_LEN, controller_kind, controller_params, new_memory
 
-pytestmark = pytest.mark.xdist_group("fuzz_compiled")  # the module's fixtures: one worker
-
 AGENTS = 4
 ACTIVE = 2
 ticks = st.sampled_from([0, 1, 127, 128, 65_536, 2**33, wire.INT64_MAX])

@@ -22,8 +22,6 @@ from tests.fuzz import FUZZ, guarded, mutate_tree
 from world_server.arena.scenario import ArenaScenario
 from world_server.grid.scenario import Scenario
 
-pytestmark = pytest.mark.xdist_group("fuzz_scenario")  # the module's fixtures: one worker
-
 FILES = sorted(BUNDLED_DIR.glob("*.toml"))
 TEXTS = {path: path.read_text(encoding="utf-8") for path in FILES}
 ODD_VALUES = ["-1", "0", "1", "1e309", "-1e309", "nan", "inf", "9223372036854775807", "-9223372036854775808",

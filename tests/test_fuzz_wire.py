@@ -18,8 +18,6 @@ from world_server.arena.face import wire as arena
 from world_server.grid.face import wire as grid
 from world_server.grid.face.layout import ACT_LEN, MEM_LEN, PERC_F_LEN
 
-pytestmark = pytest.mark.xdist_group("fuzz_wire")  # the module's fixtures: one worker
-
 REASONS = reason_patterns("swarm/core/wire.py", "swarm/core/memory_codec.py", "world_server/grid/face/wire.py",
                           "world_server/arena/face/wire.py")  # fmt: skip
 NONCE = "0123456789abcdef"

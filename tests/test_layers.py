@@ -22,8 +22,6 @@ from pathlib import Path
 import grimp
 import pytest
 
-pytestmark = pytest.mark.xdist_group("layers")  # the module's fixtures: one worker
-
 PACKAGES = ("swarm", "agents", "world_server")
 LAYERS = {  # module prefix -> layer (the longest prefix wins)
     "swarm": 0,

@@ -15,8 +15,6 @@ import pytest
 
 from swarm.scenario import BUNDLED_DIR, scenario_schema
 
-pytestmark = pytest.mark.xdist_group("schema")  # the module's fixtures: one worker
-
 ROOT = Path(__file__).parents[1]
 SCENARIOS = [*sorted(BUNDLED_DIR.glob("*.toml")), ROOT / "examples" / "flocking" / "flock.toml"]
 

@@ -26,8 +26,6 @@ from swarm.scenario import load_scenario
 from tests.distributed import ServerThread, free_endpoint, start_agents, stop
 from world_server.grid.face import wire as proto
 
-pytestmark = pytest.mark.xdist_group("secure")  # the module's fixtures: one worker
-
 KEYS = Keys("sec")
 
 

@@ -19,8 +19,6 @@ from swarm.scenario import load_scenario, parse_scenario_data, parse_scenario_te
 from swarm.sweeps import run_sweep
 from swarm.sweeps.jobs import assign
 
-pytestmark = pytest.mark.xdist_group("sweep")  # the module's fixtures: one worker
-
 METRICS = ["reached", "collisions", "mean_path_ratio", "distance"]
 TINY = {"scenarios": ["zmaze"], "controller": "wander", "seeds": [1, 2], "max_ticks": 50, "metrics": METRICS,
         "grid": {"wander.speed": [0.4, 0.8]}}  # fmt: skip
