@@ -145,8 +145,9 @@ def test_compose_runs_a_users_controller_package_from_an_image_built_from_ours(c
 
     wheels, context = tmp_path / "wheels", tmp_path / "context"
     package = ROOT / "examples" / "flocking"
-    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "--no-index",
-                    "-w", str(wheels), str(package)], check=True, capture_output=True, timeout=300)  # fmt: skip
+    wheel = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-w", str(wheels), str(package)],
+                           capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert wheel.returncode == 0, wheel.stdout[-2000:] + wheel.stderr[-2000:]
     (wheel,) = wheels.glob("*.whl")
     context.mkdir()
     for file in (wheel, package / "flock.toml"):
