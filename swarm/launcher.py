@@ -30,7 +30,7 @@ import time
 from pathlib import Path
 
 from agents.controllers import aot
-from swarm.core import wire
+from swarm.core import mesh, wire
 from swarm.core.bus import open_client
 from swarm.core.credentials import MONITOR, ROUTER, Identity, agent_name, identity_in
 from swarm.core.credentials import make as make_credentials
@@ -166,7 +166,7 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
         folder = None
         if credentials is not None:
             folder = Path(credentials) if credentials else make_credentials(Path(tmp) / "credentials", len(agent_cmds),
-                                                                            hosts=(_host_of(listen),))  # fmt: skip
+                                                                            hosts=(_router_host(listen),))  # fmt: skip
             world_cmd, agent_cmds = _secured(folder, world_cmd, agent_cmds)
         children = _Children(Path(tmp), run_id)
         session = None
@@ -409,9 +409,12 @@ def _secured(folder: Path, world_cmd: list[str], agent_cmds: list[list[str]]):
     return world_cmd, agent_cmds
 
 
-def _host_of(endpoint: str) -> str:
-    """The host of `proto/host:port` ([v6] unbracketed): the name the router's certificate must carry."""
-    return endpoint.split("/", 1)[-1].rsplit(":", 1)[0].strip("[]")
+def _router_host(listen: str) -> str:
+    """The name the router's certificate must carry: the host of --listen."""
+    try:
+        return mesh.split(listen)[1]
+    except ValueError as exc:
+        raise RunError(f"--listen {exc}") from None
 
 
 def _connect(listen: str, world: subprocess.Popen, identity: Identity | None = None, timeout: float = 300.0):

@@ -172,3 +172,13 @@ def test_credentials_are_private_and_a_bad_folder_is_one_line(creds, tmp_path):
     assert bad.returncode == 2
     assert bad.stderr.strip().splitlines() == [f"swarm: error: {tmp_path}: not a credentials folder "
                                                "(no readable identity.json)"]  # fmt: skip
+
+
+def test_swarm_up_secure_with_an_endpoint_it_cannot_read_is_one_line(tmp_path):
+    """The router's certificate names the host of --listen: one that names none stops before anything starts."""
+    command = [sys.executable, "-m", "swarm", "up", "setup2", "--agents", "2", "--secure", "--listen", "garbage"]
+    up = subprocess.run(command, capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert up.returncode == 2
+    assert up.stderr.strip().splitlines() == [
+        "swarm: error: --listen 'garbage': expected PROTOCOL/NAME:PORT, e.g. tcp/router:7447"
+    ]
