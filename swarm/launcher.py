@@ -22,6 +22,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -147,6 +148,7 @@ def _agent_counts(scenario_ref: str, agents: int, controller: str | None) -> lis
 def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, progress, per_process, null,
               agent_args, losses: _Losses, credentials: str | None) -> dict:  # fmt: skip
     """`credentials`: None for a plain run, "" to make them, else the folder that holds them."""
+    router_host = _router_host(listen) if credentials == "" else None  # a bad --listen: one line, before compiling
     prepare(scenario_ref, progress)
     python = [sys.executable, "-m", "swarm"]
     with tempfile.TemporaryDirectory(prefix="swarm-up-") as tmp:
@@ -166,7 +168,7 @@ def _swarm_up(scenario_ref, agents, controller, run_id, listen, world_options, p
         folder = None
         if credentials is not None:
             folder = Path(credentials) if credentials else make_credentials(Path(tmp) / "credentials", len(agent_cmds),
-                                                                            hosts=(_router_host(listen),))  # fmt: skip
+                                                                            hosts=(router_host,))  # fmt: skip
             world_cmd, agent_cmds = _secured(folder, world_cmd, agent_cmds)
         children = _Children(Path(tmp), run_id)
         session = None
@@ -410,9 +412,9 @@ def _secured(folder: Path, world_cmd: list[str], agent_cmds: list[list[str]]):
 
 
 def _router_host(listen: str) -> str:
-    """The name the router's certificate must carry: the host of --listen."""
+    """The name the router's certificate must carry: the host of --listen (less zenoh's ?metadata and #config)."""
     try:
-        return mesh.split(listen)[1]
+        return mesh.split(re.split(r"[?#]", listen, maxsplit=1)[0])[1]
     except ValueError as exc:
         raise RunError(f"--listen {exc}") from None
 

@@ -145,9 +145,9 @@ def test_compose_runs_a_users_controller_package_from_an_image_built_from_ours(c
 
     wheels, context = tmp_path / "wheels", tmp_path / "context"
     package = ROOT / "examples" / "flocking"
-    wheel = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-w", str(wheels), str(package)],
+    built = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-w", str(wheels), str(package)],
                            capture_output=True, text=True, timeout=300)  # fmt: skip
-    assert wheel.returncode == 0, wheel.stdout[-2000:] + wheel.stderr[-2000:]
+    assert built.returncode == 0, built.stdout[-2000:] + built.stderr[-2000:]
     (wheel,) = wheels.glob("*.whl")
     context.mkdir()
     for file in (wheel, package / "flock.toml"):

@@ -186,7 +186,7 @@ class Gate:
     def let_alive(self, awaited: bool) -> bool:
         """May a liveliness change go to the world's thread?  One the world waits for (the token of an
         agent joining, the end of one in the run) draws on another bucket than the rest, so a client
-        that declares tokens by the thousand spends its own budget, never a joining agent's."""
+        that declares tokens by the thousand on keys the world awaits nothing on spends only its own budget."""
         bucket = self._alive[NOW if awaited else OTHER]
         if bucket.closed(self.window[1], self.clock):
             bucket.drop()

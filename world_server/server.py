@@ -614,7 +614,7 @@ class WorldServer:
 
     def stop_agents(self, reason: str) -> None:
         for group in set(self.group_of.values()):
-            self.session.put(self.keys.obs(group), wire.stop_message(reason))
+            self.session.put(self.keys.obs(group), wire.stop_message(reason), congestion_control=LOSSLESS)
 
     def close(self) -> None:
         if self.recorder is not None:  # an interrupted run still ends its recording

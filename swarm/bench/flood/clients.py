@@ -19,6 +19,7 @@ import os
 import time
 
 import numpy as np
+import zenoh
 
 from swarm.core import wire
 from swarm.core.bus import open_client
@@ -91,24 +92,26 @@ def _garbage(session, keys: wire.Keys, garbage: list[bytes], pace: _Pace, ready)
 
 
 class _Heard:
-    """What the flooding client hears of the agent processes, on zenoh's thread: the tick of each one's
-    newest observation, and its answer to it."""
+    """What the flooding client hears of the agent processes: the tick of each one's newest observation,
+    and its answer to it.  Read by the flooding loop (`poll`) from ring channels, which drop old samples
+    when it falls behind: a subscriber that stops reading would hold a lock-step world's tick, whose
+    messages wait for room on their links (swarm.core.bus.LOSSLESS)."""
 
     def __init__(self, session, keys: wire.Keys):
         self.tick: dict[str, int] = {}
         self.answer: dict[str, bytes] = {}
-        self._decls = [session.declare_subscriber(keys.obs("*"), self._on_obs),
-                       session.declare_subscriber(keys.act("*"), self._on_act)]  # fmt: skip
+        self._obs = session.declare_subscriber(keys.obs("*"), zenoh.handlers.RingChannel(64))
+        self._act = session.declare_subscriber(keys.act("*"), zenoh.handlers.RingChannel(64))
 
-    def _on_obs(self, sample) -> None:
-        if (tick := wire.peek_tick(sample.payload.to_bytes())) is not None:
-            self.tick[str(sample.key_expr).rsplit("/", 1)[1]] = tick
-
-    def _on_act(self, sample) -> None:
-        group = str(sample.key_expr).rsplit("/", 1)[1]
-        raw = sample.payload.to_bytes()
-        if group in self.tick and wire.peek_tick(raw) == self.tick[group]:  # its answer (or a copy of it)
-            self.answer[group] = raw
+    def poll(self) -> None:
+        """Take what came since the last poll: observations first, then the answers to them."""
+        while (sample := self._obs.try_recv()) is not None:
+            if (tick := wire.peek_tick(sample.payload.to_bytes())) is not None:
+                self.tick[str(sample.key_expr).rsplit("/", 1)[1]] = tick
+        while (sample := self._act.try_recv()) is not None:
+            group, raw = str(sample.key_expr).rsplit("/", 1)[1], sample.payload.to_bytes()
+            if group in self.tick and wire.peek_tick(raw) == self.tick[group]:  # its answer (or a copy of it)
+                self.answer[group] = raw
 
 
 def _forgeries(family: str, tick: int, garbage: bytes) -> list[bytes]:
@@ -125,20 +128,22 @@ def _forgeries(family: str, tick: int, garbage: bytes) -> list[bytes]:
     return [past, never, past[: len(past) // 2] + garbage]
 
 
-def _on_their_keys(session, keys: wire.Keys, pace: _Pace, heard: dict, messages) -> None:
+def _on_their_keys(session, keys: wire.Keys, pace: _Pace, heard: _Heard, what: str, messages) -> None:
     """Put `messages(value, k)` on each agent process's action key in turn, for each `group: value` of
-    `heard` (what was heard of it so far)."""
+    `heard.<what>` (what was heard of it so far)."""
     pubs: dict[str, object] = {}
     k = 0
     while True:
-        for group, value in list(heard.items()):
+        heard.poll()
+        values = getattr(heard, what)
+        for group, value in list(values.items()):
             pub = pubs.get(group) or pubs.setdefault(group, session.declare_publisher(keys.act(group)))
             for _ in range(BATCH):
                 pub.put(messages(value, k))
                 k += 1
             if not pace.sent(BATCH):
                 return
-        if not heard and pace.stop.wait(0.05):
+        if not values and pace.stop.wait(0.05):
             return
 
 
@@ -153,7 +158,7 @@ def _forged(session, keys: wire.Keys, family: str, garbage: list[bytes], pace: _
 
     heard = _Heard(session, keys)
     ready.release()
-    _on_their_keys(session, keys, pace, heard.tick, forged)
+    _on_their_keys(session, keys, pace, heard, "tick", forged)
 
 
 def _own(session, keys: wire.Keys, garbage: list[bytes], pace: _Pace, ready) -> None:
@@ -162,7 +167,7 @@ def _own(session, keys: wire.Keys, garbage: list[bytes], pace: _Pace, ready) -> 
 
     heard = _Heard(session, keys)
     ready.release()
-    _on_their_keys(session, keys, pace, heard.answer, again)
+    _on_their_keys(session, keys, pace, heard, "answer", again)
 
 
 class Floods:
