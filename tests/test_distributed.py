@@ -40,11 +40,11 @@ def test_lockstep_equals_the_in_process_engine(ref, controller, agents, seed, ph
     assert summary.get("blocked_moves") == expected.get("blocked_moves")
 
 
-@pytest.mark.parametrize("lossless", [False, True])
-def test_the_runs_own_puts_wait_for_a_slow_reader_where_zenohs_default_drops_them(lossless):
-    """Sixty 1 MB messages (an animat's memory and maps come to this) to a reader that takes 10 ms each:
-    more than the link's queue and the sockets' buffers hold, so zenoh's default drops some of them once
-    the queue is full; LOSSLESS loses none."""
+def test_the_runs_own_puts_wait_for_a_slow_reader():
+    """Sixty 1 MB messages (an animat's memory and maps come to this) to a reader that takes 10 ms each,
+    more than the link's queue and the sockets' buffers hold: LOSSLESS loses none.  (zenoh's default
+    drops a put once the queue stays full: 22 of 60 of these arrived on an idle machine, and all 60 when
+    a busy one slowed the writer too, so how many it drops is no test.)"""
     import threading
 
     import zenoh
@@ -53,7 +53,7 @@ def test_the_runs_own_puts_wait_for_a_slow_reader_where_zenohs_default_drops_the
     router, client = open_router(endpoint), open_client(endpoint)
     try:
         inbox = router.declare_subscriber("slow/reader", zenoh.handlers.FifoChannel(4))
-        publisher = client.declare_publisher("slow/reader", **({"congestion_control": LOSSLESS} if lossless else {}))
+        publisher = client.declare_publisher("slow/reader", congestion_control=LOSSLESS)
         deadline = time.monotonic() + 10
         while not publisher.matching_status.matching:  # the subscription has reached the client
             assert time.monotonic() < deadline
@@ -72,7 +72,7 @@ def test_the_runs_own_puts_wait_for_a_slow_reader_where_zenohs_default_drops_the
         client.put("slow/reader", b"end", congestion_control=LOSSLESS)
         reader.join(30)
         assert not reader.is_alive()
-        assert (got == list(range(60))) if lossless else (len(got) < 60), len(got)
+        assert got == list(range(60)), len(got)
     finally:
         client.close()
         router.close()
