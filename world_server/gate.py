@@ -166,11 +166,7 @@ class Gate:
             if sender in self.members:
                 mine = self._member(key, space)
             else:  # a stranger's put is not even copied unless let in
-                bucket = self._strangers[space]
-                if bucket.closed(tick, clock):
-                    bucket.drop()
-                    return None
-                return (sample.payload.to_bytes(), sender) if self._spend(bucket) else None
+                return (sample.payload.to_bytes(), sender) if self._admit(self._strangers[space]) else None
         now, other, lag = mine
         if other.closed(tick, clock) and now.closed(tick, clock):  # the usual flood, once the answer is in
             other.drop()
@@ -178,33 +174,30 @@ class Gate:
         raw = sample.payload.to_bytes()
         said, (first, last) = wire.peek_tick(raw), self.window
         bucket = now if said is not None and first - lag <= said <= last else other
-        if bucket.closed(tick, clock):
-            bucket.drop()
-            return None
-        return (raw, sender) if self._spend(bucket) else None
+        return (raw, sender) if self._admit(bucket) else None
 
     def let_alive(self, awaited: bool) -> bool:
         """May a liveliness change go to the world's thread?  One the world waits for (the token of an
         agent joining, the end of one in the run) draws on another bucket than the rest, so a client
         that declares tokens by the thousand on keys the world awaits nothing on spends only its own budget."""
-        bucket = self._alive[NOW if awaited else OTHER]
-        if bucket.closed(self.window[1], self.clock):
-            bucket.drop()
-            return False
-        return self._spend(bucket)
+        return self._admit(self._alive[NOW if awaited else OTHER])
 
     def let_in(self, space: str, query) -> bool:
         """Has a query budget left?  One that has not is dropped unanswered (counted)."""
         kind = OTHER
         if space == "join" and (payload := query.payload) is not None and len(payload) <= 1024:
             kind = NOW if JOIN_HEAD in payload.to_bytes()[:24] else OTHER
-        bucket = self._asking[space, kind]
-        if bucket.closed(self.window[1], self.clock):
-            bucket.drop()
-        elif self._spend(bucket):
+        if self._admit(self._asking[space, kind]):
             return True
         query.drop()
         return False
+
+    def _admit(self, bucket: Bucket) -> bool:
+        """Take a token from `bucket`: a closed one drops the message without the lock (counted)."""
+        if bucket.closed(self.window[1], self.clock):
+            bucket.drop()
+            return False
+        return self._spend(bucket)
 
     def _spend(self, bucket: Bucket) -> bool:
         with self._lock:

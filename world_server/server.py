@@ -241,14 +241,12 @@ class WorldServer:
         let_alive, slots = self.gate.let_alive, self.slots
 
         def callback(sample) -> None:
-            agent = self._sender(sample)
-            awaited = (
-                agent is not None
-                and 0 <= agent < len(slots)
-                and (slots[agent] == JOINING or (sample.kind == zenoh.SampleKind.DELETE and slots[agent] == ACTIVE))
-            )
+            agent, gone = self._sender(sample), sample.kind == zenoh.SampleKind.DELETE
+            if agent is not None and not 0 <= agent < len(slots):
+                agent = None
+            awaited = agent is not None and (slots[agent] == JOINING or (gone and slots[agent] == ACTIVE))
             if let_alive(awaited):
-                put(("alive", sample))
+                put(("alive", (agent, gone)))
 
         return callback
 
@@ -372,14 +370,15 @@ class WorldServer:
         self.group_of[agent] = group
         self.group_ids[agent] = self.group_index.setdefault(group, len(self.group_index))
 
-    def _on_alive(self, sample) -> None:
-        agent = self._sender(sample)
-        if agent is None or not 0 <= agent < len(self.slots):
+    def _on_alive(self, item: tuple[int | None, bool]) -> None:
+        """(agent, gone) of a liveliness change the gate let in (`_on_liveliness`); None: not a slot's key."""
+        agent, gone = item
+        if agent is None:
             return
-        if sample.kind == zenoh.SampleKind.PUT and self.slots[agent] == JOINING:
+        if not gone and self.slots[agent] == JOINING:
             self.slots[agent] = ACTIVE
             self.returning[agent] = False
-        elif sample.kind == zenoh.SampleKind.DELETE and self.slots[agent] in (JOINING, ACTIVE):
+        elif gone and self.slots[agent] in (JOINING, ACTIVE):
             self._lose(agent)
 
     def _lose(self, agent: int) -> None:
