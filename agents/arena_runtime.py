@@ -96,16 +96,18 @@ class ArenaAgentRuntime(AgentRuntime):
         self.kept = keep = obs.keep and not self.null
         # the memory's arrays are written once, straight into the message (the save-tick peak)
         memory = [(a, memory_codec.pieces(self.guard.memory(b, a))) for b, a in mine] if keep else []
-        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory, rab)
-        if self.recorded and not self.null:  # before the action: the world has them when it ends the tick
-            self._send_records(obs.tick, brains, ids)
+        # the records go before the action, which names them: the world awaits those at the run's end
+        records = self._send_records(obs.tick, brains, ids) if self.recorded and not self.null else []
+        payload = arena_proto.actions(obs.tick, agents, np.array(wheels).reshape(-1, 3), shared, memory, rab, records)
         self.act_publisher.put(payload)
         if not self.null:
             self._send_plans(obs.tick, agents)
         return len(agents)
 
-    def _send_records(self, tick: int, brains: list, ids: list[int]) -> None:
-        """The record() of each controller the world records by shape (swarm.recording.records)."""
+    def _send_records(self, tick: int, brains: list, ids: list[int]) -> list[int]:
+        """The record() of each controller the world records by shape (swarm.recording.records): the
+        agents whose record went out (a tick without a number to show sends none)."""
+        sent = []
         for brain, agent in zip(brains, ids, strict=True):
             if agent not in self.recorded or agent in self.quiet:
                 continue
@@ -120,6 +122,8 @@ class ArenaAgentRuntime(AgentRuntime):
                 print(f"swarm: the recording leaves out robot {agent}'s record(): {why}", file=sys.stderr, flush=True)
                 continue
             self.session.put(self.keys.record(self.group), message, congestion_control=LOSSLESS)
+            sent.append(agent)
+        return sent
 
     def _send_plans(self, tick: int, agents: list[int]) -> None:
         """A controller's new plan goes to the world once, for the recording."""

@@ -23,3 +23,11 @@ def test_the_table_gives_the_20_percent_budget_as_a_quarter_of_the_plain_run():
     text = format_recording_bench({"runs": [row]})
     assert "    160    12.0     1.0    13.0     1.0         3.0             0.9" in text
     assert "20%" in text
+
+
+def test_a_robots_record_message_carries_its_image_every_tenth_tick():
+    from swarm.bench.recording.measure import record_bytes
+
+    scalar, image = record_bytes(0), record_bytes(128)
+    assert 0 < scalar < 100
+    assert 128 * 128 * 8 / 10 < image - scalar < 128 * 128 * 8 / 10 + 200  # float64 on the wire, every 10 ticks

@@ -48,3 +48,19 @@ def test_a_record_message_carries_numbers_and_arrays_and_refuses_anything_else()
     assert arena_proto.record_message(0, 0, {"big": np.zeros((400, 400))}) is None  # over MAX_RECORD_BYTES
     forged = arena_proto.pack({"type": "record", "family": "arena", "tick": 1, "agent": 0, "record": b"\x93\x01"})
     assert isinstance(arena_proto.parse_record(forged), arena_proto.Rejected)
+
+
+def test_a_record_of_arrays_alone_does_not_hold_the_runs_end_for_the_deadline(tmp_path):
+    """braitenberg's record() is one array, sent every 10th tick: the last tick (24) sends none, and its
+    action says so, so the world ends the run without waiting its 30 s deadline for a record."""
+    scenario = load_scenario("zmaze").with_overrides(controller="braitenberg", agents=2, max_ticks=25)
+    there = tmp_path / "there.rrd"
+    summary, _ = run_world(scenario, "arrays", [("braitenberg", 1, 2)], deadline=30.0, record=str(there))
+    assert summary["ticks"] == 25 and summary["wall_seconds"] < 15.0, summary["wall_seconds"]
+    rows = rrd_rows(there)
+    assert all(rows[f"controllers/{a}/bars/wheels"] == 3 for a in (0, 1))  # ticks 0, 10 and 20
+    acts = arena_proto.parse_acts(arena_proto.actions(7, [0, 1], np.zeros((2, 3)), records=[1]))
+    assert acts.records == (1,) and arena_proto.parse_acts(arena_proto.actions(8, [0], np.zeros((1, 3)))).records == ()
+    bad = arena_proto.pack({"type": "act", "family": "arena", "tick": 1, "agents": [0],
+                            "wheels": np.zeros(2).tobytes(), "records": ["x"]})  # fmt: skip
+    assert isinstance(arena_proto.parse_acts(bad), arena_proto.Rejected)

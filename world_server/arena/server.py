@@ -49,6 +49,7 @@ class ArenaKind:
         self.shares = ShareLog()
         self.memory: list[bytes | None] = [None] * self.world.n  # each controller's memory at the last save
         self.recorded_tick = np.full(self.world.n, -1, np.int64)  # the last tick of each robot's record() logged
+        self.record_due = np.full(self.world.n, -1, np.int64)  # the last tick an action said a record() was sent
         self.state_file = Path(server.state_dir) / f"{server.keys.run}.arena.npz" if server.state_dir else None
         # every publication, for `get <share>/**`, kept across a restart
         self.shared_history = SharedHistory(self.state_file.with_suffix(".shared.msgpack") if self.state_file else None)
@@ -138,13 +139,14 @@ class ArenaKind:
 
     def _await_last_records(self) -> None:
         """A record() rides its own key, so the last tick's may still be on its way when that tick's actions
-        are in: wait for it (at most the tick deadline) from every active robot that sends one."""
+        are in: wait (at most the tick deadline) for those the actions said were sent, from every active
+        robot.  A record() with no number in it goes out only on the ticks that carry its arrays, so the
+        last tick's action is what tells whether one is coming."""
         s = self.server
         if s.recorder is None:
             return
         until = time.monotonic() + s.deadline
-        sending = self.recorded_tick >= 0
-        while ((self.recorded_tick < s.tick - 1) & sending & (s.slots == ACTIVE)).any() and time.monotonic() < until:
+        while ((self.recorded_tick < self.record_due) & (s.slots == ACTIVE)).any() and time.monotonic() < until:
             s.drain(0.05)
 
     # ------------------------------------------------------------------ joins
@@ -250,6 +252,11 @@ class ArenaKind:
         if msg.shared:
             self._take_shared(msg, group, answered)
         self.world.broadcast([(a, data) for a, data in msg.rab if a in taken])  # heard next tick, as in-process
+        for a in msg.records:
+            if a in answered:
+                self.record_due[a] = max(self.record_due[a], msg.tick)
+            else:
+                s.stats.reject("act: records names an agent it did not act for")
         for a, blob in msg.memory:
             if a in taken and s.group_of.get(a) == group and s.saves_after(msg.tick):
                 self.memory[a] = blob

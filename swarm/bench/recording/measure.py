@@ -4,6 +4,9 @@ In-process (`swarm run --record`): setup 1 to completion over several seeds,
 ticks/s without and with the recording, and the file's bytes per tick.
 Distributed (`swarm up`, lock-step, where recording is on by default): runs
 with and without, alternated, same seed (the runs are equal tick for tick).
+Distributed arena: a user's kind of controller (payload.py), whose record()
+each agent process sends the world every tick, at sizes from one scalar to a
+128 x 128 image: what those messages cost a lock-step run.
 """
 
 from __future__ import annotations
@@ -13,6 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
 from swarm.engines.grid import Engine
 from swarm.launcher import swarm_up
 from swarm.recording.grid import Recorder, run_meta
@@ -20,6 +25,10 @@ from swarm.scenario import load_scenario
 from world_server.server import new_run_id
 
 QUICK_TICKS = 150  # a quick distributed run: enough ticks to time, few enough to take seconds
+ARENA = Path(__file__).with_name("arena.toml")
+ARENA_ROBOTS, ARENA_PER_PROCESS = 16, 4
+ARENA_TICKS = 600  # a full bench's arena run: 10 s of its ticks/s timed, 60 images a robot
+VIEWS = (0, 16, 64, 128)  # payload.py's record() images, cells a side
 
 
 def _recorder(engine: Engine, path: Path, runtime: str = "in-process") -> Recorder:
@@ -110,6 +119,39 @@ def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int
             "mb_per_run": round(size / 1e6, 2)}  # fmt: skip
 
 
+def record_bytes(cells: int) -> float:
+    """Bytes a robot's record() message carries a tick, on average: the scalars every tick, the image
+    every ARRAYS_EVERY ticks (world_server/arena/face/wire.py)."""
+    from world_server.arena.face.wire import ARRAYS_EVERY, record_message, record_values
+
+    record = {"turning": 0} | ({"view": np.zeros((cells, cells), np.float32)} if cells else {})
+    sizes = [len(record_message(tick, 0, record_values(record, tick)) or b"") for tick in range(ARRAYS_EVERY)]
+    return sum(sizes) / ARRAYS_EVERY
+
+
+def _arena_distributed(cells: int, tmp: Path, port: int, pairs: int, ticks: int) -> dict:
+    """ARENA_ROBOTS robots of payload.py's View<cells>, lock-step, `pairs` runs each way alternated."""
+    rates: dict[bool, list[float]] = {False: [], True: []}
+    size = 0
+    for _ in range(pairs):
+        for record in (False, True):
+            run_id = f"benchrec{new_run_id()}"
+            path = tmp / f"{run_id}.rrd"
+            s = swarm_up(str(ARENA), ARENA_ROBOTS, f"swarm.bench.recording.payload:View{cells}", 1, run_id,
+                         f"tcp/127.0.0.1:{port + record}", deadline=10.0, progress=False,
+                         per_process=ARENA_PER_PROCESS, record=str(path) if record else None, on_loss="strict",
+                         world_args=["--max-ticks", str(ticks)])  # fmt: skip
+            rates[record].append(s["ticks_per_second"])
+            if record:
+                size = path.stat().st_size
+    plain, recorded = statistics.median(rates[False]), statistics.median(rates[True])
+    return {"runtime": "arena", "agents": ARENA_ROBOTS, "per_process": ARENA_PER_PROCESS, "view": cells,
+            "runs": pairs, "ticks": ticks, "record_bytes": round(record_bytes(cells)),
+            "ticks_per_second": round(plain, 2), "recorded_ticks_per_second": round(recorded, 2),
+            "cost": round(1 - recorded / plain, 3), "bytes_per_tick": round(size / ticks),
+            "mb_per_run": round(size / 1e6, 2)}  # fmt: skip
+
+
 def bench_recording(quick: bool = False, port: int = 7650) -> dict:
     """`quick` checks every part in seconds rather than measuring: one seed in process, and
     distributed runs of few agent processes that stop at QUICK_TICKS."""
@@ -120,6 +162,9 @@ def bench_recording(quick: bool = False, port: int = 7650) -> dict:
         rows = [_in_process(n, seeds, Path(tmp)) for n in (20, 160)]
         for i, (agents, per_process) in enumerate(((20, 10), (160, 40)) if quick else ((20, 1), (160, 10))):
             rows.append(_distributed(agents, per_process, Path(tmp), port + 2 * i, pairs, max_ticks))
+        arena_ticks = QUICK_TICKS if quick else ARENA_TICKS
+        for i, cells in enumerate(VIEWS[-1:] if quick else VIEWS):
+            rows.append(_arena_distributed(cells, Path(tmp), port + 4 + 2 * i, pairs, arena_ticks))
     return {"benchmark": "recording", "scenario": "setup1", "quick": quick, "runs": rows}
 
 
@@ -127,7 +172,7 @@ def format_recording_bench(result: dict) -> str:
     header = f"{'runtime':>12}{'agents':>7}{'ticks/s':>10}{'recorded':>10}{'cost':>7}{'B/tick':>8}{'MB/run':>8}"
     extent = f"--quick: distributed runs stop at {QUICK_TICKS} ticks" if result.get("quick") else "to completion"
     lines = [f"Recording cost, setup1 {extent} (cost = share of ticks/s lost to recording)", "", header]
-    for r in result["runs"]:
+    for r in (r for r in result["runs"] if r["runtime"] != "arena"):
         lines.append(f"{r['runtime']:>12}{r['agents']:>7}{r['ticks_per_second']:>10}"
                      f"{r['recorded_ticks_per_second']:>10}{r['cost']:>7.0%}{r['bytes_per_tick']:>8}"
                      f"{r['mb_per_run']:>8}")  # fmt: skip
@@ -145,4 +190,15 @@ def format_recording_bench(result: dict) -> str:
         "close, drained: closing the file after all its data reached rerun and 0.2 s passed;",
         "rerun writes the file's footer (chunk index) and frees its buffers then, whatever we do before.",
     ]
+    arena = [r for r in result["runs"] if r["runtime"] == "arena"]
+    if arena:
+        lines += ["", f"Distributed arena: {arena[0]['agents']} robots in processes of {arena[0]['per_process']}, "
+                  f"{arena[0]['ticks']} ticks, lock-step; each robot's record() carries a view of cells x cells "
+                  "float32 (sent as float64 every 10 ticks)", "",
+                  f"{'view':>7}{'record B/robot-tick':>21}{'ticks/s':>10}{'recorded':>10}{'cost':>7}{'B/tick':>9}"
+                  f"{'MB/run':>8}"]  # fmt: skip
+        for r in arena:
+            lines.append(f"{r['view']:>7}{r['record_bytes']:>21}{r['ticks_per_second']:>10}"
+                         f"{r['recorded_ticks_per_second']:>10}{r['cost']:>7.0%}{r['bytes_per_tick']:>9}"
+                         f"{r['mb_per_run']:>8}")  # fmt: skip
     return "\n".join(lines)

@@ -9,7 +9,10 @@
                   tick's observations (`shared` there too), so in lock-step every robot reads
                   tick t's writes at tick t + 1, as in the in-process engine
                   and what their robots broadcast to their range-and-bearing neighbours
-                  (`rab`: [agent, bytes], at most MAX_PAYLOAD each), heard from the next tick on
+                  (`rab`: [agent, bytes], at most MAX_PAYLOAD each), heard from the next tick on,
+                  and, while the world records, the agents whose record() for this tick went
+                  out on records/<group> before it (`records`: [agent]; the world awaits those
+                  at the run's end)
                   At the ticks after which the world saves its state (`keep` in the
                   observation), the action also carries each controller's memory
                   (`memory`: [agent, bytes of swarm.core.memory_codec]); the world stores it
@@ -30,6 +33,7 @@ within its robot's limits) and counts what it refuses by reason.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import msgpack
@@ -88,6 +92,7 @@ class ArenaActs:
     shared: Shared = ()  # what these agents publish this tick, not yet judged
     memory: Memories = ()  # at a save: each controller's memory after this tick's step
     rab: Broadcasts = ()  # what these agents' robots broadcast this tick, not yet judged
+    records: tuple[int, ...] = ()  # the agents whose record() for this tick was sent before this message
 
 
 @dataclass(frozen=True)
@@ -189,11 +194,13 @@ def observations(tick: int, agents, perceptions: list[dict[str, np.ndarray]], sh
 
 
 def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = (), memory: Memories | MemoryPieces = (),
-            rab: Broadcasts = ()) -> bytes:  # fmt: skip
+            rab: Broadcasts = (), records: Sequence[int] = ()) -> bytes:  # fmt: skip
     """(K, 2) wheel speeds, or (K, 3) with a consummatory act each: the acts go
     in their own field, and only when one is not 0 (the message of robots
-    without a metabolism stays as it was); so do broadcasts, only when there are.
-    Memory given as pieces is written into the message once (the same bytes as its blob would give)."""
+    without a metabolism stays as it was); so do broadcasts, only when there are,
+    and the agents whose record() for this tick went out before it (the world
+    waits for those at the run's end).  Memory given as pieces is written into
+    the message once (the same bytes as its blob would give)."""
     wheels = np.asarray(wheels, np.float64).reshape(len(agents), -1)
     m = {"type": "act", "family": FAMILY_ARENA, "tick": tick, "agents": [int(a) for a in agents],
          "wheels": np.ascontiguousarray(wheels[:, :2]).astype("<f8").tobytes()}  # fmt: skip
@@ -203,6 +210,8 @@ def actions(tick: int, agents, wheels: np.ndarray, shared: Shared = (), memory: 
         m["shared"] = _shared_field(shared)
     if rab:
         m["rab"] = [[int(a), bytes(b)] for a, b in rab]
+    if records:
+        m["records"] = [int(a) for a in records]
     if memory:
         return pack_ending_with(m, "memory", _memory_pieces(memory))
     return pack(m)
@@ -284,7 +293,10 @@ def parse_acts(data: bytes) -> ArenaActs | Rejected:
         wheels = np.column_stack([wheels, np.frombuffer(acts, dtype="<f8").astype(np.float64)])
     if bad := first_rejection(memory := parse_memory(m.get("memory"), agents), rab := parse_rab(m.get("rab"), agents)):
         return bad
-    return ArenaActs(tick, agents, wheels, shared, memory, rab)
+    records = int_list(m, "records") if "records" in m else np.zeros(0, np.int64)
+    if isinstance(records, Rejected):
+        return records
+    return ArenaActs(tick, agents, wheels, shared, memory, rab, tuple(records.tolist()))
 
 
 @dataclass(frozen=True)
