@@ -6,10 +6,13 @@ confirmation seeds:
 - case 1: SPA's path length against A* paths that keep 4, 6 and 8 cm from the walls (SPA keeps
   to the middle of the corridors; L_o keeps the paper's 4 cm);
 - case 2: where each SPA run that missed its goal ended: how far from its start, and the two
-  nearest walls with the gap between them (a 7.4 cm robot in a 10-11 cm passage).
+  nearest walls with the gap between them (a 7.4 cm robot in a 10-11 cm passage);
+- case 3: the paper's three claims with the runs the report leaves out (the box appeared on the
+  robot) kept, beside the report's numbers: what the drop rule changes.
 
     python scripts/dft_diagnostics.py                                  # docs/reports/billing2015/runs.csv
     python scripts/dft_diagnostics.py --runs OUT/runs.csv              # another `swarm reproduce billing2015`
+                                                                       # (its case3.csv read beside it)
 """
 
 from __future__ import annotations
@@ -23,6 +26,8 @@ import pandas as pd
 from scipy import stats
 
 from agents.controllers.navigation.astar import Planner
+from swarm.experiments import stats as S
+from swarm.experiments.billing2015.reproduce import case3_tally
 from swarm.experiments.report import markdown_table
 from swarm.scenario import load_scenario
 from world_server.arena.scenario import clearance_at
@@ -79,6 +84,26 @@ def failure_table(runs: pd.DataFrame) -> pd.DataFrame:
     return failed[columns].sort_values(["walls", "pair", "noise"]).round(2)
 
 
+def case3_drop_table(case3: pd.DataFrame) -> pd.DataFrame:
+    """Case 3's claims, judged as the report judges them, on the kept runs and on every run: the early
+    obstacle's share south and the late one's share north (exact binomial against one half), and the red
+    switches of full against partial boxes between the two (Fisher's exact test)."""
+    rows = []
+    for which, sel in (("box on the robot left out (the report)", case3[~case3.on_robot]), ("none left out", case3)):
+        t = case3_tally(sel.to_dict("records"))
+        red, mid = t["red"], t["mid"]
+        rows.append({"runs": which, "n": len(sel),
+                     "early: south": f"{t['south']}/{t['early']}", "p": _p(S.binomial(t["south"], t["early"]).p),
+                     "late: north": f"{t['north']}/{t['late']}", "p ": _p(S.binomial(t["north"], t["late"]).p),
+                     "mid, red: full": f"{red['full']}/{mid['full']}", "partial": f"{red['partial']}/{mid['partial']}",
+                     "Fisher p": _p(S.fisher(red["full"], mid["full"], red["partial"], mid["partial"]).p)})  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def _p(p: float) -> str:
+    return "< 0.001" if p < 0.001 else f"{p:.3f}"
+
+
 def markdown(frame: pd.DataFrame) -> str:
     return markdown_table(list(frame.columns), [[f"{v:g}" if isinstance(v, float) else str(v) for v in row]
                                                 for row in frame.itertuples(index=False)])  # fmt: skip
@@ -88,7 +113,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=Path, default=Path("docs/reports/billing2015/runs.csv"),
                         help="runs.csv of `swarm reproduce billing2015` (default: the bundled report's)")  # fmt: skip
-    runs = pd.read_csv(parser.parse_args().runs)
+    path = parser.parse_args().runs
+    runs = pd.read_csv(path)
     print("Case 1, SPA's reached runs: L_p / L_o with L_o planned at each clearance\n")
     print(markdown(clearance_table(runs)))
     failures = failure_table(runs)
@@ -96,6 +122,9 @@ def main() -> None:
     print(f"\nCase 2, SPA's runs that missed their goal: {len(failures)} "
           f"({near.sum()} ended within {NEAR_START * 100:.0f} cm of their start)\n")  # fmt: skip
     print(markdown(failures))
+    case3 = pd.read_csv(path.with_name("case3.csv"))
+    print("\nCase 3: the paper's claims with and without the runs whose box appeared on the robot\n")
+    print(markdown(case3_drop_table(case3)))
 
 
 if __name__ == "__main__":

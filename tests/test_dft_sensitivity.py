@@ -76,3 +76,12 @@ def test_an_unknown_parameter_is_refused_in_one_line(tmp_path):
     assert done.returncode == 2 and len(lines) == 1, done.stderr
     assert lines[0].startswith("swarm: error: ") and "'tau' is not swept" in lines[0] and "prox_gain" in lines[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_its_seeds_lie_in_one_range_development_or_confirmation(tmp_path):
+    """Seed 9998 draws the pairs, which run on 9999 and 10000: the last is a confirmation seed."""
+    from swarm.core.errors import ScenarioError
+
+    with pytest.raises(ScenarioError, match="within one range: development"):
+        run_sensitivity("dft-sensitivity", None, reps=2, jobs=1, seed=9998, out=tmp_path / "out", progress=False)
+    assert not (tmp_path / "out").exists()

@@ -11,6 +11,7 @@ statements about the route the robot takes.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -169,8 +170,21 @@ def _pairs_section(case: str, rows: list[dict], quick: bool):
 # --------------------------------------------------------------------- case 3
 
 
+def case3_tally(runs: Sequence[dict]) -> dict:
+    """What the paper's case-3 claims count among `runs`: the runs whose obstacle came early and those that
+    went south, came late and kept north, and per obstacle the runs in between and their red switches."""
+    early = [r for r in runs if r["appear"] < paper.EARLY]
+    late = [r for r in runs if r["appear"] > paper.LATE]
+    mid = {kind: [r for r in runs if r["obstacle"] == kind and paper.EARLY < r["appear"] < paper.LATE]
+           for kind in CASE3_BOXES}  # fmt: skip
+    return {"early": len(early), "south": sum(r["route"] == "south" for r in early),
+            "late": len(late), "north": sum(r["route"] == "north" for r in late),
+            "mid": {kind: len(sel) for kind, sel in mid.items()},
+            "red": {kind: sum(r["route"] == "north-then-south" for r in sel) for kind, sel in mid.items()}}  # fmt: skip
+
+
 def _case3_section(rows: list[dict]):
-    kept = [r for r in rows if not r["on_robot"]]
+    t = case3_tally([r for r in rows if not r["on_robot"]])
     lines = []
     for kind in CASE3_BOXES:
         for noise in ("low", "high"):
@@ -178,25 +192,19 @@ def _case3_section(rows: list[dict]):
             used = [r for r in sel if not r["on_robot"]]
             counts = [str(sum(r["route"] == route for r in used)) for route in ROUTE_COLOUR]
             lines.append([kind, noise, str(len(sel)), str(len(sel) - len(used)), *counts])
-    early = [r for r in kept if r["appear"] < paper.EARLY]
-    late = [r for r in kept if r["appear"] > paper.LATE]
-    mid = {kind: [r for r in kept if r["obstacle"] == kind and paper.EARLY < r["appear"] < paper.LATE]
-           for kind in CASE3_BOXES}  # fmt: skip
-    south = sum(r["route"] == "south" for r in early)
-    north = sum(r["route"] == "north" for r in late)
-    red = {kind: sum(r["route"] == "north-then-south" for r in sel) for kind, sel in mid.items()}
+    red, mid = t["red"], t["mid"]
     claims = [
         P.Claim(f"case3: an obstacle appearing before t = {paper.EARLY} sends the robot south, whatever its type",
-                "south (Fig. 13-16)", S.proportion_ci(south, len(early)).text(3) + " south",
-                S.binomial(south, len(early), 0.5)),
+                "south (Fig. 13-16)", S.proportion_ci(t["south"], t["early"]).text(3) + " south",
+                S.binomial(t["south"], t["early"], 0.5)),
         P.Claim(f"case3: an obstacle appearing after t = {paper.LATE}: the robot keeps the north route",
-                "always north", S.proportion_ci(north, len(late)).text(3) + " north",
-                S.binomial(north, len(late), 0.5)),
+                "always north", S.proportion_ci(t["north"], t["late"]).text(3) + " north",
+                S.binomial(t["north"], t["late"], 0.5)),
         P.Claim(f"case3: within {paper.EARLY} < t < {paper.LATE} a full obstacle makes the robot switch north to "
                 "south (red), a partial one does not", "full: red; partial: north",
-                f"red: full {S.proportion_ci(red['full'], len(mid['full'])).text(3)}, partial "
-                f"{S.proportion_ci(red['partial'], len(mid['partial'])).text(3)}",
-                S.fisher(red["full"], len(mid["full"]), red["partial"], len(mid["partial"]))),
+                f"red: full {S.proportion_ci(red['full'], mid['full']).text(3)}, partial "
+                f"{S.proportion_ci(red['partial'], mid['partial']).text(3)}",
+                S.fisher(red["full"], mid["full"], red["partial"], mid["partial"])),
     ]  # fmt: skip
     table = R.markdown_table(["obstacle", "noise", "runs", "left out (box on the robot)", *ROUTE_COLOUR], lines)
     return "Case 3: an obstacle across the north route", table, claims

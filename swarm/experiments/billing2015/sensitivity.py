@@ -28,13 +28,14 @@ from swarm.core.errors import ScenarioError
 from swarm.core.plots import pyplot, save_figure
 from swarm.experiments.billing2015.carrot import RUN_FIELDS, fmt, run_pair
 from swarm.experiments.billing2015.dft import pair_jobs
-from swarm.experiments.protocol import DEVELOPMENT_SEEDS
+from swarm.experiments.protocol import CONFIRMATION_SEEDS, DEVELOPMENT_SEEDS
 from swarm.experiments.runner import Outputs, batch_run
 from swarm.experiments.stats import mcnemar, proportion_ci
 
 NAME = "dft-sensitivity"
 SCENARIO = "large-maze"
 NOISE = "low"  # SPA-LN: the condition whose failures include the proximity inhibition alone (docs/dft.md, case 2)
+SEED_BANDS = {"development": DEVELOPMENT_SEEDS, "confirmation": CONFIRMATION_SEEDS}
 REPS = 6  # pairs per condition: 11 conditions, about 10 minutes on 2 cores (8 pairs took 14 min)
 
 
@@ -171,8 +172,11 @@ def run_sensitivity(name: str, scenario: str | None, reps: int | None, jobs: int
     if parameter is not None and parameter not in BY_NAME:
         raise ScenarioError("command line", "--parameter", f"{parameter!r} is not swept: one of {', '.join(BY_NAME)}")
     reps = REPS if reps is None else reps
-    if seed not in DEVELOPMENT_SEEDS or seed + reps not in DEVELOPMENT_SEEDS:
-        raise ScenarioError("command line", "--seed", f"{name} runs on development seeds (0 to 9999)")
+    # seed draws the pairs and pair k runs on seed + k (dft.pair_jobs): all of them in one range
+    band = next((b for b, pool in SEED_BANDS.items() if seed in pool and seed + reps in pool), None)
+    if band is None:
+        raise ScenarioError("command line", "--seed", f"{name} runs its pairs' seeds within one range: development "
+                            "(0 to 9999) to explore, confirmation (10000 to 19999) to report")  # fmt: skip
     parameters = [parameter] if parameter else list(BY_NAME)
     out = Outputs(out, name)
     rows = batch_run(run_level, plan(parameters, reps, seed, max_ticks), jobs=jobs, desc=name, progress=progress)
@@ -183,6 +187,7 @@ def run_sensitivity(name: str, scenario: str | None, reps: int | None, jobs: int
                        for s in SWEPT if s.name in parameters)  # fmt: skip
     title = (f"# Sensitivity of SPA in case 2 (large maze, {NOISE} noise), one parameter at a time\n\n"
              f"{reps} start/goal pairs per condition, the same pairs and seeds in every condition "
-             f"(dft-case2's); seed {seed} (development seeds); at most {max_ticks or 3000} steps of 64 ms.\n\n"
+             f"(dft-case2's); pairs drawn from seed {seed}, run on seeds {seed + 1}..{seed + reps} ({band} seeds); "
+             f"at most {max_ticks or 3000} steps of 64 ms.\n\n"
              f"{levels}\n\n")  # fmt: skip
     return out.finish(summary, title + md)
