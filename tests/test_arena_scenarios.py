@@ -23,6 +23,7 @@ ARENAS = [
     "tmaze-1.5",
     "tmaze-2",
     "office",
+    "office-l",
     "bg-colony",
 ]
 
@@ -126,6 +127,18 @@ def test_office_tours_have_the_documented_lengths_and_the_mapping_tour_is_driven
     assert lengths["mapping"] == pytest.approx(75, rel=0.05)
     assert lengths["localize"] == pytest.approx(250, rel=0.05)
     assert lengths["localize-off-map"] == pytest.approx(250, rel=0.05)
+    assert lengths["new-path"] == pytest.approx(250, rel=0.05)
+    summary = ArenaEngine(s).run()
+    robot = summary["robots"][0]
+    assert summary["finished"] and robot["collisions"] == 0 and robot["path_ratio"] < 1.1
+
+
+def test_the_held_out_office_l_floor_has_its_tours_and_drives_its_mapping_tour():
+    s = load_scenario("office-l")
+    lengths = {k: sum(math.dist(a, b) for a, b in itertools.pairwise(r)) for k, r in s.routes.items()}
+    assert lengths["mapping"] == pytest.approx(75, rel=0.05)
+    assert lengths["new-path"] == pytest.approx(250, rel=0.05) and lengths["localize"] == pytest.approx(250, rel=0.05)
+    assert len([z for z in s.zones if z.kind == "place"]) == 25
     summary = ArenaEngine(s).run()
     robot = summary["robots"][0]
     assert summary["finished"] and robot["collisions"] == 0 and robot["path_ratio"] < 1.1

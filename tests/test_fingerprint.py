@@ -4,6 +4,7 @@ the controller on the office floor."""
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import subprocess
@@ -439,11 +440,65 @@ def test_the_floors_place_graph_joins_places_through_doors_and_the_corridor_only
                                                     "links_not_adjacent": 1}  # fmt: skip
 
 
+def _polyline(points, step: float = 0.05) -> np.ndarray:
+    """Points every `step` along a route's waypoints."""
+    pts = np.asarray(points, float)
+    out = [a + (b - a) * t for a, b in itertools.pairwise(pts)
+           for t in np.arange(0, 1, step / max(float(np.hypot(*(b - a))), 1e-9))]  # fmt: skip
+    return np.array([*out, pts[-1]])
+
+
+@pytest.mark.parametrize("floor", ["office", "office-l"])
+def test_each_floors_new_path_keeps_to_lines_of_its_own_and_starts_elsewhere(floor):
+    """The paper's second tour was "a new path": ours starts away from the mapping tour's ends and keeps
+    off its lines but for doorways and crossings, while `localize` (where a floor has one to compare)
+    follows them."""
+    from swarm.experiments.tapus2006.fingerprint import retracing
+
+    routes = load_scenario(floor).routes
+    mapping, new = _polyline(routes["mapping"]), _polyline(routes["new-path"])
+    retraced, gap = retracing(mapping, new)
+    assert retraced / len(new) < 0.2 and gap > 0.4, (retraced / len(new), gap)
+    assert min(math.dist(routes["new-path"][0], routes["mapping"][k]) for k in (0, -1)) > 5.0
+    if floor == "office":
+        old, old_gap = retracing(mapping, _polyline(routes["localize"]))
+        assert old / len(_polyline(routes["localize"])) > 0.5 and old_gap < 0.1
+
+
+def test_retracing_counts_a_tours_points_near_the_mapping_tour():
+    from swarm.experiments.tapus2006.fingerprint import retracing
+
+    mapped = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    assert retracing(mapped, np.array([[0.05, 0.0], [1.0, 0.5], [2.0, 2.0]])) == (1, 0.5)
+    assert retracing(mapped, np.empty((0, 2)))[0] == 0
+
+
+def test_a_floor_without_a_localization_tour_is_refused_in_one_line(tmp_path):
+    from swarm.experiments.tapus2006.fingerprint import run_fingerprint_experiment, second_tours
+
+    assert second_tours(load_scenario("office")) == ("new-path", "localize", "localize-off-map")
+    from swarm.scenario import BUNDLED_DIR
+
+    text = (BUNDLED_DIR / "office.toml").read_text().split("[routes]")
+    mapping = next(line for line in text[1].splitlines() if line.startswith("mapping = "))
+    rest = text[1].split("\n[[group]]", 1)[1]
+    floor = tmp_path / "mapping-only.toml"
+    floor.write_text(text[0] + "[routes]\n" + mapping + "\n\n[[group]]" + rest)
+    with pytest.raises(ScenarioError, match="no localization tour; fingerprint-localize needs one of 'new-path'"):
+        run_fingerprint_experiment("fingerprint-localize", str(floor), 1, 1, 0, tmp_path / "out", progress=False)
+    from swarm.experiments.tapus2006.robustness import run_robustness_experiment
+
+    with pytest.raises(ScenarioError, match="no localization tour; fingerprint-robustness needs one of 'new-path'"):
+        run_robustness_experiment("fingerprint-robustness", str(floor), 1, 1, 0, tmp_path / "out", progress=False)
+    assert not (tmp_path / "out").exists()
+
+
 def test_localization_on_the_second_tour_beats_matching_alone_and_chance():
     from swarm.experiments.tapus2006.fingerprint import localize_job
 
     row = localize_job(("office", "low", 0, "localize"))
     assert row["fingerprints"] >= 1000 and row["on_map"] >= 0.95 * row["fingerprints"]  # it stays on the map
+    assert row["retraced"] > 0.5 * row["fingerprints"] and row["gap_median_m"] < 0.1  # along the mapping lines
     assert row["match_correct"] > 5 * row["chance"]  # matching alone well above chance
     assert row["links_markov_correct"] > row["match_correct"] + 0.03  # a filter clearly above matching alone
     assert row["markov_correct"] >= 0.98 and row["markov_correct"] > row["links_markov_correct"]  # the grid more

@@ -23,7 +23,7 @@ WAYPOINTS = 8  # the mapping tour's first stretch, driven twice: seconds, not mi
 
 @pytest.fixture(scope="module")
 def routes():
-    return short_routes("office", WAYPOINTS)
+    return short_routes("office", WAYPOINTS, "new-path")
 
 
 @pytest.fixture(scope="module")
@@ -60,8 +60,8 @@ def test_a_kidnapping_yields_a_recovery_count_or_a_censored_flag(written):
 
 
 def test_zero_camera_noise_equals_the_baseline_run_exactly(routes):
-    base = robustness_job(("office", BASELINE, math.nan, 3, routes))
-    quiet = robustness_job(("office", "camera", 0.0, 3, routes))
+    base = robustness_job(("office", BASELINE, math.nan, 3, routes, "new-path"))
+    quiet = robustness_job(("office", "camera", 0.0, 3, routes, "new-path"))
     skip = {"condition", "level", "wall_seconds"}
     assert {k: v for k, v in base.items() if k not in skip} == {k: v for k, v in quiet.items() if k not in skip}
 

@@ -3,8 +3,8 @@ places on the office floor."""
 
 from swarm.core.registry import ExperimentSpec, Option, PaperSpec
 
-_FLOOR = Option("--scenario", "a floor with 'mapping', 'localize' and 'localize-off-map' routes and place zones "
-                "(default office)")  # fmt: skip
+_FLOOR = Option("--scenario", "a floor with place zones, a 'mapping' route and localization tours among "
+                "'new-path', 'localize' and 'localize-off-map' (default office; office-l is another)")  # fmt: skip
 _TEAM_FLOOR = Option("--scenario", "a floor with a 'mapping' route (robot k of N drives its k-th stretch) and place "
                      "zones (default office: robot k surveys the k-th stretch of the corridor and its rooms)",
                      metavar="FILE")  # fmt: skip

@@ -8,9 +8,11 @@ Tapus, Battaglia & Siegwart (2006), section 3, on the `office` floor.
 - map: the ~76 m mapping tour, a fingerprint every 15 cm (~500), the map's
   nodes against the floor's 20 ground-truth places, and the node count as
   theta varies (the paper: 20 nodes);
-- localize: the map of the mapping tour, then the ~253 m localization tour
-  (~1770 fingerprints, every one on the mapped floor, as the paper's robot
-  stayed on its map): the share of fingerprints placed at the right node
+- localize: the map of the mapping tour, then each localization tour the
+  floor has: `new-path` (~250 m on lines of its own through the mapped
+  rooms, the paper's "new path"), `localize` (~253 m, the mapped rooms in
+  other orders along the mapping tour's lines): the share of fingerprints
+  placed at the right node
   by matching alone (paper 81%) and by the Markov filter (paper 100%: ours
   on the map's odometric grid, and over the links alone beside it), and the
   rank of the right node among the matches when matching alone misses
@@ -48,7 +50,9 @@ from swarm.experiments.tapus2006 import paper
 NOISES = ("low", "high")
 THETAS = (0.2, 0.35, 0.5, 0.65, 0.8)
 PAPER_NODES, PAPER_MATCH, PAPER_MARKOV = paper.NODES, paper.MATCH, paper.MARKOV
-LOCALIZE_TOURS = ("localize", "localize-off-map")  # on the mapped floor (the paper's case), and leaving it
+LOOP_TOURS = ("localize", "localize-off-map")  # revisiting the mapped rooms, and leaving them: mapped for loops
+LOCALIZE_TOURS = ("new-path", *LOOP_TOURS)  # the paper's "new path" first; a floor may lack some
+RETRACE = 0.10  # a second-tour fingerprint this close to a mapping fingerprint retraces the mapping tour
 OFF_MAP = 1.0  # a fingerprint taken farther than this from every mapping fingerprint is off the mapped floor
 TOLERANCE = 0.5  # nodes whose mapping fingerprints lie this much farther than the nearest count as right too
 
@@ -128,8 +132,9 @@ def tour_scenario(name: str, route: str, noise: str, seed: int, table: dict | No
         raise ScenarioError(name, "kind", "the fingerprint experiments map an arena floor")
     s = replace(s, routes={**s.routes, **(routes or {})})
     if route not in s.routes:
-        raise ScenarioError(name, "routes", f"no route {route!r}; the fingerprint experiments need "
-                            "'mapping', 'localize' and 'localize-off-map' routes")  # fmt: skip
+        tours = ", ".join(repr(t) for t in LOCALIZE_TOURS)
+        raise ScenarioError(name, "routes", f"no route {route!r}; the fingerprint experiments need a 'mapping' "
+                            f"route and a localization tour ({tours})")  # fmt: skip
     robot = s.groups[0].robot
     for sensor, changes in (sensors or {}).items():
         spec = getattr(robot.sensors, sensor)
@@ -349,6 +354,31 @@ def map_job(job: tuple) -> dict:
             **judge_map(run, places(s), place_graph(s)), "wall_seconds": round(run["wall_seconds"], 2)}  # fmt: skip
 
 
+def second_tours(scenario) -> tuple[str, ...]:
+    """The localization tours (LOCALIZE_TOURS) that the floor's [routes] hold."""
+    return tuple(t for t in LOCALIZE_TOURS if t in scenario.routes)
+
+
+def localization_tours(name: str, which: str) -> tuple[str, ...]:
+    """Floor `name`'s localization tours, for experiment `which`; a floor without one is refused in one line."""
+    tours = second_tours(tour_scenario(name, "mapping", "low", 0))
+    if not tours:
+        wanted = ", ".join(repr(t) for t in LOCALIZE_TOURS)
+        raise ScenarioError(name, "routes", f"no localization tour; {which} needs one of {wanted}")
+    return tours
+
+
+def retracing(mapped_xy: np.ndarray, tour_xy: np.ndarray) -> tuple[int, float]:
+    """How closely a second tour follows the mapping tour: (its fingerprints taken within RETRACE of a
+    mapping fingerprint, the median distance from one of its fingerprints to the nearest mapping one)."""
+    from scipy.spatial import cKDTree
+
+    if not len(mapped_xy) or not len(tour_xy):
+        return 0, math.nan
+    gap = cKDTree(mapped_xy).query(tour_xy)[0]
+    return int((gap <= RETRACE).sum()), float(np.median(gap))
+
+
 def right_nodes(mapped: dict, xy: np.ndarray, aliased: dict[int, int] | None = None,
                 zones: list | None = None) -> set[int] | None:  # fmt: skip
     """The nodes that stand for where `xy` is: those holding a mapping fingerprint taken within TOLERANCE
@@ -414,6 +444,7 @@ def localization_counts(mapped: dict, loc: dict, zones: list) -> dict:
             order = np.argsort(-like, kind="stable")
             ranks.append(int(np.flatnonzero(np.isin(order, list(right)))[0]) + 1)
     ranks = np.array(ranks, np.int64)
+    retraced, gap = retracing(mapped["truth"][:, :2], loc["truth"][:, :2])
     loose_sums = np.array(loose, np.int64).reshape(-1, 3).sum(axis=0)
     return {"map_nodes": k, "fingerprints": len(loc["matched"]), "on_map": len(by_match), "off_map": off,
             "aliased_nodes": len(aliased), "match_right": int(sum(by_match)), "markov_right": int(sum(by_markov)),
@@ -421,7 +452,8 @@ def localization_counts(mapped: dict, loc: dict, zones: list) -> dict:
             "markov_right_loose": int(loose_sums[1]), "links_right_loose": int(loose_sums[2]),
             "chance": round(float(np.mean(chance)), 4),
             "missed_rank2": int((ranks == 2).sum()), "missed_rank3": int((ranks == 3).sum()),
-            "missed_rank_over3": int((ranks > 3).sum()), "right": track}  # fmt: skip
+            "missed_rank_over3": int((ranks > 3).sum()), "retraced": retraced, "gap_median_m": round(gap, 3),
+            "right": track}  # fmt: skip
 
 
 def localize_job(job: tuple) -> dict:
@@ -430,7 +462,7 @@ def localize_job(job: tuple) -> dict:
     share = {f"{key}_correct": round(c[right] / c["on_map"], 4) if c["on_map"] else math.nan
              for key, right in (("match", "match_right"), ("markov", "markov_right"),
                                 ("links_markov", "links_right"), ("markov_loose", "markov_right_loose"))}  # fmt: skip
-    head = ("map_nodes", "fingerprints", "on_map", "off_map", "aliased_nodes")
+    head = ("map_nodes", "fingerprints", "on_map", "off_map", "aliased_nodes", "retraced", "gap_median_m")
     tail = ("chance", "missed_rank2", "missed_rank3", "missed_rank_over3", "ticks", "finished", "wall_seconds")
     return {"scenario": name, "route": route, "noise": noise, "seed": seed, **{k: c[k] for k in head}, **share,
             **{k: c[k] for k in tail}}  # fmt: skip
@@ -482,21 +514,23 @@ def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | Non
                                out: Path | None, progress: bool = True) -> dict:  # fmt: skip
     name = scenario or "office"
     reps = reps or 3
-    tour_scenario(name, "mapping", "low", seed)  # a floor it cannot map is refused here, in one line
+    tours = second_tours(tour_scenario(name, "mapping", "low", seed))  # a floor it cannot map is refused here
+    if which == "fingerprint-localize":
+        tours = localization_tours(name, which)
     out = Outputs(out, which)
     if which == "fingerprint-calibrate":
         return _calibrate(name, seed, out)
     if which == "fingerprint-map":
         work = [(name, noise, seed + r, theta, "mapping") for noise in NOISES for r in range(reps) for theta in THETAS]
-        work += [(name, noise, seed + r, 0.5, route) for route in LOCALIZE_TOURS for noise in NOISES
+        work += [(name, noise, seed + r, 0.5, route) for route in LOOP_TOURS if route in tours for noise in NOISES
                  for r in range(reps)]  # loops  # fmt: skip
         rows = batch_run(map_job, work, jobs=jobs, desc=which, progress=progress)
-        rows.sort(key=lambda r: (("mapping", *LOCALIZE_TOURS).index(r["route"]), NOISES.index(r["noise"]), r["theta"],
+        rows.sort(key=lambda r: (("mapping", *LOOP_TOURS).index(r["route"]), NOISES.index(r["noise"]), r["theta"],
                                  r["seed"]))  # fmt: skip
         md = _map_table(rows, name, reps, seed)
         plot_map(rows, name, seed, out / "plot.png")
     elif which == "fingerprint-localize":
-        work = [(name, noise, seed + r, route) for route in LOCALIZE_TOURS for noise in NOISES for r in range(reps)]
+        work = [(name, noise, seed + r, route) for route in tours for noise in NOISES for r in range(reps)]
         rows = batch_run(localize_job, work, jobs=jobs, desc=which, progress=progress)
         rows.sort(key=lambda r: (LOCALIZE_TOURS.index(r["route"]), NOISES.index(r["noise"]), r["seed"]))
         md = _localize_table(rows, name, reps, seed)
@@ -504,7 +538,7 @@ def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | Non
     else:
         raise ValueError(f"unknown fingerprint experiment {which!r}")
     out.runs(rows)
-    tours = ("mapping",) if which == "fingerprint-map" else LOCALIZE_TOURS
+    tours = ("mapping",) if which == "fingerprint-map" else tours
     summary = [{"route": t, "noise": n,
                 **{k: round(_mean([r for r in rows if r["noise"] == n and r["route"] == t and
                                    (which != "fingerprint-map" or r["theta"] == 0.5)], k), 4)
@@ -530,7 +564,7 @@ def _map_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
              "| tour | noise | theta | fingerprints | nodes | paper | places with a node | nodes per place | "
              "purity | loops closed | room revisits closed | corridor seen again: on an old node |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
-    for route in ("mapping", *LOCALIZE_TOURS):
+    for route in ("mapping", *LOOP_TOURS):
         for noise in NOISES:
             for theta in THETAS:
                 sel = [r for r in rows if r["route"] == route and r["noise"] == noise and r["theta"] == theta]
@@ -560,9 +594,9 @@ def _localize_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
         f"# Fingerprint localization (Tapus et al. 2006), `{name}`\n",
         f"Map from the mapping tour, then a localization tour; {reps} runs per tour and noise level "
         f"(seeds {seed}..{seed + reps - 1}).\n",
-        "| tour | noise | map nodes | fingerprints (on the map) | matching alone | paper | Markov filter | paper | "
-        "links only | chance | misses by matching: right node 2nd / 3rd / lower |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| tour | noise | map nodes | fingerprints (on the map) | retracing | matching alone | paper | Markov filter | "
+        "paper | links only | chance | misses by matching: right node 2nd / 3rd / lower |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for route in LOCALIZE_TOURS:
         for noise in NOISES:
@@ -571,7 +605,9 @@ def _localize_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
                 continue
             m, k = _mean(sel, "match_correct"), _mean(sel, "markov_correct")
             lines.append(f"| {route} | {noise} | {_mean(sel, 'map_nodes'):.1f} | {_mean(sel, 'fingerprints'):.0f} "
-                         f"({_mean(sel, 'on_map'):.0f}) | {m:.1%} | {PAPER_MATCH:.0%} ({m - PAPER_MATCH:+.1%}) | "
+                         f"({_mean(sel, 'on_map'):.0f}) | {_share(_mean(sel, 'retraced') / _mean(sel, 'fingerprints'))}"
+                         f", median {_mean(sel, 'gap_median_m'):.2f} m | {m:.1%} | {PAPER_MATCH:.0%} "
+                         f"({m - PAPER_MATCH:+.1%}) | "
                          f"{k:.1%} | {PAPER_MARKOV:.0%} ({k - PAPER_MARKOV:+.1%}) | "
                          f"{_mean(sel, 'links_markov_correct'):.1%} | {_mean(sel, 'chance'):.1%} | "
                          f"{_mean(sel, 'missed_rank2'):.0f} / {_mean(sel, 'missed_rank3'):.0f} / "
@@ -580,8 +616,11 @@ def _localize_table(rows: list[dict], name: str, reps: int, seed: int) -> str:
                  f"{TOLERANCE} m more); fingerprints farther than {OFF_MAP} m from every mapping fingerprint (the "
                  "rooms the mapping tour did not enter) are left out.  Markov filter: the belief on the map's "
                  "odometric grid (the controller's default); links only: the same likelihoods through the "
-                 "link-only motion model.  The paper's robot stayed on its map (`localize`); "
-                 "`localize-off-map` also enters the eight rooms the mapping tour did not.  Chance: a node "
+                 "link-only motion model.  The paper's robot stayed on its map on \"a new path\" (`new-path`: "
+                 "lines of its own through the mapped rooms); `localize` retraces the mapping tour's lines; "
+                 "`localize-off-map` also enters the eight rooms the mapping tour did not.  Retracing: the share "
+                 f"of the tour's fingerprints taken within {RETRACE:.2f} m of a mapping fingerprint, and the median "
+                 "distance to the nearest one.  Chance: a node "
                  "drawn at random.  The paper's floor and tours are not available; ours are in "
                  "docs/fingerprint.md.")  # fmt: skip
     return "\n".join(lines) + "\n"
@@ -663,7 +702,7 @@ def plot_localize(rows: list[dict], path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(8, 5.2))
-    groups = [(route, n) for route in LOCALIZE_TOURS for n in NOISES]
+    groups = [(route, n) for route in LOCALIZE_TOURS for n in NOISES if any(r["route"] == route for r in rows)]
     x = np.arange(len(groups))
     bars = (("match_correct", "matching alone"), ("links_markov_correct", "Markov, links only"),
             ("markov_correct", "Markov filter (grid)"))  # fmt: skip

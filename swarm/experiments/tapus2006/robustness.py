@@ -13,7 +13,8 @@ set (agents/controllers/fingerprint/params.py) and the scout's specified sensors
 - spacing (the paper's delta-d, metres between fingerprints) and theta (the matching threshold), on
   both tours.
 
-Each run maps on the mapping tour and localizes on the `localize` tour (fingerprint.localize_run);
+Each run maps on the mapping tour and localizes on the floor's first localization tour, `new-path` on
+`office` (fingerprint.second_tours, fingerprint.localize_run);
 the shares are fingerprint.localization_counts' (matching alone, the Markov filter over the links,
 the paper's kind, and on the odometric grid).  Ground truth (the robot's true pose, the place zones)
 scores the runs here; the kidnapper moves the robot between the route's waypoints.  The controller
@@ -30,9 +31,8 @@ from typing import Any
 import numpy as np
 
 from swarm.experiments.runner import Outputs, batch_run
-from swarm.experiments.tapus2006.fingerprint import along, drive_tour, localize_run, tour_scenario
+from swarm.experiments.tapus2006.fingerprint import along, drive_tour, localization_tours, localize_run, tour_scenario
 
-ROUTE = "localize"
 HOLD = 3  # fingerprints on the map in a row at a right node that count as recovered
 ESTIMATORS = (("match_correct", "matching alone"), ("links_markov_correct", "Markov, links (paper's)"),
               ("markov_correct", "Markov, grid"))  # fmt: skip
@@ -117,12 +117,12 @@ def recovery(right: np.ndarray, start: int, hold: int = HOLD) -> tuple[int, bool
 
 
 def robustness_job(job: tuple) -> dict:
-    """One run: (floor, condition, level, seed, routes) -> a row."""
-    name, condition, level, seed, routes = job
+    """One run: (floor, condition, level, seed, routes, second tour) -> a row."""
+    name, condition, level, seed, routes, route = job
     change = {} if condition in (BASELINE, "kidnap") else CONDITIONS[condition][0](level)
     leg: dict = {}  # the kidnapped tour's own numbers: where the kidnapping came, how far the robot was carried
     second = kidnapped(seed, leg) if condition == "kidnap" else None
-    _, c = localize_run(name, "low", seed, ROUTE, routes=routes, second=second, per_print=True, **change)
+    _, c = localize_run(name, "low", seed, route, routes=routes, second=second, per_print=True, **change)
     shares = {key: round(c[right] / c["on_map"], 4) if c["on_map"] else math.nan
               for key, right in (("match_correct", "match_right"), ("links_markov_correct", "links_right"),
                                  ("markov_correct", "markov_right"))}  # fmt: skip
@@ -136,11 +136,11 @@ def robustness_job(job: tuple) -> dict:
     return row | {"ticks": c["ticks"], "finished": c["finished"], "wall_seconds": c["wall_seconds"]}
 
 
-def short_routes(name: str, waypoints: int) -> dict:
+def short_routes(name: str, waypoints: int, route: str) -> dict:
     """Both tours cut to the mapping tour's first `waypoints` waypoints (a quick run that stays on its map)."""
     s = tour_scenario(name, "mapping", "low", 0)
     cut = tuple(s.routes["mapping"][:waypoints])
-    return {"mapping": cut, ROUTE: cut}
+    return {"mapping": cut, route: cut}
 
 
 def run_robustness_experiment(which: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
@@ -154,11 +154,11 @@ def run_robustness_experiment(which: str, scenario: str | None, reps: int | None
     unknown = [c for c in chosen if c not in CONDITIONS]
     if unknown:
         raise ValueError(f"unknown condition {unknown[0]!r}; expected one of {', '.join(CONDITIONS)}")
-    routes = short_routes(name, waypoints) if waypoints else None
-    tour_scenario(name, "mapping", "low", seed, routes=routes)  # a floor it cannot map is refused here, in one line
+    tours = localization_tours(name, which)  # a floor it cannot map, or without a second tour: one line
+    routes = short_routes(name, waypoints, tours[0]) if waypoints else None
     seeds = range(seed, seed + reps)
-    work = [(name, BASELINE, math.nan, s, routes) for s in seeds]
-    work += [(name, c, lv, s, routes) for c in chosen for lv in CONDITIONS[c][1]
+    work = [(name, BASELINE, math.nan, s, routes, tours[0]) for s in seeds]
+    work += [(name, c, lv, s, routes, tours[0]) for c in chosen for lv in CONDITIONS[c][1]
              if c == "kidnap" or lv != CONDITIONS[c][2] for s in seeds]  # fmt: skip
     rows = batch_run(robustness_job, work, jobs=jobs, desc=which, progress=progress)
     out = Outputs(out, which)
@@ -166,7 +166,7 @@ def run_robustness_experiment(which: str, scenario: str | None, reps: int | None
     summary = summarize(rows, chosen)
     out.runs(summary, file="summary.csv")
     band = "confirmation" if is_confirmation(seed) else "development" if seed in DEVELOPMENT_SEEDS else "other"
-    md = table(summary, name, seeds, band, waypoints)
+    md = table(summary, name, seeds, band, waypoints, tours[0])
     plot(summary, rows, out / "plot.png")
     return out.finish(None, md)
 
@@ -226,8 +226,8 @@ def _median(r: dict, f: str) -> str:
     return f"{text} ({r[f'censored_{f}']} of {r['n']} censored)"
 
 
-def table(summary: list[dict], name: str, seeds: range, band: str, waypoints: int | None) -> str:
-    tours = f"the mapping tour's first {waypoints} waypoints, twice" if waypoints else "mapping, then `localize`"
+def table(summary: list[dict], name: str, seeds: range, band: str, waypoints: int | None, route: str) -> str:
+    tours = f"the mapping tour's first {waypoints} waypoints, twice" if waypoints else f"mapping, then `{route}`"
     lines = [f"# Fingerprint localization under conditions (Tapus et al. 2006), `{name}`\n",
              f"{len(seeds)} runs per condition level, {band} seeds {seeds.start}..{seeds.stop - 1}; {tours}.  "
              "Each condition changes one thing from the declared parameters (the declared level is the same "
