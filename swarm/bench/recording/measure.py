@@ -28,6 +28,7 @@ QUICK_TICKS = 150  # a quick distributed run: enough ticks to time, few enough t
 ARENA = Path(__file__).with_name("arena.toml")
 ARENA_ROBOTS, ARENA_PER_PROCESS = 16, 4
 ARENA_TICKS = 600  # a full bench's arena run: 10 s of its ticks/s timed, 60 images a robot
+QUICK_ARENA_TICKS = 30
 VIEWS = (0, 16, 64, 128)  # payload.py's record() images, cells a side
 
 
@@ -129,7 +130,8 @@ def record_bytes(cells: int) -> float:
     return sum(sizes) / ARRAYS_EVERY
 
 
-def _arena_distributed(cells: int, tmp: Path, port: int, pairs: int, ticks: int) -> dict:
+def _arena_distributed(cells: int, tmp: Path, port: int, pairs: int, ticks: int,
+                       per_process: int = ARENA_PER_PROCESS) -> dict:  # fmt: skip
     """ARENA_ROBOTS robots of payload.py's View<cells>, lock-step, `pairs` runs each way alternated."""
     rates: dict[bool, list[float]] = {False: [], True: []}
     size = 0
@@ -139,13 +141,13 @@ def _arena_distributed(cells: int, tmp: Path, port: int, pairs: int, ticks: int)
             path = tmp / f"{run_id}.rrd"
             s = swarm_up(str(ARENA), ARENA_ROBOTS, f"swarm.bench.recording.payload:View{cells}", 1, run_id,
                          f"tcp/127.0.0.1:{port + record}", deadline=10.0, progress=False,
-                         per_process=ARENA_PER_PROCESS, record=str(path) if record else None, on_loss="strict",
+                         per_process=per_process, record=str(path) if record else None, on_loss="strict",
                          world_args=["--max-ticks", str(ticks)])  # fmt: skip
             rates[record].append(s["ticks_per_second"])
             if record:
                 size = path.stat().st_size
     plain, recorded = statistics.median(rates[False]), statistics.median(rates[True])
-    return {"runtime": "arena", "agents": ARENA_ROBOTS, "per_process": ARENA_PER_PROCESS, "view": cells,
+    return {"runtime": "arena", "agents": ARENA_ROBOTS, "per_process": per_process, "view": cells,
             "runs": pairs, "ticks": ticks, "record_bytes": round(record_bytes(cells)),
             "ticks_per_second": round(plain, 2), "recorded_ticks_per_second": round(recorded, 2),
             "cost": round(1 - recorded / plain, 3), "bytes_per_tick": round(size / ticks),
@@ -162,9 +164,10 @@ def bench_recording(quick: bool = False, port: int = 7650) -> dict:
         rows = [_in_process(n, seeds, Path(tmp)) for n in (20, 160)]
         for i, (agents, per_process) in enumerate(((20, 10), (160, 40)) if quick else ((20, 1), (160, 10))):
             rows.append(_distributed(agents, per_process, Path(tmp), port + 2 * i, pairs, max_ticks))
-        arena_ticks = QUICK_TICKS if quick else ARENA_TICKS
+        # --quick: the largest view, one agent process, a few ticks: the path runs, nothing is timed
+        arena = {"ticks": QUICK_ARENA_TICKS, "per_process": ARENA_ROBOTS} if quick else {"ticks": ARENA_TICKS}
         for i, cells in enumerate(VIEWS[-1:] if quick else VIEWS):
-            rows.append(_arena_distributed(cells, Path(tmp), port + 4 + 2 * i, pairs, arena_ticks))
+            rows.append(_arena_distributed(cells, Path(tmp), port + 4 + 2 * i, pairs, **arena))
     return {"benchmark": "recording", "scenario": "setup1", "quick": quick, "runs": rows}
 
 

@@ -511,12 +511,15 @@ def _mean(rows: list[dict], key: str) -> float:
 
 
 def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | None, jobs: int | None, seed: int,
-                               out: Path | None, progress: bool = True) -> dict:  # fmt: skip
+                               out: Path | None, progress: bool = True,
+                               tours: tuple[str, ...] | None = None) -> dict:  # fmt: skip
+    """`tours` keeps fingerprint-localize to those of the floor's localization tours (a smoke run's one)."""
     name = scenario or "office"
     reps = reps or 3
+    chosen = tours
     tours = second_tours(tour_scenario(name, "mapping", "low", seed))  # a floor it cannot map is refused here
     if which == "fingerprint-localize":
-        tours = localization_tours(name, which)
+        tours = tuple(t for t in localization_tours(name, which) if chosen is None or t in chosen)
     out = Outputs(out, which)
     if which == "fingerprint-calibrate":
         return _calibrate(name, seed, out)
