@@ -22,7 +22,6 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import re
 import signal
 import subprocess
 import sys
@@ -412,9 +411,9 @@ def _secured(folder: Path, world_cmd: list[str], agent_cmds: list[list[str]]):
 
 
 def _router_host(listen: str) -> str:
-    """The name the router's certificate must carry: the host of --listen (less zenoh's ?metadata and #config)."""
+    """The name the router's certificate must carry: the host of --listen."""
     try:
-        return mesh.split(re.split(r"[?#]", listen, maxsplit=1)[0])[1]
+        return mesh.split(listen)[1]
     except ValueError as exc:
         raise RunError(f"--listen {exc}") from None
 

@@ -24,6 +24,7 @@ def test_a_router_links_to_every_address_but_its_own():
 
 
 def test_a_bad_mesh_endpoint_is_one_line():
+    assert split("tcp/router:7447?iface=eth0#rx_buffer_size=65536") == ("tcp", "router", 7447)  # zenoh's extras
     with pytest.raises(ValueError, match="expected PROTOCOL/NAME:PORT"):
         split("router:7447")
     out = subprocess.run([sys.executable, "-m", "swarm", "router", "--mesh", "router"], capture_output=True,

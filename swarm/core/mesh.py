@@ -12,14 +12,15 @@ reach the other nodes), and only then reads the others: the later of the two see
 
 from __future__ import annotations
 
+import re
 import socket
 import time
 from collections.abc import Callable
 
 
 def split(endpoint: str) -> tuple[str, str, int]:
-    """("tcp", "router", 7447) from "tcp/router:7447"."""
-    proto, sep, rest = endpoint.partition("/")
+    """("tcp", "router", 7447) from "tcp/router:7447" (zenoh's ?metadata and #config left out)."""
+    proto, sep, rest = re.split(r"[?#]", endpoint, maxsplit=1)[0].partition("/")
     host, colon, port = rest.rpartition(":")
     if not (sep and colon and proto and host and port.isdigit()):
         raise ValueError(f"{endpoint!r}: expected PROTOCOL/NAME:PORT, e.g. tcp/router:7447")

@@ -14,6 +14,7 @@ from __future__ import annotations
 import statistics
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -97,23 +98,31 @@ def _close_floor(agents: int, seeds: range, tmp: Path) -> float:
     return round(total * 1000 / len(seeds), 1)
 
 
-def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int, max_ticks: int) -> dict:
-    """`pairs` runs each way, alternated (plain, recorded, plain, ...), same seed:
-    the median ticks/s of each, since one lock-step run over zenoh moves by a
-    few percent on its own."""
+def _alternated(pairs: int, tmp: Path, port: int, up: Callable[[str, str, str | None], dict]):
+    """`pairs` runs each way, alternated (plain, recorded, plain, ...): `up(run_id, listen, record)` runs one,
+    same seed each time.  The median ticks/s of each way, since one lock-step run over zenoh moves by a
+    few percent on its own, and the last recorded run's file size and ticks."""
     rates: dict[bool, list[float]] = {False: [], True: []}
     size = ticks = 0
     for _ in range(pairs):
         for record in (False, True):
             run_id = f"benchrec{new_run_id()}"
             path = tmp / f"{run_id}.rrd"
-            s = swarm_up("setup1", agents, "cmarking", 1, run_id, f"tcp/127.0.0.1:{port + record}", deadline=10.0,
-                         max_iterations=max_ticks, progress=False, per_process=per_process,
-                         record=str(path) if record else None, on_loss="strict")  # fmt: skip
+            s = up(run_id, f"tcp/127.0.0.1:{port + record}", str(path) if record else None)
             rates[record].append(s["ticks_per_second"])
             if record:
                 size, ticks = path.stat().st_size, s["iterations"]
-    plain, recorded = statistics.median(rates[False]), statistics.median(rates[True])
+    return statistics.median(rates[False]), statistics.median(rates[True]), size, ticks
+
+
+def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int, max_ticks: int) -> dict:
+    """Setup 1 under `swarm up`, plain and recorded (_alternated)."""
+
+    def up(run_id: str, listen: str, record: str | None) -> dict:
+        return swarm_up("setup1", agents, "cmarking", 1, run_id, listen, deadline=10.0, max_iterations=max_ticks,
+                        progress=False, per_process=per_process, record=record, on_loss="strict")  # fmt: skip
+
+    plain, recorded, size, ticks = _alternated(pairs, tmp, port, up)
     return {"runtime": "distributed", "agents": agents, "per_process": per_process, "runs": pairs, "ticks": ticks,
             "ticks_per_second": round(plain, 2), "recorded_ticks_per_second": round(recorded, 2),
             "cost": round(1 - recorded / plain, 3), "bytes_per_tick": round(size / max(ticks, 1)),
@@ -132,21 +141,14 @@ def record_bytes(cells: int) -> float:
 
 def _arena_distributed(cells: int, tmp: Path, port: int, pairs: int, ticks: int,
                        per_process: int = ARENA_PER_PROCESS) -> dict:  # fmt: skip
-    """ARENA_ROBOTS robots of payload.py's View<cells>, lock-step, `pairs` runs each way alternated."""
-    rates: dict[bool, list[float]] = {False: [], True: []}
-    size = 0
-    for _ in range(pairs):
-        for record in (False, True):
-            run_id = f"benchrec{new_run_id()}"
-            path = tmp / f"{run_id}.rrd"
-            s = swarm_up(str(ARENA), ARENA_ROBOTS, f"swarm.bench.recording.payload:View{cells}", 1, run_id,
-                         f"tcp/127.0.0.1:{port + record}", deadline=10.0, progress=False,
-                         per_process=per_process, record=str(path) if record else None, on_loss="strict",
-                         world_args=["--max-ticks", str(ticks)])  # fmt: skip
-            rates[record].append(s["ticks_per_second"])
-            if record:
-                size = path.stat().st_size
-    plain, recorded = statistics.median(rates[False]), statistics.median(rates[True])
+    """ARENA_ROBOTS robots of payload.py's View<cells>, lock-step, plain and recorded (_alternated)."""
+
+    def up(run_id: str, listen: str, record: str | None) -> dict:
+        return swarm_up(str(ARENA), ARENA_ROBOTS, f"swarm.bench.recording.payload:View{cells}", 1, run_id, listen,
+                        deadline=10.0, progress=False, per_process=per_process, record=record, on_loss="strict",
+                        world_args=["--max-ticks", str(ticks)])  # fmt: skip
+
+    plain, recorded, size, _ = _alternated(pairs, tmp, port, up)
     return {"runtime": "arena", "agents": ARENA_ROBOTS, "per_process": per_process, "view": cells,
             "runs": pairs, "ticks": ticks, "record_bytes": round(record_bytes(cells)),
             "ticks_per_second": round(plain, 2), "recorded_ticks_per_second": round(recorded, 2),

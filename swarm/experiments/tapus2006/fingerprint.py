@@ -359,9 +359,10 @@ def second_tours(scenario) -> tuple[str, ...]:
     return tuple(t for t in LOCALIZE_TOURS if t in scenario.routes)
 
 
-def localization_tours(name: str, which: str) -> tuple[str, ...]:
-    """Floor `name`'s localization tours, for experiment `which`; a floor without one is refused in one line."""
-    tours = second_tours(tour_scenario(name, "mapping", "low", 0))
+def localization_tours(scenario, name: str, which: str) -> tuple[str, ...]:
+    """The localization tours of floor `name` (`scenario`), for experiment `which`; a floor without one is
+    refused in one line."""
+    tours = second_tours(scenario)
     if not tours:
         wanted = ", ".join(repr(t) for t in LOCALIZE_TOURS)
         raise ScenarioError(name, "routes", f"no localization tour; {which} needs one of {wanted}")
@@ -516,10 +517,9 @@ def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | Non
     """`tours` keeps fingerprint-localize to those of the floor's localization tours (a smoke run's one)."""
     name = scenario or "office"
     reps = reps or 3
-    chosen = tours
-    tours = second_tours(tour_scenario(name, "mapping", "low", seed))  # a floor it cannot map is refused here
-    if which == "fingerprint-localize":
-        tours = tuple(t for t in localization_tours(name, which) if chosen is None or t in chosen)
+    floor = tour_scenario(name, "mapping", "low", seed)  # a floor it cannot map is refused here, in one line
+    has = localization_tours(floor, name, which) if which == "fingerprint-localize" else second_tours(floor)
+    tours = tuple(t for t in has if tours is None or t in tours)
     out = Outputs(out, which)
     if which == "fingerprint-calibrate":
         return _calibrate(name, seed, out)

@@ -191,10 +191,10 @@ def _mapping(rows: Sequence[dict], kind: str = "localize"):
                       f"{false}/{len(sel)}: {_pct(S.proportion_ci(false, len(sel)))}",
                       f"{np.mean(_col(sel, 'closure_events')):.1f}",
                       _pct(S.mean_ci(_col(sel, "closure_precision"))), _links(sel)])  # fmt: skip
-        claims += [] if kind != "localize" else [P.Claim(
-                              f"noise {noise}: the map of the {paper.MAPPING_TOUR_M} m tour has {paper.NODES} nodes",
-                              f"{paper.NODES} (1 run)", f"{est.text(3)} (mean of {len(sel)} runs)",
-                              against(nodes, paper.NODES), expected=0)]  # fmt: skip
+        if kind == "localize":  # the paper's 20 nodes were its floor's
+            claims.append(P.Claim(f"noise {noise}: the map of the {paper.MAPPING_TOUR_M} m tour has {paper.NODES} "
+                                  "nodes", f"{paper.NODES} (1 run)", f"{est.text(3)} (mean of {len(sel)} runs)",
+                                  against(nodes, paper.NODES), expected=0))  # fmt: skip
     table = R.markdown_table(["noise", "runs", "nodes (95% CI)", "paper", "places with a node / visited",
                               "purity (95% CI)", "runs with a false closure (Wilson 95% CI)",
                               "loop closures a run", "closure precision (95% CI over runs)",
@@ -262,6 +262,8 @@ def _localization(rows: Sequence[dict], kind: str = "localize"):
                               "grid, pooled (Wilson)", "grid, aliased nodes right at both ends", "chance",
                               "misses with the right node 2nd/3rd"],
                              lines)  # fmt: skip
+    if kind != "localize":
+        return "", table, claims
     n = paper.LOCALIZE_FINGERPRINTS
     note = (f"\nThe paper: matching alone {paper.MATCH:.0%}, the Markov filter {paper.MARKOV:.0%}, of more than "
             f"{n} fingerprints in one run; were they independent, their Wilson intervals would be "
@@ -276,8 +278,6 @@ def _localization(rows: Sequence[dict], kind: str = "localize"):
             "and the median distance to the nearest one (`swarm experiment fingerprint-localize` gives it for "
             "`localize` too, a tour along the mapping tour's lines: docs/fingerprint.md).\n\n"
             "![per-run shares at the right node](localization.png)\n")  # fmt: skip
-    if kind != "localize":
-        return "", table, claims
     return f"Localization: the {paper.LOCALIZE_TOUR_M} m new path (ours 249 m)", table + note, claims
 
 
@@ -297,13 +297,14 @@ def _other_floor(rows: Sequence[dict]):
                               f"{r['refit_centre']}, {r['refit_width']}", f"{r['declared_balanced_accuracy']:.1%}",
                               f"{r['refit_balanced_accuracy']:.1%}", f"{r['cost_auc']:.3f}"] for r in sel])  # fmt: skip
     floor = load_scenario(OTHER_FLOOR)
+    zones = fingerprint.places(floor)
     note = (f"`{OTHER_FLOOR}` (docs/fingerprint.md) is L-shaped, 30 x 24 m, with rooms of several sizes, "
             "off-centre doors and two pairs of look-alike rooms. Every parameter of the model (the alignment's "
             "costs, the matching probability, theta, the filters' constants) was fitted or chosen on `office`; "
             "none was looked at on this floor before these runs. Its mapping tour, its new path and its places "
             "are its own; the tables and claims read as the office ones above, with its own places "
-            f"({len(fingerprint.places(floor))} place zones, {len(fingerprint.place_graph(floor))} pairs joined) and "
-            f"its largest place zone's diagonal ({fingerprint.far_apart(fingerprint.places(floor)):.1f} m) as the "
+            f"({len(zones)} place zones, {len(fingerprint.place_graph(floor))} pairs joined) and "
+            f"its largest place zone's diagonal ({fingerprint.far_apart(zones):.1f} m) as the "
             "span no one place holds. The paper's 20 nodes were its floor's; this floor has no node count to "
             "meet.\n\n"
             "**The mapping tour's maps**\n\n" + maps + "\n**Localization on its new path**\n\n" + table +

@@ -154,7 +154,8 @@ def run_robustness_experiment(which: str, scenario: str | None, reps: int | None
     unknown = [c for c in chosen if c not in CONDITIONS]
     if unknown:
         raise ValueError(f"unknown condition {unknown[0]!r}; expected one of {', '.join(CONDITIONS)}")
-    tours = localization_tours(name, which)  # a floor it cannot map, or without a second tour: one line
+    # a floor it cannot map, or without a second tour: one line
+    tours = localization_tours(tour_scenario(name, "mapping", "low", seed), name, which)
     routes = short_routes(name, waypoints, tours[0]) if waypoints else None
     seeds = range(seed, seed + reps)
     work = [(name, BASELINE, math.nan, s, routes, tours[0]) for s in seeds]
