@@ -59,6 +59,29 @@ def test_two_robots_meeting_head_on_do_not_pass_through_each_other():
     assert w.bodies.collisions.min() >= 1
 
 
+def test_collisions_are_the_contacts_chipmunk_begins_in_a_crowd():
+    """Contacts begun are read from the space after each step; a `begin` callback, Chipmunk's own
+    word for a new contact, counts the same ones, through the checkpoints' rebuilt spaces too."""
+    from swarm.bench.arena.measure import LASER_BOT, bench_world
+
+    w = bench_world(200, LASER_BOT, obstacles=20, side=10.0)
+    begun = np.zeros(w.n, np.int64)
+
+    def count(arbiter, space, data):
+        for shape in arbiter.shapes:
+            if hasattr(shape, "robot"):
+                begun[shape.robot] += 1
+
+    turn = np.linspace(-0.4, 0.4, w.n) * w.max_wheel
+    wheels = np.column_stack([0.8 * w.max_wheel - turn, 0.8 * w.max_wheel + turn])
+    for tick in range(2 * w.scenario.checkpoint + 10):
+        if tick % w.scenario.checkpoint == 0:  # a checkpoint rebuilds the space: hook the new one
+            w.bodies.space.on_collision(begin=count)
+        w.apply(wheels)
+    assert begun.sum() > 200
+    np.testing.assert_array_equal(w.bodies.collisions, begun)
+
+
 def test_bad_actions_are_counted_and_never_acted_on():
     w = _world()
     before = w.pose.copy()

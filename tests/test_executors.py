@@ -5,25 +5,24 @@ it is gone when they end."""
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import os
 import signal
-import socket
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import pytest
 
+from swarm.bench.executors.head import free_port as _free_port
+from swarm.bench.executors.head import processes as _processes
+from swarm.bench.executors.head import ray_head
 from swarm.cli import main
 from swarm.experiments.executors import LocalExecutor, RayExecutor, use
 from swarm.experiments.runner import JobFailed, batch_run
 
 ROOT = Path(__file__).resolve().parents[1]
-RAY = Path(sys.executable).with_name("ray")
 SWEEP = """scenarios = ["zmaze"]
 controller = "wander"
 seeds = [1, 2]
@@ -33,24 +32,6 @@ metrics = ["reached", "distance"]
 "wander.speed" = [0.4, 0.8]
 """
 WALL_CLOCK = {"wall_s", "wall_seconds"}  # columns of seconds taken, which no two runs share
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def _processes() -> dict[int, tuple[int, int, str]]:
-    """Every live process (zombies left out): pid -> (parent, session, command line)."""
-    found = {}
-    for name in filter(str.isdigit, os.listdir("/proc")):
-        with contextlib.suppress(OSError):
-            fields = Path(f"/proc/{name}/stat").read_text().rpartition(")")[2].split()
-            cmd = Path(f"/proc/{name}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
-            if fields[0] != "Z":
-                found[int(name)] = (int(fields[1]), int(fields[3]), cmd)
-    return found
 
 
 def _in_session(session: int):
@@ -70,28 +51,9 @@ def _none_left(which, seconds: float = 30) -> None:
 def cluster():
     """A Ray cluster of 2 CPUs on this machine, its workers importing this checkout: its address.
     At the end every process of it (its own session) is killed, and none is left running."""
-    port = _free_port()
-    temp = tempfile.mkdtemp(prefix="ray", dir="/tmp")  # short: Ray's socket paths must fit in 107 bytes
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
-    cmd = [str(RAY), "start", "--head", f"--port={port}", "--num-cpus=2", "--include-dashboard=false",
-           "--disable-usage-stats", f"--temp-dir={temp}", "--block"]  # fmt: skip
-    with open(Path(temp) / "head.log", "w") as log:
-        head = subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
-    try:
-        deadline = time.monotonic() + 60
-        while True:
-            assert head.poll() is None, (Path(temp) / "head.log").read_text()
-            with contextlib.suppress(OSError), socket.create_connection(("127.0.0.1", port), timeout=1):
-                break
-            assert time.monotonic() < deadline, "the Ray head did not open its port in 60 s"
-            time.sleep(0.2)
-        yield f"127.0.0.1:{port}"
-    finally:
-        for pid in [p for p, (_, sid, _) in _processes().items() if sid == head.pid]:
-            with contextlib.suppress(ProcessLookupError):
-                os.kill(pid, signal.SIGKILL)
-        head.wait(timeout=30)
-        _none_left(_in_session(head.pid))
+    with ray_head(2, str(ROOT)) as (address, session):
+        yield address
+    _none_left(_in_session(session))
 
 
 @pytest.fixture(autouse=True)

@@ -98,9 +98,11 @@ class DiffDrive:
             self._key(disc, self._walls + i)
             self._bodies.append(body)
             self._discs.append(disc)
-        space.on_collision(ROBOT_TYPE, WALL_TYPE, begin=self._begin)
-        space.on_collision(ROBOT_TYPE, ROBOT_TYPE, begin=self._begin)
         self.space = space
+        ids = np.array([body.id for body in self._bodies], np.int64)  # bodies' addresses: sorted, to find robots
+        self._body_order = np.argsort(ids)
+        self._body_ids = ids[self._body_order]
+        self._arbiters = pymunk.batch.Buffer()
         self._obstacles: dict[int, list] = {}
         self._force = np.zeros(2 * self.n + 2)
         self._set = pymunk.batch.Buffer()
@@ -125,11 +127,22 @@ class DiffDrive:
         self._key(shape, len(self._keyed) if key is None else key)
         return [shape]
 
-    def _begin(self, arbiter, space, data) -> None:
-        for shape in arbiter.shapes:
-            if shape.collision_type == ROBOT_TYPE:
-                self.collisions[shape.robot] += 1
-                self.contact[shape.robot] = True
+    def _count_begun(self) -> None:
+        """The contacts that began in the last step, counted per robot (a robot pair counts for both).
+        Chipmunk marks them first contacts; reading them in one batch costs what a `begin` callback
+        into Python costs for a handful (a dense crowd begins hundreds a step)."""
+        self._arbiters.clear()
+        fields = self._batch.ArbiterFields
+        self._batch.get_space_arbiters(self.space, fields.BODY_A_ID | fields.BODY_B_ID | fields.IS_FIRST_CONTACT,
+                                       self._arbiters)  # fmt: skip
+        pairs = np.frombuffer(self._arbiters.int_buf(), np.int64).reshape(-1, 3)
+        bodies = pairs[pairs[:, 2] != 0, :2].ravel()
+        if len(bodies) == 0 or self.n == 0:
+            return
+        at = np.minimum(np.searchsorted(self._body_ids, bodies), self.n - 1)
+        robots = self._body_order[at[self._body_ids[at] == bodies]]
+        np.add.at(self.collisions, robots, 1)
+        self.contact[robots] = True
 
     # ---------------------------------------------------------------- obstacles
 
@@ -168,6 +181,7 @@ class DiffDrive:
             _push(v, cos, sin, state, self.dt, self._force)
             self._batch.set_space_bodies(self.space, self._batch.BodyFields.FORCE, self._set)
             self.space.step(self.dt)
+            self._count_begun()
             for i in pinned_at:
                 self._bodies[i].position = (float(pinned_at[i][0]), float(pinned_at[i][1]))
                 self._bodies[i].velocity = (0.0, 0.0)
