@@ -11,7 +11,7 @@ from pathlib import Path
 from agents.controllers import CONTROLLERS as CONTROLLER_REGISTRY
 from swarm.cli_check import add_check_parsers
 from swarm.cli_reproduce import add_reproduce_parser, cmd_reproduce
-from swarm.cli_secure import add_credentials_parser, credentials_arg, identity, up_args
+from swarm.cli_secure import add_credentials_parser, agent_identity, credentials_arg, identity, up_args
 from swarm.cli_sweep import add_sweep_parser
 from swarm.core.errors import RecordingError, RunError, ScenarioError, StateError, raise_interrupt
 from swarm.core.registry import Option, Registry, resolve
@@ -379,7 +379,9 @@ def _client_args(p: argparse.ArgumentParser) -> None:
     """Where a client of a running world finds it: agents, monitor, status."""
     p.add_argument("--connect", default="tcp/127.0.0.1:7447", metavar="ENDPOINT", help="the router")
     p.add_argument("--run-id", default="default", help="the world's run id (default: default)")
-    credentials_arg(p, "`agent<i>` for agent process i, `monitor` for monitor and status")
+    credentials_arg(
+        p, "`agent<i>` for agent process i, or DIR/agent-pool to claim a free one; `monitor` for monitor and status"
+    )
 
 
 def _tick_args(p: argparse.ArgumentParser) -> None:
@@ -494,7 +496,7 @@ def cmd_agent(args) -> int:
     try:
         runtime = make_runtime(args.run_id, args.controller, args.connect, args.count, null=args.null,
                                join_timeout=args.join_timeout, on_error=args.on_controller_error,
-                               ids_file=args.ids_file, identity=identity(args))  # fmt: skip
+                               ids_file=args.ids_file, identity=agent_identity(args))  # fmt: skip
     except JoinRefused as exc:
         print(f"swarm: {exc}", file=sys.stderr)
         return 0 if ENDED in str(exc) else 2  # a late agent of a finished run has nothing to do

@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 
-from swarm.core.credentials import Identity, load
+from swarm.core.credentials import POOL, Identity, claim, is_pool, load
 from swarm.core.tables import positive
 
 ENV = "SWARM_CREDENTIALS"  # the default of --credentials: a container gets its folder without a new command
@@ -21,6 +22,15 @@ def credentials_arg(p: argparse.ArgumentParser, who: str) -> None:
 def identity(args: argparse.Namespace) -> Identity | None:
     """The identity `--credentials` names, or None (a plain run)."""
     return load(args.credentials) if args.credentials else None
+
+
+def agent_identity(args: argparse.Namespace) -> Identity | None:
+    """An agent process's identity: the folder `--credentials` names, or one claimed from a pool."""
+    if args.credentials and is_pool(args.credentials):
+        claimed = claim(args.credentials)
+        print(f"swarm: this agent process is {claimed.name} (claimed from {args.credentials})", file=sys.stderr)
+        return claimed
+    return identity(args)
 
 
 def up_args(p: argparse.ArgumentParser) -> None:
@@ -51,12 +61,16 @@ def add_credentials_parser(sub) -> None:
                       help="also an `agents` identity for identical replicas (compose --scale): any of them "
                       "may put on any agent process's keys; the world still refuses actions for another's "
                       "agents")  # fmt: skip
+    made.add_argument("--pool", action="store_true",
+                      help="put agent1..agentN in DIR/agent-pool, for identical replicas (compose --scale) to "
+                      "claim one each: mount the pool into every agent container")  # fmt: skip
     made.set_defaults(handler=cmd_credentials)
 
 
 def cmd_credentials(args: argparse.Namespace) -> int:
     from swarm.core.credentials import make
 
-    folder = make(args.dir, args.agent_processes, tuple(args.host), args.shared_agents)
-    print(f"swarm: credentials for {args.agent_processes} agent processes in {folder}")
+    folder = make(args.dir, args.agent_processes, tuple(args.host), args.shared_agents, args.pool)
+    where = f" (agents in {folder / POOL})" if args.pool else ""
+    print(f"swarm: credentials for {args.agent_processes} agent processes in {folder}{where}")
     return 0

@@ -119,6 +119,33 @@ def test_compose_up_swarm_runs_to_the_end_and_records(compose):
     print(f"docker compose up swarm (images built): {took:.1f} s")
 
 
+def test_compose_secure_over_tls_gives_each_agent_replica_its_own_identity(compose, tmp_path):
+    """compose.secure.yaml with LINK=tls: every link TLS with the run's certificates, the replicas each
+    claim an identity of the pool, and the run ends as the plain one above."""
+    from swarm.core import credentials
+
+    creds = credentials.make(tmp_path / "creds", 3, hosts=("router",), pool=True)
+    run_id = f"secure{uuid.uuid4().hex[:6]}"
+    compose.env.update(RUN_ID=run_id, SCENARIO="open", SEED="1", AGENTS="3", MAX_AGENTS="3", LINK="tls",
+                       CREDENTIALS=str(creds))  # fmt: skip
+    secure = ("-f", "compose.yaml", "-f", "compose.secure.yaml")
+    try:
+        up = compose(*secure, "up", "--scale", "agent=3", "swarm", timeout=600, check=False)
+        log = compose(*secure, "logs", "--no-color", "swarm").stdout
+        agents = compose(*secure, "logs", "--no-color", "agent").stdout
+        assert compose.exit_code("swarm") == 0, up.stdout[-3000:] + up.stderr[-3000:] + log + agents[-3000:]
+        assert "open: cmarking x3, seed 1: finished after 2367 iterations" in log, log  # = the plain run
+        assert "agents joined 3 (at most 3 at once), lost 0" in log, log
+        claimed = {line.split(" is ")[1].split()[0] for line in agents.splitlines() if "this agent process is" in line}
+        assert claimed == {"agent1", "agent2", "agent3"}, agents[-3000:]
+    finally:
+        compose(*secure, "down", "--remove-orphans", "--timeout", "5", check=False, timeout=300)
+        for key in ("LINK", "CREDENTIALS"):
+            compose.env.pop(key, None)
+        for recording in (ROOT / "runs").glob(f"{run_id}-*.rrd"):
+            recording.unlink()
+
+
 def test_compose_runs_an_arena_with_the_carrot_controller(compose):
     """SCENARIO=zmaze CONTROLLER=carrot docker compose up swarm: 64 slots, the 2 agents that join drive."""
     run_id = f"arena{uuid.uuid4().hex[:6]}"

@@ -182,3 +182,60 @@ def test_swarm_up_secure_with_an_endpoint_it_cannot_read_is_one_line(tmp_path):
     assert up.stderr.strip().splitlines() == [
         "swarm: error: --listen 'garbage': expected PROTOCOL/NAME:PORT, e.g. tcp/router:7447"
     ]
+
+
+CLAIM = ("import sys\nfrom swarm.core.credentials import claim\nprint(claim(sys.argv[1]).name, flush=True)\n"
+         "sys.stdin.read()\n")  # holds its identity until its stdin closes  # fmt: skip
+
+
+def _claimer(pool: Path) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-c", CLAIM, str(pool)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+
+
+def test_replicas_claim_an_identity_each_and_a_killed_ones_is_free_again(tmp_path):
+    pool = credentials.make(tmp_path, 2, pool=True) / credentials.POOL
+    assert not (tmp_path / agent_name(1)).exists() and (pool / agent_name(2) / "key.pem").is_file()
+    assert pool.stat().st_mode & 0o777 == 0o700 and credentials.is_pool(pool)
+    first = _claimer(pool)
+    killed = first.stdout.readline().strip()
+    second = _claimer(pool)
+    kept = second.stdout.readline().strip()
+    assert {killed, kept} == {agent_name(1), agent_name(2)}
+    third = _claimer(pool)
+    assert third.wait(timeout=60) == 1
+    assert third.stderr.read().strip().splitlines()[-1] == (
+        f"swarm.core.credentials.CredentialsError: {pool}: all 2 agent identities are held by running processes; "
+        "make a bigger pool with `swarm credentials DIR --pool --agent-processes N`"
+    )
+    first.kill()  # kill -9: the kernel lets its lock go
+    first.wait(timeout=30)
+    fourth = _claimer(pool)
+    try:
+        assert fourth.stdout.readline().strip() == killed
+    finally:
+        for p in (second, fourth):
+            p.stdin.close()
+            p.wait(timeout=30)
+
+
+def test_replicas_from_a_pool_run_a_secure_run_as_the_engine(tmp_path):
+    """Identical `swarm agent --credentials POOL` commands, as compose's replicas run them."""
+    creds = credentials.make(tmp_path, 2, pool=True)
+    scenario = load_scenario("setup2").with_overrides(agents=2, seed=5)
+    expected = Engine(scenario).run().summary
+    endpoint = free_endpoint()
+    world = ServerThread(scenario, "pool", endpoint, deadline=10.0, identity=identity_in(creds, ROUTER)).start()
+    cmd = [sys.executable, "-m", "swarm", "agent", "--connect", endpoint, "--run-id", "pool", "--controller",
+           scenario.controller, "--credentials", str(creds / credentials.POOL)]  # fmt: skip
+    procs = [subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for _ in range(2)]
+    try:
+        summary = world.join(timeout=120)
+        for p in procs:
+            assert p.wait(timeout=30) == 0, p.stderr.read().decode()[-2000:]
+    finally:
+        stop(procs)
+        world.close()
+    assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
+    for key in ("iterations", "delivered", "total", "finished", "explored_cells"):
+        assert summary[key] == expected[key], key

@@ -16,6 +16,13 @@ the name is also its message group, so the router's rules can name its keys)
 and, made only on request, `agents`: one identity shared by identical
 replicas that cannot each be handed their own (compose's `--scale`).
 
+Identical replicas can instead claim one each from a pool, DIR/agent-pool/agent<i>
+(`make(..., pool=True)`): a process that is handed the pool takes the first
+identity no live process holds (a lock on its file, which the kernel lets go
+when the process dies, however it dies) and keeps it for its life.  Each
+replica then puts only on its own keys; every replica can read the whole pool,
+so a replica that is itself hostile could still log in as another.
+
 Passwords and keys come from the operating system's randomness, never from
 the run's seed: a seed is public, a credential must not be derivable from it.
 """
@@ -33,6 +40,7 @@ from pathlib import Path
 from swarm.core.errors import RunError
 
 ROUTER, WORLD, MONITOR, SHARED_AGENTS = "router", "world", "monitor", "agents"
+POOL = "agent-pool"  # the agent identities of `make(..., pool=True)`, for replicas to claim
 LOCAL_HOSTS = ("localhost", "127.0.0.1", "::1")
 VALID_DAYS = 30
 
@@ -101,26 +109,64 @@ def load(folder: str | Path) -> Identity:
     return Identity(str(name), str(password), folder)
 
 
+_claimed: list[int] = []  # the claimed identities' locked files, open for the life of the process
+
+
+def is_pool(folder: str | Path) -> bool:
+    """Whether `folder` holds agent identities to claim (DIR/agent-pool), not one identity."""
+    folder = Path(folder)
+    return not (folder / "identity.json").exists() and any(_pool_members(folder))
+
+
+def _pool_members(folder: Path) -> list[Path]:
+    found = [p for p in folder.glob("agent*") if p.name[len("agent") :].isdigit() and (p / "identity.json").is_file()]
+    return sorted(found, key=lambda p: int(p.name[len("agent") :]))
+
+
+def claim(pool: str | Path) -> Identity:
+    """The first identity of `pool` that no live process holds, now held by this one until it exits;
+    a one-line CredentialsError when every one is held."""
+    import fcntl
+
+    members = _pool_members(Path(pool))
+    for folder in members:
+        fd = os.open(folder / "identity.json", os.O_RDONLY)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue
+        _claimed.append(fd)
+        return load(folder)
+    raise CredentialsError(f"{pool}: all {len(members)} agent identities are held by running processes; make a "
+                           "bigger pool with `swarm credentials DIR --pool --agent-processes N`")  # fmt: skip
+
+
 def identity_in(run_folder: str | Path, name: str) -> Identity:
     """The identity `name` of a run's credentials folder (as `make` writes it)."""
     return load(Path(run_folder) / name)
 
 
-def make(folder: str | Path, agent_processes: int, hosts: tuple[str, ...] = (), shared_agents: bool = False) -> Path:
+def make(folder: str | Path, agent_processes: int, hosts: tuple[str, ...] = (), shared_agents: bool = False,
+         pool: bool = False) -> Path:  # fmt: skip
     """Write a run's credentials into `folder` (made, and left private to this user): a CA, the
-    router's certificate for `hosts` and this machine's loopback names, and one identity per process."""
+    router's certificate for `hosts` and this machine's loopback names, and one identity per process
+    (the agent processes' in `folder`/agent-pool with `pool`)."""
     from cryptography.hazmat.primitives.asymmetric import ec
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-    names = [ROUTER, WORLD, MONITOR, *(agent_name(i) for i in range(1, agent_processes + 1))]
+    agents = [agent_name(i) for i in range(1, agent_processes + 1)]
+    names = [ROUTER, WORLD, MONITOR, *agents]
     names += [SHARED_AGENTS] if shared_agents else []
     ca_key = ec.generate_private_key(ec.SECP256R1())
     ca_cert = _certificate("swarm run CA", ca_key.public_key(), ca_key, None, ca=True)
     ca_pem = _pem(ca_cert)
     passwords = {name: secrets.token_urlsafe(24) for name in names}
+    if pool:
+        (folder / POOL).mkdir(exist_ok=True, mode=0o700)
     for name in names:
-        where = folder / name
+        where = (folder / POOL if pool and name in agents else folder) / name
         where.mkdir(exist_ok=True, mode=0o700)
         key = ec.generate_private_key(ec.SECP256R1())
         sans = (*LOCAL_HOSTS, *hosts) if name == ROUTER else ()
