@@ -7,10 +7,11 @@ import argparse
 import os
 import sys
 
-from swarm.core.credentials import POOL, Identity, claim, is_pool, load
+from swarm.core.credentials import POOL, CredentialsError, Identity, claim, is_pool, load
 from swarm.core.tables import positive
 
 ENV = "SWARM_CREDENTIALS"  # the default of --credentials: a container gets its folder without a new command
+SLOT_ENV = "SWARM_AGENT_SLOT"  # a replica's number (Docker Swarm's {{.Task.Slot}}): its identity in a pool
 
 
 def credentials_arg(p: argparse.ArgumentParser, who: str) -> None:
@@ -27,7 +28,10 @@ def identity(args: argparse.Namespace) -> Identity | None:
 def agent_identity(args: argparse.Namespace) -> Identity | None:
     """An agent process's identity: the folder `--credentials` names, or one claimed from a pool."""
     if args.credentials and is_pool(args.credentials):
-        claimed = claim(args.credentials)
+        slot = os.environ.get(SLOT_ENV) or None
+        if slot is not None and not slot.isdigit():
+            raise CredentialsError(f"${SLOT_ENV} is {slot!r}: expected the replica's number, e.g. {{{{.Task.Slot}}}}")
+        claimed = claim(args.credentials, None if slot is None else int(slot))
         print(f"swarm: this agent process is {claimed.name} (claimed from {args.credentials})", file=sys.stderr)
         return claimed
     return identity(args)

@@ -18,6 +18,7 @@ import time
 from swarm.core import wire
 from swarm.core.bus import open_client, open_router
 from swarm.core.credentials import Identity
+from swarm.core.errors import RunError
 from swarm.core.mesh import others
 from swarm.core.wire import world_info
 from world_server import progress_keys
@@ -41,6 +42,9 @@ def status(connect: str, run_id: str, router_only: bool = False, timeout: float 
 def serve_router(listen: str, identity: Identity | None = None, mesh: tuple[str, ...] = ()) -> None:
     """A bare zenoh router until SIGTERM or Ctrl-C; with `identity` (the `router` folder) it checks
     logins and enforces the access rules; linked to every other router each `mesh` name lists."""
+    if identity is not None and mesh and not all(e.startswith("tls/") for e in (listen, *mesh)):
+        raise RunError("a secure mesh of routers needs TLS links, which show each router's certificate: give "
+                       "--listen tls/... and --mesh tls/...")  # fmt: skip
     routers = [found for name in mesh for found in others(name)]
     session = open_router(listen, identity, routers)
     stop = threading.Event()

@@ -119,6 +119,11 @@ def test_compose_up_swarm_runs_to_the_end_and_records(compose):
     print(f"docker compose up swarm (images built): {took:.1f} s")
 
 
+def _claimed(log: str) -> list[str]:
+    """The identities agent replicas say they took from a pool (`swarm agent`'s first line), sorted."""
+    return sorted(line.split(" is ")[1].split()[0] for line in log.splitlines() if "this agent process is" in line)
+
+
 def test_compose_secure_over_tls_gives_each_agent_replica_its_own_identity(compose, tmp_path):
     """compose.secure.yaml with LINK=tls: every link TLS with the run's certificates, the replicas each
     claim an identity of the pool, and the run ends as the plain one above."""
@@ -136,8 +141,7 @@ def test_compose_secure_over_tls_gives_each_agent_replica_its_own_identity(compo
         assert compose.exit_code("swarm") == 0, up.stdout[-3000:] + up.stderr[-3000:] + log + agents[-3000:]
         assert "open: cmarking x3, seed 1: finished after 2367 iterations" in log, log  # = the plain run
         assert "agents joined 3 (at most 3 at once), lost 0" in log, log
-        claimed = {line.split(" is ")[1].split()[0] for line in agents.splitlines() if "this agent process is" in line}
-        assert claimed == {"agent1", "agent2", "agent3"}, agents[-3000:]
+        assert _claimed(agents) == ["agent1", "agent2", "agent3"], agents[-3000:]
     finally:
         compose(*secure, "down", "--remove-orphans", "--timeout", "5", check=False, timeout=300)
         for key in ("LINK", "CREDENTIALS"):
@@ -270,34 +274,54 @@ def _stack_down(stack: str, nodes: Nodes) -> None:
     docker("volume", "rm", f"{stack}_state", check=False)
 
 
-def test_stack_deploy_runs_on_two_nodes_as_compose_does(swarm_nodes, tmp_path):
+def _stack_run(nodes: Nodes, tmp_path, files: tuple[str, ...], **settings: str) -> dict[str, str]:
+    """Deploy `files` (stack.yaml first) as a stack of its own for a run of `open` with 3 agents, check what
+    every deployment must give (the compose run's result, a router on each node, the world on the labelled
+    one, agents on both, the recording), tear it down: the services' logs, by service."""
     stack, run_id = f"swarmstack{uuid.uuid4().hex[:6]}", f"stack{uuid.uuid4().hex[:6]}"
     ports = {name: free_endpoint().rsplit(":", 1)[1] for name in ("ROUTER_PORT", "VIEWER_PORT", "GRPC_PORT")}
     env = {**os.environ, **ports, "IMAGE": "swarm:local", "RUN_ID": run_id, "SCENARIO": "open", "SEED": "1",
-           "AGENTS": "3", "MAX_AGENTS": "3", "RUNS": str(tmp_path)}  # fmt: skip
+           "AGENTS": "3", "MAX_AGENTS": "3", "RUNS": str(tmp_path), **settings}  # fmt: skip
     started = time.monotonic()
     try:
-        docker("stack", "deploy", "--detach=true", "--resolve-image", "never", "-c", "stack.yaml", stack, cwd=ROOT,
+        compose_files = [arg for f in files for arg in ("-c", f)]
+        docker("stack", "deploy", "--detach=true", "--resolve-image", "never", *compose_files, stack, cwd=ROOT,
                env=env)  # fmt: skip
         done = _finished(f"{stack}_swarm", timeout=300)
         took = time.monotonic() - started
-        log = _logs(f"{stack}_swarm")
+        logs = {service: _logs(f"{stack}_{service}") for service in ("swarm", "router", "world", "agent")}
+        log = logs["swarm"]
         if not done:
             for service in ("router", "world", "agent"):
-                print(_logs(f"{stack}_{service}")[-3000:])
+                print(logs[service][-3000:])
         assert done, f"the monitor did not finish: {log[-3000:]}"
         assert "open: cmarking x3, seed 1: finished after 2367 iterations" in log, log  # = swarm run, = compose
         assert "delivered 6000/6000" in log and "agents joined 3 (at most 3 at once), lost 0" in log, log
-        assert _task_nodes(f"{stack}_router") == {swarm_nodes.manager, swarm_nodes.worker}  # global: one each
-        assert _task_nodes(f"{stack}_world") == {swarm_nodes.manager}  # the labelled node
-        assert _task_nodes(f"{stack}_agent") == {swarm_nodes.manager, swarm_nodes.worker}
-        routers = _logs(f"{stack}_router")
-        assert "linked to tcp/" in routers, routers  # the later router found the earlier one by name
+        assert _task_nodes(f"{stack}_router") == {nodes.manager, nodes.worker}  # global: one each
+        assert _task_nodes(f"{stack}_world") == {nodes.manager}  # the labelled node
+        assert _task_nodes(f"{stack}_agent") == {nodes.manager, nodes.worker}
         (recording,) = tmp_path.glob(f"{run_id}-*.rrd")
         from swarm.review.report import read_recording, summary_from
 
         summary = summary_from(read_recording(recording))
         assert (summary["iterations"], summary["delivered"], summary["agents_peak"]) == (2367, 6000, 3)
-        print(f"docker stack deploy on two nodes, to the summary: {took:.1f} s")
+        print(f"docker stack deploy {' '.join(compose_files)} on two nodes, to the summary: {took:.1f} s")
+        return logs
     finally:
-        _stack_down(stack, swarm_nodes)
+        _stack_down(stack, nodes)
+
+
+def test_stack_deploy_runs_on_two_nodes_as_compose_does(swarm_nodes, tmp_path):
+    logs = _stack_run(swarm_nodes, tmp_path, ("stack.yaml",))
+    assert "linked to tcp/" in logs["router"], logs["router"]  # the later router found the earlier one by name
+
+
+def test_a_secure_stack_over_tls_links_its_routers_and_gives_each_replica_its_own_identity(swarm_nodes, tmp_path):
+    """stack.secure.yaml: the routers of both nodes check logins and rules and know each other by the run's
+    router certificate; replica N of the agents is the pool's agentN (its task slot)."""
+    from swarm.core import credentials
+
+    creds = credentials.make(tmp_path / "creds", 3, hosts=("host.docker.internal",), pool=True)
+    logs = _stack_run(swarm_nodes, tmp_path, ("stack.yaml", "stack.secure.yaml"), LINK="tls", CREDENTIALS=str(creds))
+    assert "linked to tls/" in logs["router"], logs["router"]
+    assert _claimed(logs["agent"]) == ["agent1", "agent2", "agent3"], logs["agent"][-3000:]

@@ -7,6 +7,7 @@ world's; a secure run ends exactly as a plain one."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -50,6 +51,27 @@ class Heard:
         time.sleep(wait)
         with self.lock:
             return set(self.keys)
+
+
+STAY = np.array([[4, 0, 0, 0, 0, 0, 0, 0]], dtype=np.int64)
+
+
+def _ends_as_the_engine(world: ServerThread, procs: list, expected: dict, closing=(), meanwhile=lambda: None) -> None:
+    """`meanwhile()`, then the world's run and its agent processes end well, with the engine's result and
+    nothing refused; the processes and sessions (`closing`) are stopped either way."""
+    try:
+        meanwhile()
+        summary = world.join(timeout=120)
+        for p in procs:
+            assert p.wait(timeout=30) == 0, p.stderr.read().decode()[-2000:]
+    finally:
+        for session in closing:
+            session.close()
+        stop(procs)
+        world.close()
+    assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
+    for key in ("iterations", "delivered", "total", "finished", "explored_cells"):
+        assert summary[key] == expected[key], key
 
 
 def _wrong_password(creds: Path, tmp_path: Path) -> credentials.Identity:
@@ -131,21 +153,13 @@ def test_a_secure_world_never_sees_a_forged_action_and_ends_as_the_engine(creds)
     world = ServerThread(scenario, "sec", endpoint, deadline=10.0, identity=identity_in(creds, ROUTER)).start()
     procs = start_agents(endpoint, "sec", scenario.controller, 2, credentials=creds)
     forger = open_client(endpoint, timeout=30.0, identity=identity_in(creds, agent_name(3)))  # a spare process
-    try:
-        stay = np.array([[4, 0, 0, 0, 0, 0, 0, 0]], dtype=np.int64)
+
+    def forge() -> None:
         for _ in range(200):  # a plain run counts each: "names an agent of another process"
-            forger.put(KEYS.act(agent_name(1)), proto.actions(0, [0], stay, [False]))
+            forger.put(KEYS.act(agent_name(1)), proto.actions(0, [0], STAY, [False]))
             forger.put(KEYS.act(agent_name(2)), b"\x00\xffgarbage")
-        summary = world.join(timeout=120)
-        for p in procs:
-            assert p.wait(timeout=30) == 0, p.stderr.read().decode()[-2000:]
-    finally:
-        forger.close()
-        stop(procs)
-        world.close()
-    assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
-    for key in ("iterations", "delivered", "total", "finished", "explored_cells"):
-        assert summary[key] == expected[key], key
+
+    _ends_as_the_engine(world, procs, expected, closing=(forger,), meanwhile=forge)
 
 
 def test_swarm_up_secure_over_tls_ends_as_the_engine(tmp_path):
@@ -184,13 +198,14 @@ def test_swarm_up_secure_with_an_endpoint_it_cannot_read_is_one_line(tmp_path):
     ]
 
 
-CLAIM = ("import sys\nfrom swarm.core.credentials import claim\nprint(claim(sys.argv[1]).name, flush=True)\n"
+CLAIM = ("import sys\nfrom swarm.core.credentials import claim\n"
+         "print(claim(sys.argv[1], *map(int, sys.argv[2:])).name, flush=True)\n"
          "sys.stdin.read()\n")  # holds its identity until its stdin closes  # fmt: skip
 
 
-def _claimer(pool: Path) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-c", CLAIM, str(pool)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+def _claimer(pool: Path, *slot: int) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-c", CLAIM, str(pool), *map(str, slot)], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
 
 
 def test_replicas_claim_an_identity_each_and_a_killed_ones_is_free_again(tmp_path):
@@ -219,6 +234,28 @@ def test_replicas_claim_an_identity_each_and_a_killed_ones_is_free_again(tmp_pat
             p.wait(timeout=30)
 
 
+def test_a_numbered_replica_takes_its_own_identity_or_says_why_not(tmp_path):
+    """Across hosts no lock is shared: replica N (Docker Swarm's task slot) is the pool's agentN."""
+    pool = credentials.make(tmp_path, 2, pool=True) / credentials.POOL
+    second = _claimer(pool, 2)
+    try:
+        assert second.stdout.readline().strip() == agent_name(2)
+        for slot, why in ((2, f"{agent_name(2)} is held by another running process (replica 2 twice?)"),
+                          (3, f"no identity {agent_name(3)} for replica 3")):  # fmt: skip
+            refused = _claimer(pool, slot)
+            assert refused.wait(timeout=60) == 1 and why in refused.stderr.read()
+    finally:
+        second.stdin.close()
+        second.wait(timeout=30)
+    bad = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(pool), "--connect",
+                          free_endpoint()], capture_output=True, text=True, timeout=60,
+                         env={**os.environ, "SWARM_AGENT_SLOT": "x"})  # fmt: skip
+    assert bad.returncode == 2
+    assert bad.stderr.strip().splitlines() == [
+        "swarm: error: $SWARM_AGENT_SLOT is 'x': expected the replica's number, e.g. {{.Task.Slot}}"
+    ]
+
+
 def test_replicas_from_a_pool_run_a_secure_run_as_the_engine(tmp_path):
     """Identical `swarm agent --credentials POOL` commands, as compose's replicas run them."""
     creds = credentials.make(tmp_path, 2, pool=True)
@@ -229,13 +266,33 @@ def test_replicas_from_a_pool_run_a_secure_run_as_the_engine(tmp_path):
     cmd = [sys.executable, "-m", "swarm", "agent", "--connect", endpoint, "--run-id", "pool", "--controller",
            scenario.controller, "--credentials", str(creds / credentials.POOL)]  # fmt: skip
     procs = [subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for _ in range(2)]
-    try:
-        summary = world.join(timeout=120)
-        for p in procs:
-            assert p.wait(timeout=30) == 0, p.stderr.read().decode()[-2000:]
-    finally:
-        stop(procs)
-        world.close()
-    assert summary["rejected_messages"] == 0 and summary["agents_lost"] == 0
-    for key in ("iterations", "delivered", "total", "finished", "explored_cells"):
-        assert summary[key] == expected[key], key
+    _ends_as_the_engine(world, procs, expected)
+
+
+def test_a_run_across_two_secure_routers_over_tls_ends_as_the_engine(creds):
+    """The world hosts router A; router B, meshed to A over TLS, serves the agent processes (a second
+    host's router): each router lets in only what its rules allow, and they carry the rest to each other."""
+    scenario = load_scenario("setup2").with_overrides(agents=2, seed=13)
+    expected = Engine(scenario).run().summary
+    near, far = (free_endpoint().replace("tcp/", "tls/") for _ in range(2))
+    world = ServerThread(scenario, "sec", near, deadline=10.0, identity=identity_in(creds, ROUTER)).start()
+    second = open_router(far, identity_in(creds, ROUTER), connect=[near])
+    procs = start_agents(far, "sec", scenario.controller, 2, credentials=creds)
+    forger = open_client(far, timeout=30.0, identity=identity_in(creds, agent_name(3)))
+
+    def forge() -> None:
+        for _ in range(200):  # refused at router B: never crosses to A
+            forger.put(KEYS.act(agent_name(1)), proto.actions(0, [0], STAY, [False]))
+
+    _ends_as_the_engine(world, procs, expected, closing=(forger, second), meanwhile=forge)
+
+
+def test_a_secure_mesh_over_plain_tcp_is_refused_in_one_line(creds):
+    router = subprocess.run([sys.executable, "-m", "swarm", "router", "--listen", free_endpoint(), "--mesh",
+                             "tcp/router:7447", "--credentials", str(creds / ROUTER)],
+                            capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert router.returncode == 2
+    assert router.stderr.strip().splitlines() == [
+        "swarm: error: a secure mesh of routers needs TLS links, which show each router's certificate: give "
+        "--listen tls/... and --mesh tls/..."
+    ]

@@ -7,6 +7,12 @@ itself), subscribes only to its own observations, and may ask the world's
 queryables (join, info, shared spaces) and declare liveliness tokens.  The
 world may do anything in the run's key space; a monitor only reads.  Rules
 name every run (`swarm/*/...`), so one router serves any run id.
+
+Routers meshed over TLS forward to each other whatever their own rules let in:
+each router checks the processes that log in to it, and a peer is known by the
+`router` certificate of the run's CA.  That certificate is the only way to know
+it: a link a router opens carries no login to the router that opened it, so a
+mesh of secure routers needs `tls/` links.
 """
 
 from __future__ import annotations
@@ -45,7 +51,7 @@ def _agent(name: str, group: str) -> list[dict]:
 
 
 def _rules_of(name: str) -> list[dict]:
-    if name == credentials.WORLD:
+    if name in (credentials.WORLD, credentials.ROUTER):  # a peer router carries what its own rules let in
         return [_rule(f"{name}-all", WORLD_MESSAGES, ["ingress", "egress"], [f"{ANY.prefix}/**"])]
     if name == credentials.MONITOR:
         return [_rule(f"{name}-subscribe", ["declare_subscriber"], ["ingress"], [ANY.state]),
@@ -59,14 +65,15 @@ def _rules_of(name: str) -> list[dict]:
 
 def access_control(users: list[str], tls: bool) -> dict:
     """zenoh's `access_control` section for these users; over TLS a subject must also show the
-    certificate of its name (both must match: a password alone, or a certificate alone, is not enough)."""
+    certificate of its name (both must match: a password alone, or a certificate alone, is not enough),
+    save a peer router, known by its certificate alone (module docstring)."""
     rules, subjects, policies = [], [], []
     for name in users:
         mine = _rules_of(name)
         if not mine:
             continue
         rules += mine
-        subject = {"id": name, "usernames": [name]}
+        subject: dict = {"id": name} if tls and name == credentials.ROUTER else {"id": name, "usernames": [name]}
         if tls:
             subject["cert_common_names"] = [name]
         subjects.append(subject)

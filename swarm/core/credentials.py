@@ -19,7 +19,9 @@ replicas that cannot each be handed their own (compose's `--scale`).
 Identical replicas can instead claim one each from a pool, DIR/agent-pool/agent<i>
 (`make(..., pool=True)`): a process that is handed the pool takes the first
 identity no live process holds (a lock on its file, which the kernel lets go
-when the process dies, however it dies) and keeps it for its life.  Each
+when the process dies, however it dies) and keeps it for its life; a replica
+an orchestrator numbers (Docker Swarm's task slot, $SWARM_AGENT_SLOT) takes
+agent<slot>, as locks do not reach across hosts.  Each
 replica then puts only on its own keys; every replica can read the whole pool,
 so a replica that is itself hostile could still log in as another.
 
@@ -123,12 +125,18 @@ def _pool_members(folder: Path) -> list[Path]:
     return sorted(found, key=lambda p: int(p.name[len("agent") :]))
 
 
-def claim(pool: str | Path) -> Identity:
-    """The first identity of `pool` that no live process holds, now held by this one until it exits;
-    a one-line CredentialsError when every one is held."""
+def claim(pool: str | Path, slot: int | None = None) -> Identity:
+    """The first identity of `pool` that no live process holds, now held by this one until it exits
+    (`slot`: agent<slot> alone, as an orchestrator numbers its replicas); a one-line CredentialsError
+    when none is free."""
     import fcntl
 
     members = _pool_members(Path(pool))
+    if slot is not None:
+        members = [m for m in members if m.name == agent_name(slot)]
+        if not members:
+            raise CredentialsError(f"{pool}: no identity {agent_name(slot)} for replica {slot}; make a bigger "
+                                   "pool with `swarm credentials DIR --pool --agent-processes N`")  # fmt: skip
     for folder in members:
         fd = os.open(folder / "identity.json", os.O_RDONLY)
         try:
@@ -138,6 +146,9 @@ def claim(pool: str | Path) -> Identity:
             continue
         _claimed.append(fd)
         return load(folder)
+    if slot is not None:
+        raise CredentialsError(f"{pool}: {agent_name(slot)} is held by another running process (replica {slot} "
+                               "twice?)")  # fmt: skip
     raise CredentialsError(f"{pool}: all {len(members)} agent identities are held by running processes; make a "
                            "bigger pool with `swarm credentials DIR --pool --agent-processes N`")  # fmt: skip
 
