@@ -28,6 +28,7 @@ from tests.distributed import ServerThread, free_endpoint, start_agents, stop
 from world_server.grid.face import wire as proto
 
 KEYS = Keys("sec")
+COLD_START = 240.0  # s the world waits for its agents: a cold cache compiles their kernels first, under load
 
 
 @pytest.fixture(scope="module")
@@ -61,7 +62,7 @@ def _ends_as_the_engine(world: ServerThread, procs: list, expected: dict, closin
     nothing refused; the processes and sessions (`closing`) are stopped either way."""
     try:
         meanwhile()
-        summary = world.join(timeout=120)
+        summary = world.join(timeout=COLD_START + 120)
         for p in procs:
             assert p.wait(timeout=30) == 0, p.stderr.read().decode()[-2000:]
     finally:
@@ -150,7 +151,8 @@ def test_a_secure_world_never_sees_a_forged_action_and_ends_as_the_engine(creds)
     engine = Engine(scenario)
     expected = engine.run().summary
     endpoint = free_endpoint()
-    world = ServerThread(scenario, "sec", endpoint, deadline=10.0, identity=identity_in(creds, ROUTER)).start()
+    world = ServerThread(scenario, "sec", endpoint, deadline=10.0, start_timeout=COLD_START,
+                         identity=identity_in(creds, ROUTER)).start()  # fmt: skip
     procs = start_agents(endpoint, "sec", scenario.controller, 2, credentials=creds)
     forger = open_client(endpoint, timeout=30.0, identity=identity_in(creds, agent_name(3)))  # a spare process
 
@@ -262,7 +264,8 @@ def test_replicas_from_a_pool_run_a_secure_run_as_the_engine(tmp_path):
     scenario = load_scenario("setup2").with_overrides(agents=2, seed=5)
     expected = Engine(scenario).run().summary
     endpoint = free_endpoint()
-    world = ServerThread(scenario, "pool", endpoint, deadline=10.0, identity=identity_in(creds, ROUTER)).start()
+    world = ServerThread(scenario, "pool", endpoint, deadline=10.0, start_timeout=COLD_START,
+                         identity=identity_in(creds, ROUTER)).start()  # fmt: skip
     cmd = [sys.executable, "-m", "swarm", "agent", "--connect", endpoint, "--run-id", "pool", "--controller",
            scenario.controller, "--credentials", str(creds / credentials.POOL)]  # fmt: skip
     procs = [subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for _ in range(2)]
@@ -275,7 +278,8 @@ def test_a_run_across_two_secure_routers_over_tls_ends_as_the_engine(creds):
     scenario = load_scenario("setup2").with_overrides(agents=2, seed=13)
     expected = Engine(scenario).run().summary
     near, far = (free_endpoint().replace("tcp/", "tls/") for _ in range(2))
-    world = ServerThread(scenario, "sec", near, deadline=10.0, identity=identity_in(creds, ROUTER)).start()
+    world = ServerThread(scenario, "sec", near, deadline=10.0, start_timeout=COLD_START,
+                         identity=identity_in(creds, ROUTER)).start()  # fmt: skip
     second = open_router(far, identity_in(creds, ROUTER), connect=[near])
     procs = start_agents(far, "sec", scenario.controller, 2, credentials=creds)
     forger = open_client(far, timeout=30.0, identity=identity_in(creds, agent_name(3)))
