@@ -7,7 +7,7 @@ import argparse
 import os
 import sys
 
-from swarm.core.credentials import POOL, CredentialsError, Identity, claim, is_pool, load
+from swarm.core.credentials import POOL, CredentialsError, Identity, claim, is_number, is_pool, load
 from swarm.core.tables import positive
 
 ENV = "SWARM_CREDENTIALS"  # the default of --credentials: a container gets its folder without a new command
@@ -29,7 +29,7 @@ def agent_identity(args: argparse.Namespace) -> Identity | None:
     """An agent process's identity: the folder `--credentials` names, or one claimed from a pool."""
     if args.credentials and is_pool(args.credentials):
         slot = os.environ.get(SLOT_ENV) or None
-        if slot is not None and not slot.isdigit():
+        if slot is not None and not is_number(slot):
             raise CredentialsError(f"${SLOT_ENV} is {slot!r}: expected the replica's number, e.g. {{{{.Task.Slot}}}}")
         claimed = claim(args.credentials, None if slot is None else int(slot))
         print(f"swarm: this agent process is {claimed.name} (claimed from {args.credentials})", file=sys.stderr)

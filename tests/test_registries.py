@@ -43,7 +43,7 @@ JOBS = 2  # worker processes of an experiment's smoke run
 # with -m experiment), and why.
 SLOW_BENCHMARKS = {
     "distributed": "16 timed runs of world and agent processes over zenoh (10 and 50 agents, 3 pairs): 76 s",
-    "executors": "four whole `swarm experiment carrot` commands, one starting Ray, one on a Ray head it starts: 100 s",
+    "executors": "four whole `swarm experiment carrot` commands, one starting Ray, one on a Ray head it starts: 55 s",
 }
 
 

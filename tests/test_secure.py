@@ -183,6 +183,7 @@ def test_credentials_are_private_and_a_bad_folder_is_one_line(creds, tmp_path):
         assert (creds / name / "identity.json").stat().st_mode & 0o777 == 0o600
     assert (creds / ROUTER / "users.txt").stat().st_mode & 0o777 == 0o600
     assert not (creds / agent_name(1) / "users.txt").exists()  # an agent holds its own password only
+    assert not credentials.is_pool(creds)  # a run's folder of agent<i>: no agent claims from it by mistake
     bad = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(tmp_path), "--connect",
                           free_endpoint()], capture_output=True, text=True, timeout=60)  # fmt: skip
     assert bad.returncode == 2
@@ -205,50 +206,48 @@ CLAIM = ("import sys\nfrom swarm.core.credentials import claim\n"
          "sys.stdin.read()\n")  # holds its identity until its stdin closes  # fmt: skip
 
 
-def _claimer(pool: Path, *slot: int) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-c", CLAIM, str(pool), *map(str, slot)], stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+def _claimer(pool: Path, *slot: int, started: list[subprocess.Popen]) -> subprocess.Popen:
+    """A process that claims an identity of `pool` (agent<slot>, given one), says which, and holds it; in `started`."""
+    started.append(subprocess.Popen([sys.executable, "-c", CLAIM, str(pool), *map(str, slot)], stdin=subprocess.PIPE,
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))  # fmt: skip
+    return started[-1]
 
 
 def test_replicas_claim_an_identity_each_and_a_killed_ones_is_free_again(tmp_path):
     pool = credentials.make(tmp_path, 2, pool=True) / credentials.POOL
     assert not (tmp_path / agent_name(1)).exists() and (pool / agent_name(2) / "key.pem").is_file()
     assert pool.stat().st_mode & 0o777 == 0o700 and credentials.is_pool(pool)
-    first = _claimer(pool)
-    killed = first.stdout.readline().strip()
-    second = _claimer(pool)
-    kept = second.stdout.readline().strip()
-    assert {killed, kept} == {agent_name(1), agent_name(2)}
-    third = _claimer(pool)
-    assert third.wait(timeout=60) == 1
-    assert third.stderr.read().strip().splitlines()[-1] == (
-        f"swarm.core.credentials.CredentialsError: {pool}: all 2 agent identities are held by running processes; "
-        "make a bigger pool with `swarm credentials DIR --pool --agent-processes N`"
-    )
-    first.kill()  # kill -9: the kernel lets its lock go
-    first.wait(timeout=30)
-    fourth = _claimer(pool)
+    started: list[subprocess.Popen] = []
     try:
-        assert fourth.stdout.readline().strip() == killed
+        first = _claimer(pool, started=started)
+        killed = first.stdout.readline().strip()
+        kept = _claimer(pool, started=started).stdout.readline().strip()
+        assert {killed, kept} == {agent_name(1), agent_name(2)}
+        third = _claimer(pool, started=started)
+        assert third.wait(timeout=60) == 1
+        assert third.stderr.read().strip().splitlines()[-1] == (
+            f"swarm.core.credentials.CredentialsError: {pool}: all 2 agent identities are held by running processes; "
+            "make a bigger pool with `swarm credentials DIR --pool --agent-processes N`"
+        )
+        first.kill()  # kill -9: the kernel lets its lock go
+        first.wait(timeout=30)
+        assert _claimer(pool, started=started).stdout.readline().strip() == killed
     finally:
-        for p in (second, fourth):
-            p.stdin.close()
-            p.wait(timeout=30)
+        stop(started)
 
 
 def test_a_numbered_replica_takes_its_own_identity_or_says_why_not(tmp_path):
     """Across hosts no lock is shared: replica N (Docker Swarm's task slot) is the pool's agentN."""
     pool = credentials.make(tmp_path, 2, pool=True) / credentials.POOL
-    second = _claimer(pool, 2)
+    started: list[subprocess.Popen] = []
     try:
-        assert second.stdout.readline().strip() == agent_name(2)
+        assert _claimer(pool, 2, started=started).stdout.readline().strip() == agent_name(2)
         for slot, why in ((2, f"{agent_name(2)} is held by another running process (replica 2 twice?)"),
                           (3, f"no identity {agent_name(3)} for replica 3")):  # fmt: skip
-            refused = _claimer(pool, slot)
+            refused = _claimer(pool, slot, started=started)
             assert refused.wait(timeout=60) == 1 and why in refused.stderr.read()
     finally:
-        second.stdin.close()
-        second.wait(timeout=30)
+        stop(started)
     bad = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(pool), "--connect",
                           free_endpoint()], capture_output=True, text=True, timeout=60,
                          env={**os.environ, "SWARM_AGENT_SLOT": "x"})  # fmt: skip
@@ -283,12 +282,21 @@ def test_a_run_across_two_secure_routers_over_tls_ends_as_the_engine(creds):
     second = open_router(far, identity_in(creds, ROUTER), connect=[near])
     procs = start_agents(far, "sec", scenario.controller, 2, credentials=creds)
     forger = open_client(far, timeout=30.0, identity=identity_in(creds, agent_name(3)))
+    watcher = open_client(near, timeout=30.0, identity=identity_in(creds, WORLD))  # on A, beside the world
+    heard: list[bytes] = []
+    watcher.declare_subscriber(KEYS.act(agent_name(1)), lambda sample: heard.append(sample.payload.to_bytes()))
+    forged = proto.actions(2**40, [0], STAY, [False])  # (for a tick the run never reaches: known by it)
 
     def forge() -> None:
+        deadline = time.monotonic() + COLD_START
+        while not heard:  # agent1's own actions cross from B to A: the route is there
+            assert time.monotonic() < deadline, "no action of agent1 reached router A"
+            time.sleep(0.05)
         for _ in range(200):  # refused at router B: never crosses to A
-            forger.put(KEYS.act(agent_name(1)), proto.actions(0, [0], STAY, [False]))
+            forger.put(KEYS.act(agent_name(1)), forged)
 
-    _ends_as_the_engine(world, procs, expected, closing=(forger, second), meanwhile=forge)
+    _ends_as_the_engine(world, procs, expected, closing=(forger, watcher, second), meanwhile=forge)
+    assert heard and forged not in heard
 
 
 def test_a_secure_mesh_over_plain_tcp_is_refused_in_one_line(creds):

@@ -50,8 +50,9 @@ def _agent(name: str, group: str) -> list[dict]:
     ]
 
 
-def _rules_of(name: str) -> list[dict]:
-    if name in (credentials.WORLD, credentials.ROUTER):  # a peer router carries what its own rules let in
+def _rules_of(name: str, tls: bool) -> list[dict]:
+    # a peer router carries what its own rules let in; it is known by its certificate, so only over TLS
+    if name == credentials.WORLD or (name == credentials.ROUTER and tls):
         return [_rule(f"{name}-all", WORLD_MESSAGES, ["ingress", "egress"], [f"{ANY.prefix}/**"])]
     if name == credentials.MONITOR:
         return [_rule(f"{name}-subscribe", ["declare_subscriber"], ["ingress"], [ANY.state]),
@@ -60,7 +61,7 @@ def _rules_of(name: str) -> list[dict]:
         return _agent(name, "*")
     if name.startswith("agent") and name[len("agent") :].isdigit():
         return _agent(name, name)
-    return []  # the router's own name, or one this version does not know: nothing
+    return []  # the router's name over TCP, or one this version does not know: nothing
 
 
 def access_control(users: list[str], tls: bool) -> dict:
@@ -69,7 +70,7 @@ def access_control(users: list[str], tls: bool) -> dict:
     save a peer router, known by its certificate alone (module docstring)."""
     rules, subjects, policies = [], [], []
     for name in users:
-        mine = _rules_of(name)
+        mine = _rules_of(name, tls)
         if not mine:
             continue
         rules += mine

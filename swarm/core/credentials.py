@@ -43,6 +43,7 @@ from swarm.core.errors import RunError
 
 ROUTER, WORLD, MONITOR, SHARED_AGENTS = "router", "world", "monitor", "agents"
 POOL = "agent-pool"  # the agent identities of `make(..., pool=True)`, for replicas to claim
+POOL_MARK = "POOL"  # the file that says a folder is a pool (a run's folder of agent<i> is not one)
 LOCAL_HOSTS = ("localhost", "127.0.0.1", "::1")
 VALID_DAYS = 30
 
@@ -115,13 +116,16 @@ _claimed: list[int] = []  # the claimed identities' locked files, open for the l
 
 
 def is_pool(folder: str | Path) -> bool:
-    """Whether `folder` holds agent identities to claim (DIR/agent-pool), not one identity."""
-    folder = Path(folder)
-    return not (folder / "identity.json").exists() and any(_pool_members(folder))
+    """Whether `folder` holds agent identities to claim (DIR/agent-pool, as `make` marks it)."""
+    return (Path(folder) / POOL_MARK).is_file()
+
+
+def is_number(text: str) -> bool:
+    return text.isascii() and text.isdecimal()
 
 
 def _pool_members(folder: Path) -> list[Path]:
-    found = [p for p in folder.glob("agent*") if p.name[len("agent") :].isdigit() and (p / "identity.json").is_file()]
+    found = [p for p in folder.glob("agent*") if is_number(p.name[len("agent") :]) and (p / "identity.json").is_file()]
     return sorted(found, key=lambda p: int(p.name[len("agent") :]))
 
 
@@ -144,8 +148,13 @@ def claim(pool: str | Path, slot: int | None = None) -> Identity:
         except OSError:
             os.close(fd)
             continue
+        try:
+            claimed = load(folder)
+        except CredentialsError:
+            os.close(fd)  # (and its lock)
+            raise
         _claimed.append(fd)
-        return load(folder)
+        return claimed
     if slot is not None:
         raise CredentialsError(f"{pool}: {agent_name(slot)} is held by another running process (replica {slot} "
                                "twice?)")  # fmt: skip
@@ -176,6 +185,7 @@ def make(folder: str | Path, agent_processes: int, hosts: tuple[str, ...] = (), 
     passwords = {name: secrets.token_urlsafe(24) for name in names}
     if pool:
         (folder / POOL).mkdir(exist_ok=True, mode=0o700)
+        (folder / POOL / POOL_MARK).write_text("agent identities for replicas to claim: swarm agent --credentials\n")
     for name in names:
         where = (folder / POOL if pool and name in agents else folder) / name
         where.mkdir(exist_ok=True, mode=0o700)

@@ -412,7 +412,7 @@ class ArenaWorld:
 def default_cell(s: ArenaScenario) -> float:
     """Index cell: a robot diameter and a quarter, at least 1/256 of the arena's side.  Crowds set it:
     a ray there ends within a cell or two, and a smaller cell holds fewer discs to test (`swarm bench
-    arena`'s 1000 lasers sense 16% faster than with two diameters; sparse worlds cost the same)."""
+    arena`'s 1000 lasers sense in 16% less time than with two diameters; sparse worlds cost the same)."""
     r = max(g.robot.radius for g in s.groups)
     return max(2.5 * r, max(s.size) / 256)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -62,3 +63,4 @@ def ray_head(cpus: int, pythonpath: str) -> Iterator[tuple[str, int]]:
             with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
         head.wait(timeout=30)
+        shutil.rmtree(temp, ignore_errors=True)

@@ -4,7 +4,7 @@
 runs it, a command of its own, with `--jobs 2`, three ways: through the local pool; with `--executor
 ray`, which starts Ray on this machine and stops it within the command; and with `--executor ray
 --address`, on a cluster of this machine's cores that is already running (`ray start --head`, started
-before the command and stopped after it, untimed: a study's commands share one).  Rounds alternate
+10 s before the command and stopped after it, untimed: a study's commands share one).  Rounds alternate
 the order (the machine's speed drifts), after an untimed run that compiles the kernels; each time is
 the whole command's wall time.  Every run's rows, and the summary, must be the same every way
 (wall-clock columns aside)."""
@@ -28,6 +28,7 @@ EXPERIMENT = "carrot"
 JOBS = 2
 WALL_CLOCK = {"wall_s", "wall_seconds"}  # seconds a run took: no two runs share them
 EXECUTORS = ("local", "ray", "ray-cluster")
+HEAD_SETTLE = 10.0  # s a fresh head is left before a command uses it, as a study's long-running one would be
 
 
 def command(executor: str, reps: int, out: Path, address: str | None = None) -> list[str]:
@@ -43,6 +44,7 @@ def _place(executor: str, here: str) -> Iterator[str | None]:
         yield None
         return
     with ray_head(JOBS, here) as (address, _):
+        time.sleep(HEAD_SETTLE)  # the head starts its workers as it comes up: not the command's cost
         yield address
 
 
@@ -56,7 +58,7 @@ def bench_executors(quick: bool = False) -> dict:
     seconds: dict[str, list[float]] = {name: [] for name in EXECUTORS}
     same = True
     with tempfile.TemporaryDirectory(prefix="swarm-executors-") as folder:
-        # a first run, untimed, compiles (or loads) the kernels, which neither timed command should pay
+        # a first run, untimed, compiles (or loads) the kernels, which no timed command should pay
         subprocess.run(command("local", 1, Path(folder) / "warm"), env=env, stdout=subprocess.DEVNULL,
                        stderr=subprocess.DEVNULL, check=True)  # fmt: skip
         for r in range(rounds):
