@@ -26,8 +26,8 @@ import pandas as pd
 from scipy import stats
 
 from agents.controllers.navigation.astar import Planner
-from swarm.experiments import stats as S
-from swarm.experiments.billing2015.reproduce import case3_tally
+from swarm.experiments.billing2015.reproduce import case3_tally, case3_tests
+from swarm.experiments.protocol import p_text
 from swarm.experiments.report import markdown_table
 from swarm.scenario import load_scenario
 from world_server.arena.scenario import clearance_at
@@ -92,16 +92,13 @@ def case3_drop_table(case3: pd.DataFrame) -> pd.DataFrame:
     for which, sel in (("box on the robot left out (the report)", case3[~case3.on_robot]), ("none left out", case3)):
         t = case3_tally(sel.to_dict("records"))
         red, mid = t["red"], t["mid"]
+        early, late, switches = case3_tests(t)
         rows.append({"runs": which, "n": len(sel),
-                     "early: south": f"{t['south']}/{t['early']}", "p": _p(S.binomial(t["south"], t["early"]).p),
-                     "late: north": f"{t['north']}/{t['late']}", "p ": _p(S.binomial(t["north"], t["late"]).p),
+                     "early: south": f"{t['south']}/{t['early']}", "p": p_text(early.p),
+                     "late: north": f"{t['north']}/{t['late']}", "p ": p_text(late.p),
                      "mid, red: full": f"{red['full']}/{mid['full']}", "partial": f"{red['partial']}/{mid['partial']}",
-                     "Fisher p": _p(S.fisher(red["full"], mid["full"], red["partial"], mid["partial"]).p)})  # fmt: skip
+                     "Fisher p": p_text(switches.p)})  # fmt: skip
     return pd.DataFrame(rows)
-
-
-def _p(p: float) -> str:
-    return "< 0.001" if p < 0.001 else f"{p:.3f}"
 
 
 def markdown(frame: pd.DataFrame) -> str:

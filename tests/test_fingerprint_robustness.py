@@ -23,7 +23,7 @@ WAYPOINTS = 8  # the mapping tour's first stretch, driven twice: seconds, not mi
 
 @pytest.fixture(scope="module")
 def routes():
-    return short_routes("office", WAYPOINTS, "new-path")
+    return short_routes(tour_scenario("office", "mapping", "low", 0), WAYPOINTS, "new-path")
 
 
 @pytest.fixture(scope="module")

@@ -59,7 +59,7 @@ def _rules_of(name: str, tls: bool) -> list[dict]:
                 _rule(f"{name}-hear", ["put"], ["egress"], [ANY.state]), *_reader(name)]  # fmt: skip
     if name == credentials.SHARED_AGENTS:
         return _agent(name, "*")
-    if name.startswith("agent") and name[len("agent") :].isdigit():
+    if credentials.agent_number(name) is not None:
         return _agent(name, name)
     return []  # the router's name over TCP, or one this version does not know: nothing
 

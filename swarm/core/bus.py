@@ -63,10 +63,9 @@ def _secure(c: zenoh.Config, mode: str, endpoints: list[str], me: Identity) -> N
         # A router shows its certificate on the links it opens to its mesh peers too.  It reaches them
         # by addresses its name resolves to, which no certificate can list in advance: the CA and the
         # peer's name (`router`, checked by the access rules) stand for the host name there.
-        sides = ("listen", "connect") if mode == "router" else ("connect",)
-        tls_config = {"root_ca_certificate": str(me.ca), "enable_mtls": True,
-                      **{f"{side}_{part}": str(path) for side in sides
-                         for part, path in (("certificate", me.cert), ("private_key", me.key))}}  # fmt: skip
+        tls_config: dict = {"root_ca_certificate": str(me.ca), "enable_mtls": True}
+        for side in ("listen", "connect") if mode == "router" else ("connect",):
+            tls_config.update({f"{side}_certificate": str(me.cert), f"{side}_private_key": str(me.key)})
         if mode == "router":
             tls_config["verify_name_on_connect"] = False
         c.insert_json5("transport/link/tls", json.dumps(tls_config))

@@ -57,6 +57,12 @@ def agent_name(i: int) -> str:
     return f"agent{i}"
 
 
+def agent_number(name: str) -> int | None:
+    """i of `agent<i>` (agent_name's inverse), or None for any other name."""
+    digits = name.removeprefix("agent")
+    return int(digits) if name.startswith("agent") and is_number(digits) else None
+
+
 def own_group(identity: Identity | None) -> str | None:
     """The message group an agent process must use: its identity's name, which the router's rules name;
     None (any group) without credentials or with the shared `agents` identity."""
@@ -125,8 +131,8 @@ def is_number(text: str) -> bool:
 
 
 def _pool_members(folder: Path) -> list[Path]:
-    found = [p for p in folder.glob("agent*") if is_number(p.name[len("agent") :]) and (p / "identity.json").is_file()]
-    return sorted(found, key=lambda p: int(p.name[len("agent") :]))
+    found = [p for p in folder.glob("agent*") if agent_number(p.name) is not None and (p / "identity.json").is_file()]
+    return sorted(found, key=lambda p: agent_number(p.name))
 
 
 def claim(pool: str | Path, slot: int | None = None) -> Identity:

@@ -85,13 +85,14 @@ def claims_table(claims: Sequence[Claim]) -> str:
     lines = ["| claim | paper | ours (95% CI) | n | test | p | effect | verdict |", "|---|---|---|---|---|---|---|---|"]
     for c in claims:
         t = c.test
-        test = (t.name, str(t.n), _p(t.p), f"{t.effect:+.3g} ({t.effect_name})") if t else ("–", "", "", "")
+        test = (t.name, str(t.n), p_text(t.p), f"{t.effect:+.3g} ({t.effect_name})") if t else ("–", "", "", "")
         lines.append(f"| {c.text} | {c.paper} | {c.ours} | {test[1]} | {test[0]} | {test[2]} | {test[3]} | "
                      f"{c.verdict} |")  # fmt: skip
     return "\n".join(lines) + "\n"
 
 
-def _p(p: float) -> str:
+def p_text(p: float) -> str:
+    """A p value as the reports print it ("n/a" where no test could be made)."""
     if math.isnan(p):
         return "n/a"
     return "< 0.001" if p < 0.001 else f"{p:.3f}"

@@ -98,12 +98,14 @@ def _close_floor(agents: int, seeds: range, tmp: Path) -> float:
     return round(total * 1000 / len(seeds), 1)
 
 
-def _alternated(pairs: int, tmp: Path, port: int, up: Callable[[str, str, str | None], dict]):
+def _alternated(pairs: int, tmp: Path, port: int, up: Callable[[str, str, str | None], dict],
+                ticks: int | None = None) -> dict:  # fmt: skip
     """`pairs` runs each way, alternated (plain, recorded, plain, ...): `up(run_id, listen, record)` runs one,
     same seed each time.  The median ticks/s of each way, since one lock-step run over zenoh moves by a
-    few percent on its own, and the last recorded run's file size and ticks."""
+    few percent on its own, what recording costs, and the last recorded run's bytes a tick (over `ticks`,
+    or the ticks it played) and in all."""
     rates: dict[bool, list[float]] = {False: [], True: []}
-    size = ticks = 0
+    size = played = 0
     for _ in range(pairs):
         for record in (False, True):
             run_id = f"benchrec{new_run_id()}"
@@ -111,8 +113,12 @@ def _alternated(pairs: int, tmp: Path, port: int, up: Callable[[str, str, str | 
             s = up(run_id, f"tcp/127.0.0.1:{port + record}", str(path) if record else None)
             rates[record].append(s["ticks_per_second"])
             if record:
-                size, ticks = path.stat().st_size, s["iterations"]
-    return statistics.median(rates[False]), statistics.median(rates[True]), size, ticks
+                size, played = path.stat().st_size, s["iterations"]
+    plain, recorded = statistics.median(rates[False]), statistics.median(rates[True])
+    ticks = ticks or played
+    return {"ticks": ticks, "ticks_per_second": round(plain, 2), "recorded_ticks_per_second": round(recorded, 2),
+            "cost": round(1 - recorded / plain, 3), "bytes_per_tick": round(size / max(ticks, 1)),
+            "mb_per_run": round(size / 1e6, 2)}  # fmt: skip
 
 
 def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int, max_ticks: int) -> dict:
@@ -122,11 +128,13 @@ def _distributed(agents: int, per_process: int, tmp: Path, port: int, pairs: int
         return swarm_up("setup1", agents, "cmarking", 1, run_id, listen, deadline=10.0, max_iterations=max_ticks,
                         progress=False, per_process=per_process, record=record, on_loss="strict")  # fmt: skip
 
-    plain, recorded, size, ticks = _alternated(pairs, tmp, port, up)
-    return {"runtime": "distributed", "agents": agents, "per_process": per_process, "runs": pairs, "ticks": ticks,
-            "ticks_per_second": round(plain, 2), "recorded_ticks_per_second": round(recorded, 2),
-            "cost": round(1 - recorded / plain, 3), "bytes_per_tick": round(size / max(ticks, 1)),
-            "mb_per_run": round(size / 1e6, 2)}  # fmt: skip
+    return {
+        "runtime": "distributed",
+        "agents": agents,
+        "per_process": per_process,
+        "runs": pairs,
+        **_alternated(pairs, tmp, port, up),
+    }
 
 
 def record_bytes(cells: int) -> float:
@@ -148,12 +156,15 @@ def _arena_distributed(cells: int, tmp: Path, port: int, pairs: int, ticks: int,
                         deadline=10.0, progress=False, per_process=per_process, record=record, on_loss="strict",
                         world_args=["--max-ticks", str(ticks)])  # fmt: skip
 
-    plain, recorded, size, _ = _alternated(pairs, tmp, port, up)
-    return {"runtime": "arena", "agents": ARENA_ROBOTS, "per_process": per_process, "view": cells,
-            "runs": pairs, "ticks": ticks, "record_bytes": round(record_bytes(cells)),
-            "ticks_per_second": round(plain, 2), "recorded_ticks_per_second": round(recorded, 2),
-            "cost": round(1 - recorded / plain, 3), "bytes_per_tick": round(size / ticks),
-            "mb_per_run": round(size / 1e6, 2)}  # fmt: skip
+    return {
+        "runtime": "arena",
+        "agents": ARENA_ROBOTS,
+        "per_process": per_process,
+        "view": cells,
+        "runs": pairs,
+        "record_bytes": round(record_bytes(cells)),
+        **_alternated(pairs, tmp, port, up, ticks),
+    }
 
 
 def bench_recording(quick: bool = False, port: int = 7650) -> dict:

@@ -183,6 +183,14 @@ def case3_tally(runs: Sequence[dict]) -> dict:
             "red": {kind: sum(r["route"] == "north-then-south" for r in sel) for kind, sel in mid.items()}}  # fmt: skip
 
 
+def case3_tests(t: dict) -> tuple:
+    """The tests of case 3's claims on a `case3_tally`: the early obstacle's share south and the late one's
+    share north against one half (exact binomial), the red switches of full against partial boxes (Fisher)."""
+    red, mid = t["red"], t["mid"]
+    return (S.binomial(t["south"], t["early"], 0.5), S.binomial(t["north"], t["late"], 0.5),
+            S.fisher(red["full"], mid["full"], red["partial"], mid["partial"]))  # fmt: skip
+
+
 def _case3_section(rows: list[dict]):
     t = case3_tally([r for r in rows if not r["on_robot"]])
     lines = []
@@ -193,18 +201,16 @@ def _case3_section(rows: list[dict]):
             counts = [str(sum(r["route"] == route for r in used)) for route in ROUTE_COLOUR]
             lines.append([kind, noise, str(len(sel)), str(len(sel) - len(used)), *counts])
     red, mid = t["red"], t["mid"]
+    early, late, switches = case3_tests(t)
     claims = [
         P.Claim(f"case3: an obstacle appearing before t = {paper.EARLY} sends the robot south, whatever its type",
-                "south (Fig. 13-16)", S.proportion_ci(t["south"], t["early"]).text(3) + " south",
-                S.binomial(t["south"], t["early"], 0.5)),
+                "south (Fig. 13-16)", S.proportion_ci(t["south"], t["early"]).text(3) + " south", early),
         P.Claim(f"case3: an obstacle appearing after t = {paper.LATE}: the robot keeps the north route",
-                "always north", S.proportion_ci(t["north"], t["late"]).text(3) + " north",
-                S.binomial(t["north"], t["late"], 0.5)),
+                "always north", S.proportion_ci(t["north"], t["late"]).text(3) + " north", late),
         P.Claim(f"case3: within {paper.EARLY} < t < {paper.LATE} a full obstacle makes the robot switch north to "
                 "south (red), a partial one does not", "full: red; partial: north",
                 f"red: full {S.proportion_ci(red['full'], mid['full']).text(3)}, partial "
-                f"{S.proportion_ci(red['partial'], mid['partial']).text(3)}",
-                S.fisher(red["full"], mid["full"], red["partial"], mid["partial"])),
+                f"{S.proportion_ci(red['partial'], mid['partial']).text(3)}", switches),
     ]  # fmt: skip
     table = R.markdown_table(["obstacle", "noise", "runs", "left out (box on the robot)", *ROUTE_COLOUR], lines)
     return "Case 3: an obstacle across the north route", table, claims

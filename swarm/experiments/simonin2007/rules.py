@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from swarm.experiments import stats as S
+from swarm.experiments.protocol import p_text
 
 OURS = ("mend", "remember")
 VARIANTS = (OURS, ("descend", "remember"), ("mend", "forget"), ("descend", "forget"))
@@ -64,7 +65,7 @@ def section(rows: list[dict]) -> tuple[str, str]:
                 ratio, p = "1 (ours)", "–"
             else:
                 est, _ = S.ratio_of_means(t, ours, paired=True)
-                ratio, p = est.text(3), _p(S.wilcoxon_paired(t, ours).p)
+                ratio, p = est.text(3), p_text(S.wilcoxon_paired(t, ours).p)
             lines.append(f"| {scenario}, {agents} agents | {variant[0]} | {variant[1]} | {S.mean_ci(t).text(3)} | "
                          f"{ratio} | {p} | {unfinished}/{len(t)} |")  # fmt: skip
     lines += ["", "| rule 5 | rule 6 | setup 2: T(1)/2 - T(2) (95% CI) |", "|---|---|---|"]
@@ -72,7 +73,3 @@ def section(rows: list[dict]) -> tuple[str, str]:
         one, two = _times(rows, "setup2", 1, variant), _times(rows, "setup2", 2, variant)
         lines.append(f"| {variant[0]} | {variant[1]} | {S.mean_ci(one / 2 - two).text(3)} |")
     return "Rules the paper leaves open: what rules 5 and 6 do (ablation)", "\n".join(lines) + "\n"
-
-
-def _p(p: float) -> str:
-    return "< 0.001" if p < 0.001 else f"{p:.3f}"

@@ -518,11 +518,11 @@ def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | Non
     name = scenario or "office"
     reps = reps or 3
     floor = tour_scenario(name, "mapping", "low", seed)  # a floor it cannot map is refused here, in one line
+    if which == "fingerprint-calibrate":
+        return _calibrate(name, seed, Outputs(out, which))
     has = localization_tours(floor, name, which) if which == "fingerprint-localize" else second_tours(floor)
     tours = tuple(t for t in has if tours is None or t in tours)
-    out = Outputs(out, which)
-    if which == "fingerprint-calibrate":
-        return _calibrate(name, seed, out)
+    out = Outputs(out, which)  # (after the floor's tours: a refused floor writes nothing)
     if which == "fingerprint-map":
         work = [(name, noise, seed + r, theta, "mapping") for noise in NOISES for r in range(reps) for theta in THETAS]
         work += [(name, noise, seed + r, 0.5, route) for route in LOOP_TOURS if route in tours for noise in NOISES
@@ -541,12 +541,12 @@ def run_fingerprint_experiment(which: str, scenario: str | None, reps: int | Non
     else:
         raise ValueError(f"unknown fingerprint experiment {which!r}")
     out.runs(rows)
-    tours = ("mapping",) if which == "fingerprint-map" else tours
+    summarized = ("mapping",) if which == "fingerprint-map" else tours
     summary = [{"route": t, "noise": n,
                 **{k: round(_mean([r for r in rows if r["noise"] == n and r["route"] == t and
                                    (which != "fingerprint-map" or r["theta"] == 0.5)], k), 4)
                    for k in rows[0] if isinstance(rows[0][k], (int, float)) and k != "seed"}}
-               for t in tours for n in NOISES]  # fmt: skip
+               for t in summarized for n in NOISES]  # fmt: skip
     return out.finish(summary, md)
 
 

@@ -136,10 +136,10 @@ def robustness_job(job: tuple) -> dict:
     return row | {"ticks": c["ticks"], "finished": c["finished"], "wall_seconds": c["wall_seconds"]}
 
 
-def short_routes(name: str, waypoints: int, route: str) -> dict:
-    """Both tours cut to the mapping tour's first `waypoints` waypoints (a quick run that stays on its map)."""
-    s = tour_scenario(name, "mapping", "low", 0)
-    cut = tuple(s.routes["mapping"][:waypoints])
+def short_routes(floor, waypoints: int, route: str) -> dict:
+    """Both tours cut to the mapping tour's first `waypoints` waypoints of `floor` (a loaded scenario):
+    a quick run that stays on its map."""
+    cut = tuple(floor.routes["mapping"][:waypoints])
     return {"mapping": cut, route: cut}
 
 
@@ -155,11 +155,12 @@ def run_robustness_experiment(which: str, scenario: str | None, reps: int | None
     if unknown:
         raise ValueError(f"unknown condition {unknown[0]!r}; expected one of {', '.join(CONDITIONS)}")
     # a floor it cannot map, or without a second tour: one line
-    tours = localization_tours(tour_scenario(name, "mapping", "low", seed), name, which)
-    routes = short_routes(name, waypoints, tours[0]) if waypoints else None
+    floor = tour_scenario(name, "mapping", "low", seed)
+    route = localization_tours(floor, name, which)[0]
+    routes = short_routes(floor, waypoints, route) if waypoints else None
     seeds = range(seed, seed + reps)
-    work = [(name, BASELINE, math.nan, s, routes, tours[0]) for s in seeds]
-    work += [(name, c, lv, s, routes, tours[0]) for c in chosen for lv in CONDITIONS[c][1]
+    work = [(name, BASELINE, math.nan, s, routes, route) for s in seeds]
+    work += [(name, c, lv, s, routes, route) for c in chosen for lv in CONDITIONS[c][1]
              if c == "kidnap" or lv != CONDITIONS[c][2] for s in seeds]  # fmt: skip
     rows = batch_run(robustness_job, work, jobs=jobs, desc=which, progress=progress)
     out = Outputs(out, which)
@@ -167,7 +168,7 @@ def run_robustness_experiment(which: str, scenario: str | None, reps: int | None
     summary = summarize(rows, chosen)
     out.runs(summary, file="summary.csv")
     band = "confirmation" if is_confirmation(seed) else "development" if seed in DEVELOPMENT_SEEDS else "other"
-    md = table(summary, name, seeds, band, waypoints, tours[0])
+    md = table(summary, name, seeds, band, waypoints, route)
     plot(summary, rows, out / "plot.png")
     return out.finish(None, md)
 
