@@ -12,6 +12,7 @@ from swarm.core.tables import positive
 
 ENV = "SWARM_CREDENTIALS"  # the default of --credentials: a container gets its folder without a new command
 SLOT_ENV = "SWARM_AGENT_SLOT"  # a replica's number (Docker Swarm's {{.Task.Slot}}): its identity in a pool
+INDEX_ENV = "SWARM_AGENT_INDEX"  # a replica's index from 0 (a Kubernetes StatefulSet pod's): agent<index+1>
 
 
 def credentials_arg(p: argparse.ArgumentParser, who: str) -> None:
@@ -28,13 +29,20 @@ def identity(args: argparse.Namespace) -> Identity | None:
 def agent_identity(args: argparse.Namespace) -> Identity | None:
     """An agent process's identity: the folder `--credentials` names, or one claimed from a pool."""
     if args.credentials and is_pool(args.credentials):
-        slot = os.environ.get(SLOT_ENV) or None
-        if slot is not None and not is_number(slot):
-            raise CredentialsError(f"${SLOT_ENV} is {slot!r}: expected the replica's number, e.g. {{{{.Task.Slot}}}}")
-        claimed = claim(args.credentials, None if slot is None else int(slot))
+        claimed = claim(args.credentials, _slot())
         print(f"swarm: this agent process is {claimed.name} (claimed from {args.credentials})", file=sys.stderr)
         return claimed
     return identity(args)
+
+
+def _slot() -> int | None:
+    """The replica's number an orchestrator gives ($SWARM_AGENT_SLOT, or $SWARM_AGENT_INDEX + 1), if any."""
+    for env, example, offset in ((SLOT_ENV, "{{.Task.Slot}}", 0), (INDEX_ENV, "a StatefulSet pod's index", 1)):
+        if value := os.environ.get(env):
+            if not is_number(value):
+                raise CredentialsError(f"${env} is {value!r}: expected the replica's number, e.g. {example}")
+            return int(value) + offset
+    return None
 
 
 def up_args(p: argparse.ArgumentParser) -> None:
@@ -68,6 +76,9 @@ def add_credentials_parser(sub) -> None:
     made.add_argument("--pool", action="store_true",
                       help="put agent1..agentN in DIR/agent-pool, for identical replicas (compose --scale) to "
                       "claim one each: mount the pool into every agent container")  # fmt: skip
+    made.add_argument("--kubernetes", action="store_true",
+                      help="also write DIR/kubernetes.yaml: each folder as a Secret and the agent identities as "
+                      "one pool, for deploy/k8s-secure (kubectl apply -f DIR/kubernetes.yaml)")  # fmt: skip
     made.set_defaults(handler=cmd_credentials)
 
 
@@ -77,4 +88,9 @@ def cmd_credentials(args: argparse.Namespace) -> int:
     folder = make(args.dir, args.agent_processes, tuple(args.host), args.shared_agents, args.pool)
     where = f" (agents in {folder / POOL})" if args.pool else ""
     print(f"swarm: credentials for {args.agent_processes} agent processes in {folder}{where}")
+    if args.kubernetes:
+        from swarm.core import kubernetes_secrets
+
+        secrets = kubernetes_secrets.write(folder)
+        print(f"swarm: their Kubernetes Secrets in {secrets}: kubectl apply -f {secrets}")
     return 0

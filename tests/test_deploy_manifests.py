@@ -1,18 +1,27 @@
 """The deployments beside compose.yaml: the Kubernetes manifests (deploy/k8s/) against Kubernetes'
 API schemas, and stack.yaml and the manifests running compose.yaml's commands with its defaults,
-so the three do not drift apart.  stack.yaml on a real Docker Swarm: tests/test_compose.py."""
+so the three do not drift apart; the secure overlay (deploy/k8s-secure/), built by kubectl's
+kustomize, differing from them only by credentials and TLS.  stack.yaml on a real Docker Swarm:
+tests/test_compose.py; the secure overlay's wiring in a real run: tests/test_secure.py."""
 
 from __future__ import annotations
 
+import json
 import re
+import shutil
+import subprocess
 from pathlib import Path
 
 import kubernetes_validate
 import pytest
 import yaml
 
+from swarm.core import credentials, kubernetes_secrets
+
 ROOT = Path(__file__).resolve().parent.parent
 K8S = ROOT / "deploy" / "k8s"
+K8S_SECURE = ROOT / "deploy" / "k8s-secure"
+KUBECTL = shutil.which("kubectl")
 KUBERNETES = "1.30"  # the oldest minor version the manifests are checked against
 
 
@@ -84,3 +93,73 @@ def test_agents_and_the_world_join_their_own_nodes_router():
     assert stack["router"]["ports"][0]["mode"] == "host"
     assert by_name("Service", "router-local")["spec"]["internalTrafficPolicy"] == "Local"
     assert by_name("Service", "router")["spec"]["clusterIP"] == "None"
+
+
+def _secure_build() -> dict[tuple[str, str], dict]:
+    built = subprocess.run([KUBECTL, "kustomize", str(K8S_SECURE)], capture_output=True, text=True, timeout=120)
+    assert built.returncode == 0, built.stderr
+    return {(d["kind"], d["metadata"]["name"]): d for d in yaml.safe_load_all(built.stdout) if d}
+
+
+def _without_security(doc: dict) -> dict:
+    """`doc` with tcp/ for tls/ and without the credentials' volume, mount and variables."""
+    doc = json.loads(json.dumps(doc).replace('"tls/', '"tcp/').replace(" tls/", " tcp/"))
+    pod = doc["spec"]["template"]["spec"]
+    pod["volumes"] = [v for v in pod["volumes"] if v["name"] != "credentials"] or None
+    for c in pod["containers"]:
+        c["volumeMounts"] = [m for m in c["volumeMounts"] if m["name"] != "credentials"] or None
+        c["env"] = [e for e in c["env"] if e["name"] not in ("SWARM_CREDENTIALS", "SWARM_AGENT_INDEX")] or None
+    return _dropping_none(doc)
+
+
+def _dropping_none(value):
+    if isinstance(value, dict):
+        return {k: _dropping_none(v) for k, v in value.items() if v is not None}
+    return [_dropping_none(v) for v in value] if isinstance(value, list) else value
+
+
+SECRET_OF = {"router": credentials.ROUTER, "world": credentials.WORLD, "monitor": credentials.MONITOR}
+
+
+@pytest.mark.skipif(KUBECTL is None, reason="needs kubectl, whose kustomize builds the overlay")
+def test_the_secure_overlay_is_the_plain_manifests_with_credentials_and_tls(tmp_path):
+    """Each process mounts its own Secret of `swarm credentials --kubernetes` and links over TLS; the
+    agents are a StatefulSet (an index per pod, for its identity) with the Deployment's pod; nothing else
+    differs, and every resource is valid for Kubernetes."""
+    built, plain = _secure_build(), {(d["kind"], d["metadata"]["name"]): d for _, d in manifests()}
+    assert set(built) == set(plain) - {("Deployment", "agent")} | {("StatefulSet", "agent"), ("Service", "agent")}
+    for doc in built.values():
+        assert kubernetes_validate.validate(doc, KUBERNETES, strict=True)
+    made = kubernetes_secrets.secrets(credentials.make(tmp_path, 2))
+    secrets = {name: kubernetes_secrets.secret_name(who) for name, who in SECRET_OF.items()}
+    secrets["agent"] = kubernetes_secrets.POOL_SECRET
+    assert sorted(secrets.values()) == sorted(s["metadata"]["name"] for s in made)
+    for (kind, name), doc in built.items():
+        if name in secrets and kind != "Service":
+            pod = doc["spec"]["template"]["spec"]
+            (volume,) = [v for v in pod["volumes"] if v["name"] == "credentials"]
+            assert volume["secret"]["secretName"] == secrets[name], name
+            assert all("tcp/" not in arg for c in pod["containers"] for arg in c["args"]), name
+    for key, doc in built.items():
+        if key[1] in SECRET_OF and key[0] != "Service":
+            assert _without_security(doc) == plain[key], key
+        elif key[1] != "agent":
+            assert doc == plain[key], key
+    agents = built["StatefulSet", "agent"]
+    assert _without_security(agents)["spec"]["template"] == plain["Deployment", "agent"]["spec"]["template"]
+    assert agents["spec"]["replicas"] == plain["Deployment", "agent"]["spec"]["replicas"]
+    (index,) = [e for e in agents["spec"]["template"]["spec"]["containers"][0]["env"]
+                if e["name"] == "SWARM_AGENT_INDEX"]  # fmt: skip
+    assert index["valueFrom"]["fieldRef"]["fieldPath"] == "metadata.labels['apps.kubernetes.io/pod-index']"
+
+
+def test_the_kubernetes_secrets_are_valid_and_a_pool_too_big_for_one_is_one_line(tmp_path, monkeypatch):
+    made = kubernetes_secrets.secrets(credentials.make(tmp_path, 2, pool=True))
+    for secret in made:
+        assert kubernetes_validate.validate(secret, KUBERNETES, strict=True)
+    assert set(made[-1]["data"]) == {credentials.POOL_MARK} | {f"agent{i}.{f}" for i in (1, 2)
+                                                                for f in kubernetes_secrets.FILES}  # fmt: skip
+    monkeypatch.setattr(kubernetes_secrets, "SECRET_LIMIT", sum(map(len, made[-1]["data"].values())) * 3 // 5)
+    with pytest.raises(credentials.CredentialsError, match=r"swarm-agent-pool would hold \d+ bytes, over the \d+ a "
+                       r"Kubernetes Secret may: make at most 1 agent identities"):  # fmt: skip
+        kubernetes_secrets.secrets(tmp_path)

@@ -6,6 +6,7 @@ world's; a secure run ends exactly as a plain one."""
 
 from __future__ import annotations
 
+import base64
 import json
 import os
 import shutil
@@ -18,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from swarm.core import credentials
+from swarm.core import credentials, kubernetes_secrets
 from swarm.core.bus import open_client, open_router
 from swarm.core.credentials import MONITOR, ROUTER, WORLD, agent_name, identity_in
 from swarm.core.wire import Keys
@@ -255,6 +256,61 @@ def test_a_numbered_replica_takes_its_own_identity_or_says_why_not(tmp_path):
     assert bad.stderr.strip().splitlines() == [
         "swarm: error: $SWARM_AGENT_SLOT is 'x': expected the replica's number, e.g. {{.Task.Slot}}"
     ]
+
+
+def test_a_kubernetes_pod_takes_the_identity_after_its_index_from_the_flat_pool(tmp_path):
+    """A Secret's keys hold no '/': the pool's agent<i>.<file> files, claimed by index + 1 or by lock."""
+    creds = credentials.make(tmp_path / "creds", 3)
+    pool = _mounted(kubernetes_secrets.secrets(creds)[-1], tmp_path / "pool")
+    assert credentials.is_pool(pool)
+    assert [name for name, _, _ in credentials.pool_members(pool)] == [agent_name(i) for i in (1, 2, 3)]
+    started: list[subprocess.Popen] = []
+    try:
+        assert _claimer(pool, 2, started=started).stdout.readline().strip() == agent_name(2)
+        assert _claimer(pool, started=started).stdout.readline().strip() == agent_name(1)  # the first free one
+    finally:
+        stop(started)
+    flat = credentials.claim(pool, 3)
+    assert (flat.name, flat.cert.read_bytes()) == (agent_name(3), (creds / agent_name(3) / "cert.pem").read_bytes())
+    bad = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(pool), "--connect",
+                          free_endpoint()], capture_output=True, text=True, timeout=60,
+                         env={**os.environ, "SWARM_AGENT_INDEX": "-1"})  # fmt: skip
+    assert bad.returncode == 2
+    assert bad.stderr.strip().splitlines() == [
+        "swarm: error: $SWARM_AGENT_INDEX is '-1': expected the replica's number, e.g. a StatefulSet pod's index"
+    ]
+
+
+def _mounted(secret: dict, where: Path) -> Path:
+    """A Secret as the kubelet mounts it: a file per key, each a link into the hidden ..data folder."""
+    (where / "..data").mkdir(parents=True)
+    for key, value in secret["data"].items():
+        (where / "..data" / key).write_bytes(base64.b64decode(value))
+        (where / key).symlink_to(Path("..data") / key)
+    return where
+
+
+def test_a_secure_run_from_the_kubernetes_secrets_ends_as_the_engine(tmp_path):
+    """deploy/k8s-secure's wiring: the Secrets of `swarm credentials --kubernetes` mounted as the kubelet
+    mounts them; a router over TLS with the router's, the world joining it with the world's, and two agent
+    pods that take their identities from the one pool Secret by their StatefulSet index."""
+    creds = credentials.make(tmp_path / "creds", 2)
+    mounts = {s["metadata"]["name"]: _mounted(s, tmp_path / s["metadata"]["name"])
+              for s in kubernetes_secrets.secrets(creds)}  # fmt: skip
+    scenario = load_scenario("setup2").with_overrides(agents=2, seed=5)
+    expected = Engine(scenario).run().summary
+    endpoint = free_endpoint().replace("tcp/", "tls/")
+    router = open_router(endpoint, credentials.load(mounts[kubernetes_secrets.secret_name(ROUTER)]))
+    world = ServerThread(scenario, "k8s", endpoint, connect=endpoint, deadline=10.0, start_timeout=COLD_START,
+                         identity=credentials.load(mounts[kubernetes_secrets.secret_name(WORLD)])).start()  # fmt: skip
+    cmd = [sys.executable, "-m", "swarm", "agent", "--connect", endpoint, "--run-id", "k8s", "--controller",
+           scenario.controller, "--credentials", str(mounts[kubernetes_secrets.POOL_SECRET])]  # fmt: skip
+    procs = [subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                              env={**os.environ, "SWARM_AGENT_INDEX": str(index)}) for index in (1, 0)]  # fmt: skip
+    _ends_as_the_engine(world, procs, expected, closing=(router,))
+    said = [p.stderr.read().decode().splitlines()[0] for p in procs]
+    assert [line.split(" (claimed")[0] for line in said] == [f"swarm: this agent process is {agent_name(i)}"
+                                                            for i in (2, 1)]  # fmt: skip
 
 
 def test_replicas_from_a_pool_run_a_secure_run_as_the_engine(tmp_path):

@@ -20,8 +20,11 @@ Identical replicas can instead claim one each from a pool, DIR/agent-pool/agent<
 (`make(..., pool=True)`): a process that is handed the pool takes the first
 identity no live process holds (a lock on its file, which the kernel lets go
 when the process dies, however it dies) and keeps it for its life; a replica
-an orchestrator numbers (Docker Swarm's task slot, $SWARM_AGENT_SLOT) takes
-agent<slot>, as locks do not reach across hosts.  Each
+an orchestrator numbers (Docker Swarm's task slot, $SWARM_AGENT_SLOT, or a
+Kubernetes StatefulSet pod's index + 1, $SWARM_AGENT_INDEX) takes agent<slot>,
+as locks do not reach across hosts.  A pool is folders of agent<i>, or flat:
+files agent<i>.identity.json, agent<i>.cert.pem, ... (a Kubernetes Secret's
+keys hold no '/': swarm.core.kubernetes_secrets).  Each
 replica then puts only on its own keys; every replica can read the whole pool,
 so a replica that is itself hostile could still log in as another.
 
@@ -44,6 +47,7 @@ from swarm.core.errors import RunError
 ROUTER, WORLD, MONITOR, SHARED_AGENTS = "router", "world", "monitor", "agents"
 POOL = "agent-pool"  # the agent identities of `make(..., pool=True)`, for replicas to claim
 POOL_MARK = "POOL"  # the file that says a folder is a pool (a run's folder of agent<i> is not one)
+POOL_TEXT = "agent identities for replicas to claim: swarm agent --credentials\n"  # the mark's text
 LOCAL_HOSTS = ("localhost", "127.0.0.1", "::1")
 VALID_DAYS = 30
 
@@ -78,22 +82,23 @@ class Identity:
     name: str
     password: str
     folder: Path
+    prefix: str = ""  # a flat pool's files are agent<i>.<file>: a Kubernetes Secret's keys hold no '/'
 
     @property
     def ca(self) -> Path:
-        return self.folder / "ca.pem"
+        return self.folder / f"{self.prefix}ca.pem"
 
     @property
     def cert(self) -> Path:
-        return self.folder / "cert.pem"
+        return self.folder / f"{self.prefix}cert.pem"
 
     @property
     def key(self) -> Path:
-        return self.folder / "key.pem"
+        return self.folder / f"{self.prefix}key.pem"
 
     @property
     def users_file(self) -> Path:
-        return self.folder / "users.txt"
+        return self.folder / f"{self.prefix}users.txt"
 
     def users(self) -> list[str]:
         """The names in the router's dictionary (only a router's folder has one)."""
@@ -104,18 +109,19 @@ class Identity:
         return [line.split(":", 1)[0] for line in lines if ":" in line]
 
 
-def load(folder: str | Path) -> Identity:
-    """The identity in `folder` (DIR/<name>), or a one-line CredentialsError."""
+def load(folder: str | Path, prefix: str = "") -> Identity:
+    """The identity in `folder` (DIR/<name>), or in its files named `prefix`<file> (a flat pool's
+    agent<i>.), or a one-line CredentialsError."""
     folder = Path(folder)
     try:
-        data = json.loads((folder / "identity.json").read_text())
+        data = json.loads((folder / f"{prefix}identity.json").read_text())
         name, password = data["user"], data["password"]
     except (OSError, ValueError, KeyError, TypeError):
-        raise CredentialsError(f"{folder}: not a credentials folder (no readable identity.json)") from None
-    missing = [f for f in ("ca.pem", "cert.pem", "key.pem") if not (folder / f).is_file()]
+        raise CredentialsError(f"{folder}: not a credentials folder (no readable {prefix}identity.json)") from None
+    missing = [prefix + f for f in ("ca.pem", "cert.pem", "key.pem") if not (folder / f"{prefix}{f}").is_file()]
     if missing:
         raise CredentialsError(f"{folder}: missing {', '.join(missing)}")
-    return Identity(str(name), str(password), folder)
+    return Identity(str(name), str(password), folder, prefix)
 
 
 _claimed: list[int] = []  # the claimed identities' locked files, open for the life of the process
@@ -130,9 +136,17 @@ def is_number(text: str) -> bool:
     return text.isascii() and text.isdecimal()
 
 
-def _pool_members(folder: Path) -> list[Path]:
-    found = [p for p in folder.glob("agent*") if agent_number(p.name) is not None and (p / "identity.json").is_file()]
-    return sorted(found, key=lambda p: agent_number(p.name))
+def pool_members(folder: Path) -> list[tuple[str, Path, str]]:
+    """(name, folder, prefix) of each agent identity in `folder`, by number: its agent<i>/ folders, or its
+    agent<i>.<file> files (a flat pool, as a Kubernetes Secret mounts one)."""
+    found: dict[str, tuple[Path, str]] = {}
+    for path in folder.glob("agent*"):
+        flat = path.name.removesuffix(".identity.json")
+        if agent_number(path.name) is not None and (path / "identity.json").is_file():
+            found[path.name] = (path, "")
+        elif flat != path.name and agent_number(flat) is not None:
+            found[flat] = (folder, f"{flat}.")
+    return [(name, *found[name]) for name in sorted(found, key=agent_number)]
 
 
 def claim(pool: str | Path, slot: int | None = None) -> Identity:
@@ -141,21 +155,21 @@ def claim(pool: str | Path, slot: int | None = None) -> Identity:
     when none is free."""
     import fcntl
 
-    members = _pool_members(Path(pool))
+    members = pool_members(Path(pool))
     if slot is not None:
-        members = [m for m in members if m.name == agent_name(slot)]
+        members = [m for m in members if m[0] == agent_name(slot)]
         if not members:
             raise CredentialsError(f"{pool}: no identity {agent_name(slot)} for replica {slot}; make a bigger "
                                    "pool with `swarm credentials DIR --pool --agent-processes N`")  # fmt: skip
-    for folder in members:
-        fd = os.open(folder / "identity.json", os.O_RDONLY)
+    for _, folder, prefix in members:
+        fd = os.open(folder / f"{prefix}identity.json", os.O_RDONLY)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
             os.close(fd)
             continue
         try:
-            claimed = load(folder)
+            claimed = load(folder, prefix)
         except CredentialsError:
             os.close(fd)  # (and its lock)
             raise
@@ -191,7 +205,7 @@ def make(folder: str | Path, agent_processes: int, hosts: tuple[str, ...] = (), 
     passwords = {name: secrets.token_urlsafe(24) for name in names}
     if pool:
         (folder / POOL).mkdir(exist_ok=True, mode=0o700)
-        (folder / POOL / POOL_MARK).write_text("agent identities for replicas to claim: swarm agent --credentials\n")
+        (folder / POOL / POOL_MARK).write_text(POOL_TEXT)
     for name in names:
         where = (folder / POOL if pool and name in agents else folder) / name
         where.mkdir(exist_ok=True, mode=0o700)
@@ -200,14 +214,14 @@ def make(folder: str | Path, agent_processes: int, hosts: tuple[str, ...] = (), 
         cert = _certificate(name, key.public_key(), ca_key, ca_cert, sans=sans)
         (where / "ca.pem").write_bytes(ca_pem)
         (where / "cert.pem").write_bytes(_pem(cert))
-        _private(where / "key.pem", _key_pem(key))
-        _private(where / "identity.json", json.dumps({"user": name, "password": passwords[name]}).encode())
+        write_private(where / "key.pem", _key_pem(key))
+        write_private(where / "identity.json", json.dumps({"user": name, "password": passwords[name]}).encode())
     users = "".join(f"{name}:{passwords[name]}\n" for name in names)
-    _private(folder / ROUTER / "users.txt", users.encode())
+    write_private(folder / ROUTER / "users.txt", users.encode())
     return folder
 
 
-def _private(path: Path, data: bytes) -> None:
+def write_private(path: Path, data: bytes) -> None:
     """Write a secret readable by this user only (created 0600, never world-readable in between)."""
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
     with os.fdopen(fd, "wb") as f:
