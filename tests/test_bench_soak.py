@@ -70,6 +70,7 @@ def test_the_run_s_processes_are_found_by_their_command_line_and_joined_once_the
 
 
 @pytest.mark.experiment
+@pytest.mark.timeout(45 * 60)  # 30 minutes of ticks, the agents' start, the recording read back
 def test_a_30_minute_soak_with_a_kill_every_10_s_keeps_memory_flat_every_tick_and_every_loss(tmp_path):
     result = run(minutes=30.0, kill_every=10.0, out=str(tmp_path))
     print(format_soak_bench(result))
