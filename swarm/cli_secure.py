@@ -38,9 +38,10 @@ def agent_identity(args: argparse.Namespace) -> Identity | None:
 def _slot() -> int | None:
     """The replica's number an orchestrator gives ($SWARM_AGENT_SLOT, or $SWARM_AGENT_INDEX + 1), if any."""
     for env, example, offset in ((SLOT_ENV, "{{.Task.Slot}}", 0), (INDEX_ENV, "a StatefulSet pod's index", 1)):
-        if value := os.environ.get(env):
+        if (value := os.environ.get(env)) is not None:
             if not is_number(value):
-                raise CredentialsError(f"${env} is {value!r}: expected the replica's number, e.g. {example}")
+                why = " (a pod's index label needs Kubernetes 1.28 or newer)" if env == INDEX_ENV and not value else ""
+                raise CredentialsError(f"${env} is {value!r}: expected the replica's number, e.g. {example}{why}")
             return int(value) + offset
     return None
 
@@ -85,12 +86,15 @@ def add_credentials_parser(sub) -> None:
 def cmd_credentials(args: argparse.Namespace) -> int:
     from swarm.core.credentials import make
 
+    if args.kubernetes and args.shared_agents:
+        raise CredentialsError("--kubernetes gives each agent pod its own identity from the pool: leave out "
+                               "--shared-agents")  # fmt: skip
     folder = make(args.dir, args.agent_processes, tuple(args.host), args.shared_agents, args.pool)
     where = f" (agents in {folder / POOL})" if args.pool else ""
     print(f"swarm: credentials for {args.agent_processes} agent processes in {folder}{where}")
     if args.kubernetes:
         from swarm.core import kubernetes_secrets
 
-        secrets = kubernetes_secrets.write(folder)
-        print(f"swarm: their Kubernetes Secrets in {secrets}: kubectl apply -f {secrets}")
+        secrets = kubernetes_secrets.write(folder, args.pool)
+        print(f"swarm: their Kubernetes Secrets in {secrets}: kubectl apply --server-side -f {secrets}")
     return 0

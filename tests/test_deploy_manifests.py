@@ -6,15 +6,18 @@ tests/test_compose.py; the secure overlay's wiring in a real run: tests/test_sec
 
 from __future__ import annotations
 
+import base64
 import json
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import kubernetes_validate
 import pytest
 import yaml
+from cryptography import x509
 
 from swarm.core import credentials, kubernetes_secrets
 
@@ -154,12 +157,32 @@ def test_the_secure_overlay_is_the_plain_manifests_with_credentials_and_tls(tmp_
 
 
 def test_the_kubernetes_secrets_are_valid_and_a_pool_too_big_for_one_is_one_line(tmp_path, monkeypatch):
-    made = kubernetes_secrets.secrets(credentials.make(tmp_path, 2, pool=True))
+    made = kubernetes_secrets.secrets(credentials.make(tmp_path, 2, pool=True), pool=True)
     for secret in made:
         assert kubernetes_validate.validate(secret, KUBERNETES, strict=True)
     assert set(made[-1]["data"]) == {credentials.POOL_MARK} | {f"agent{i}.{f}" for i in (1, 2)
-                                                                for f in kubernetes_secrets.FILES}  # fmt: skip
+                                                                for f in credentials.IDENTITY_FILES}  # fmt: skip
     monkeypatch.setattr(kubernetes_secrets, "SECRET_LIMIT", sum(map(len, made[-1]["data"].values())) * 3 // 5)
     with pytest.raises(credentials.CredentialsError, match=r"swarm-agent-pool would hold \d+ bytes, over the \d+ a "
                        r"Kubernetes Secret may: make at most 1 agent identities"):  # fmt: skip
-        kubernetes_secrets.secrets(tmp_path)
+        kubernetes_secrets.secrets(tmp_path, pool=True)
+
+
+def test_swarm_credentials_writes_the_secrets_private_and_refuses_a_shared_identity_for_them(tmp_path):
+    made = subprocess.run([sys.executable, "-m", "swarm", "credentials", str(tmp_path / "c"), "--agent-processes",
+                           "2", "--pool", "--host", "router-local", "--kubernetes"], capture_output=True, text=True,
+                          timeout=60)  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    written = tmp_path / "c" / kubernetes_secrets.FILE
+    assert f"kubectl apply --server-side -f {written}" in made.stdout
+    assert written.stat().st_mode & 0o777 == 0o600
+    secrets = list(yaml.safe_load_all(written.read_text()))
+    assert secrets == kubernetes_secrets.secrets(tmp_path / "c", pool=True)
+    router = x509.load_pem_x509_certificate(base64.b64decode(secrets[0]["data"]["cert.pem"]))
+    names = router.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
+    assert "router-local" in names.get_values_for_type(x509.DNSName)
+    shared = subprocess.run([sys.executable, "-m", "swarm", "credentials", str(tmp_path / "d"), "--shared-agents",
+                             "--kubernetes"], capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert shared.returncode == 2 and shared.stderr.strip().splitlines() == [
+        "swarm: error: --kubernetes gives each agent pod its own identity from the pool: leave out --shared-agents"
+    ]

@@ -279,13 +279,24 @@ def test_a_kubernetes_pod_takes_the_identity_after_its_index_from_the_flat_pool(
     assert bad.stderr.strip().splitlines() == [
         "swarm: error: $SWARM_AGENT_INDEX is '-1': expected the replica's number, e.g. a StatefulSet pod's index"
     ]
+    unlabelled = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(pool), "--connect",
+                                 free_endpoint()], capture_output=True, text=True, timeout=60,
+                                env={**os.environ, "SWARM_AGENT_INDEX": ""})  # fmt: skip
+    assert unlabelled.returncode == 2
+    assert unlabelled.stderr.strip().splitlines() == [
+        "swarm: error: $SWARM_AGENT_INDEX is '': expected the replica's number, e.g. a StatefulSet pod's index (a "
+        "pod's index label needs Kubernetes 1.28 or newer)"
+    ]
 
 
 def _mounted(secret: dict, where: Path) -> Path:
-    """A Secret as the kubelet mounts it: a file per key, each a link into the hidden ..data folder."""
-    (where / "..data").mkdir(parents=True)
+    """A Secret as the kubelet mounts it: a file per key (mode 0400), each a link through `..data`, itself a
+    link to the folder of the Secret's current version."""
+    (where / "..2026_12_07_00_00_00.000000001").mkdir(parents=True)
+    (where / "..data").symlink_to("..2026_12_07_00_00_00.000000001")
     for key, value in secret["data"].items():
         (where / "..data" / key).write_bytes(base64.b64decode(value))
+        (where / "..data" / key).chmod(0o400)
         (where / key).symlink_to(Path("..data") / key)
     return where
 

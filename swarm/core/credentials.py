@@ -49,6 +49,7 @@ POOL = "agent-pool"  # the agent identities of `make(..., pool=True)`, for repli
 POOL_MARK = "POOL"  # the file that says a folder is a pool (a run's folder of agent<i> is not one)
 POOL_TEXT = "agent identities for replicas to claim: swarm agent --credentials\n"  # the mark's text
 LOCAL_HOSTS = ("localhost", "127.0.0.1", "::1")
+IDENTITY_FILES = ("identity.json", "ca.pem", "cert.pem", "key.pem")  # an identity's files (a router's: users.txt too)
 VALID_DAYS = 30
 
 
@@ -118,7 +119,7 @@ def load(folder: str | Path, prefix: str = "") -> Identity:
         name, password = data["user"], data["password"]
     except (OSError, ValueError, KeyError, TypeError):
         raise CredentialsError(f"{folder}: not a credentials folder (no readable {prefix}identity.json)") from None
-    missing = [prefix + f for f in ("ca.pem", "cert.pem", "key.pem") if not (folder / f"{prefix}{f}").is_file()]
+    missing = [prefix + f for f in IDENTITY_FILES[1:] if not (folder / f"{prefix}{f}").is_file()]
     if missing:
         raise CredentialsError(f"{folder}: missing {', '.join(missing)}")
     return Identity(str(name), str(password), folder, prefix)
@@ -160,9 +161,13 @@ def claim(pool: str | Path, slot: int | None = None) -> Identity:
         members = [m for m in members if m[0] == agent_name(slot)]
         if not members:
             raise CredentialsError(f"{pool}: no identity {agent_name(slot)} for replica {slot}; make a bigger "
-                                   "pool with `swarm credentials DIR --pool --agent-processes N`")  # fmt: skip
+                                   "pool with `swarm credentials DIR --agent-processes N` (and --pool, or "
+                                   "--kubernetes and its Secrets applied again)")  # fmt: skip
     for _, folder, prefix in members:
-        fd = os.open(folder / f"{prefix}identity.json", os.O_RDONLY)
+        try:
+            fd = os.open(folder / f"{prefix}identity.json", os.O_RDONLY)
+        except OSError as exc:
+            raise CredentialsError(f"{folder}: cannot read {prefix}identity.json ({exc.strerror})") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:

@@ -5,6 +5,10 @@ at $SWARM_CREDENTIALS in that process's pod.  The agent identities become one Se
 `swarm-agent-pool`, mounted into every agent pod: a Secret's keys hold no '/', so the pool is flat
 (agent<i>.identity.json, agent<i>.cert.pem, ...; swarm.core.credentials reads both layouts), and a
 pod takes agent<index+1> by its StatefulSet index ($SWARM_AGENT_INDEX).
+
+A Secret holds at most 1 MiB (about 700 agent identities).  `kubectl apply` without --server-side
+copies the whole object into an annotation of at most 256 KiB (about 140 identities), so the file is
+applied server-side.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from pathlib import Path
 import yaml
 
 from swarm.core.credentials import (
+    IDENTITY_FILES,
     MONITOR,
     POOL,
     POOL_MARK,
@@ -28,8 +33,7 @@ from swarm.core.credentials import (
 
 FILE = "kubernetes.yaml"  # written beside the folders: kubectl apply -f DIR/kubernetes.yaml
 POOL_SECRET = "swarm-agent-pool"
-SECRET_LIMIT = 1024 * 1024  # bytes of data one Secret may hold (Kubernetes refuses more)
-FILES = ("identity.json", "ca.pem", "cert.pem", "key.pem")
+SECRET_LIMIT = 1024 * 1024  # bytes of data one Secret may hold, decoded (Kubernetes refuses more)
 
 
 def secret_name(identity: str) -> str:
@@ -42,35 +46,41 @@ def _secret(name: str, files: dict[str, bytes]) -> dict:
             "metadata": {"name": name, "labels": {"app.kubernetes.io/name": "swarm"}}, "data": data}  # fmt: skip
 
 
-def secrets(folder: str | Path) -> list[dict]:
+def secrets(folder: str | Path, pool: bool = False) -> list[dict]:
     """The Secrets of the credentials `swarm credentials` wrote into `folder`: the router's, the
-    world's, the monitor's, and the agent identities as one flat pool (from DIR/agent-pool, or the
-    agent<i> folders of DIR)."""
+    world's, the monitor's, and the agent identities as one flat pool (from DIR/agent-pool with `pool`,
+    else the agent<i> folders of DIR)."""
     folder = Path(folder)
-    out = []
-    for name in (ROUTER, WORLD, MONITOR):
-        try:
-            files = {f.name: f.read_bytes() for f in sorted((folder / name).iterdir()) if f.is_file()}
-        except OSError:
-            files = {}
-        if "identity.json" not in files:
-            raise CredentialsError(f"{folder / name}: not a credentials folder; write it with `swarm credentials`")
-        out.append(_secret(secret_name(name), files))
-    agents = pool_members(folder / POOL if (folder / POOL).is_dir() else folder)
+    out = [_secret(secret_name(name), _files(folder / name)) for name in (ROUTER, WORLD, MONITOR)]
+    agents = pool_members(folder / POOL if pool else folder)
     if not agents:
         raise CredentialsError(f"{folder}: no agent identities; write them with `swarm credentials`")
-    pool = {f"{name}.{file}": (where / f"{prefix}{file}").read_bytes() for name, where, prefix in agents
-            for file in FILES}  # fmt: skip
-    out.append(_secret(POOL_SECRET, {**pool, POOL_MARK: POOL_TEXT.encode()}))
-    size = sum(map(len, out[-1]["data"].values()))
+    files = {f"{name}.{file}": where / f"{prefix}{file}" for name, where, prefix in agents for file in IDENTITY_FILES}
+    flat = {key: _read(path) for key, path in files.items()}
+    size = sum(map(len, flat.values()))
     if size > SECRET_LIMIT:
         raise CredentialsError(f"{POOL_SECRET} would hold {size} bytes, over the {SECRET_LIMIT} a Kubernetes Secret "
                                f"may: make at most {SECRET_LIMIT * len(agents) // size} agent identities")  # fmt: skip
+    out.append(_secret(POOL_SECRET, {**flat, POOL_MARK: POOL_TEXT.encode()}))
     return out
 
 
-def write(folder: str | Path) -> Path:
+def _files(folder: Path) -> dict[str, bytes]:
+    """An identity folder's files by name, or a one-line CredentialsError."""
+    if not (folder / "identity.json").is_file():
+        raise CredentialsError(f"{folder}: not a credentials folder; write it with `swarm credentials`")
+    return {path.name: _read(path) for path in sorted(folder.iterdir()) if path.is_file()}
+
+
+def _read(path: Path) -> bytes:
+    try:
+        return path.read_bytes()
+    except OSError as exc:
+        raise CredentialsError(f"{path}: cannot read it ({exc.strerror})") from None
+
+
+def write(folder: str | Path, pool: bool = False) -> Path:
     """Write `folder`/kubernetes.yaml (private to this user: it holds every key) and return it."""
     path = Path(folder) / FILE
-    write_private(path, yaml.safe_dump_all(secrets(folder), sort_keys=False).encode())
+    write_private(path, yaml.safe_dump_all(secrets(folder, pool), sort_keys=False).encode())
     return path
