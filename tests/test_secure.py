@@ -249,13 +249,18 @@ def test_a_numbered_replica_takes_its_own_identity_or_says_why_not(tmp_path):
             assert refused.wait(timeout=60) == 1 and why in refused.stderr.read()
     finally:
         stop(started)
-    bad = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(pool), "--connect",
-                          free_endpoint()], capture_output=True, text=True, timeout=60,
-                         env={**os.environ, "SWARM_AGENT_SLOT": "x"})  # fmt: skip
-    assert bad.returncode == 2
-    assert bad.stderr.strip().splitlines() == [
+    assert _refused_agent(pool, SWARM_AGENT_SLOT="x") == [
         "swarm: error: $SWARM_AGENT_SLOT is 'x': expected the replica's number, e.g. {{.Task.Slot}}"
     ]
+
+
+def _refused_agent(pool: Path, **env: str) -> list[str]:
+    """What `swarm agent --credentials POOL` says, with `env`, as it stops with status 2."""
+    refused = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(pool), "--connect",
+                              free_endpoint()], capture_output=True, text=True, timeout=60,
+                             env={**os.environ, **env})  # fmt: skip
+    assert refused.returncode == 2, refused.stderr
+    return refused.stderr.strip().splitlines()
 
 
 def test_a_kubernetes_pod_takes_the_identity_after_its_index_from_the_flat_pool(tmp_path):
@@ -272,18 +277,10 @@ def test_a_kubernetes_pod_takes_the_identity_after_its_index_from_the_flat_pool(
         stop(started)
     flat = credentials.claim(pool, 3)
     assert (flat.name, flat.cert.read_bytes()) == (agent_name(3), (creds / agent_name(3) / "cert.pem").read_bytes())
-    bad = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(pool), "--connect",
-                          free_endpoint()], capture_output=True, text=True, timeout=60,
-                         env={**os.environ, "SWARM_AGENT_INDEX": "-1"})  # fmt: skip
-    assert bad.returncode == 2
-    assert bad.stderr.strip().splitlines() == [
+    assert _refused_agent(pool, SWARM_AGENT_INDEX="-1") == [
         "swarm: error: $SWARM_AGENT_INDEX is '-1': expected the replica's number, e.g. a StatefulSet pod's index"
     ]
-    unlabelled = subprocess.run([sys.executable, "-m", "swarm", "agent", "--credentials", str(pool), "--connect",
-                                 free_endpoint()], capture_output=True, text=True, timeout=60,
-                                env={**os.environ, "SWARM_AGENT_INDEX": ""})  # fmt: skip
-    assert unlabelled.returncode == 2
-    assert unlabelled.stderr.strip().splitlines() == [
+    assert _refused_agent(pool, SWARM_AGENT_INDEX="") == [
         "swarm: error: $SWARM_AGENT_INDEX is '': expected the replica's number, e.g. a StatefulSet pod's index (a "
         "pod's index label needs Kubernetes 1.28 or newer)"
     ]
