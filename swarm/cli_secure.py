@@ -78,8 +78,9 @@ def add_credentials_parser(sub) -> None:
                       help="put agent1..agentN in DIR/agent-pool, for identical replicas (compose --scale) to "
                       "claim one each: mount the pool into every agent container")  # fmt: skip
     made.add_argument("--kubernetes", action="store_true",
-                      help="also write DIR/kubernetes.yaml: each folder as a Secret and the agent identities as "
-                      "one pool, for deploy/k8s-secure (kubectl apply -f DIR/kubernetes.yaml)")  # fmt: skip
+                      help="also write DIR/kubernetes.yaml: each folder as a Secret and the agent identities "
+                      "as one pool, for deploy/k8s-secure (kubectl apply --server-side -f DIR/kubernetes.yaml)"
+                      )  # fmt: skip
     made.set_defaults(handler=cmd_credentials)
 
 
