@@ -85,21 +85,24 @@ class Identity:
     folder: Path
     prefix: str = ""  # a flat pool's files are agent<i>.<file>: a Kubernetes Secret's keys hold no '/'
 
+    def file(self, name: str) -> Path:
+        return self.folder / f"{self.prefix}{name}"
+
     @property
     def ca(self) -> Path:
-        return self.folder / f"{self.prefix}ca.pem"
+        return self.file("ca.pem")
 
     @property
     def cert(self) -> Path:
-        return self.folder / f"{self.prefix}cert.pem"
+        return self.file("cert.pem")
 
     @property
     def key(self) -> Path:
-        return self.folder / f"{self.prefix}key.pem"
+        return self.file("key.pem")
 
     @property
     def users_file(self) -> Path:
-        return self.folder / f"{self.prefix}users.txt"
+        return self.file("users.txt")
 
     def users(self) -> list[str]:
         """The names in the router's dictionary (only a router's folder has one)."""

@@ -31,7 +31,7 @@ from swarm.core.credentials import (
     write_private,
 )
 
-FILE = "kubernetes.yaml"  # written beside the folders: kubectl apply -f DIR/kubernetes.yaml
+FILE = "kubernetes.yaml"  # written beside the folders: kubectl apply --server-side -f DIR/kubernetes.yaml
 POOL_SECRET = "swarm-agent-pool"
 SECRET_LIMIT = 1024 * 1024  # bytes of data one Secret may hold, decoded (Kubernetes refuses more)
 
@@ -55,8 +55,8 @@ def secrets(folder: str | Path, pool: bool = False) -> list[dict]:
     agents = pool_members(folder / POOL if pool else folder)
     if not agents:
         raise CredentialsError(f"{folder}: no agent identities; write them with `swarm credentials`")
-    files = {f"{name}.{file}": where / f"{prefix}{file}" for name, where, prefix in agents for file in IDENTITY_FILES}
-    flat = {key: _read(path) for key, path in files.items()}
+    flat = {f"{name}.{file}": _read(where / f"{prefix}{file}") for name, where, prefix in agents
+            for file in IDENTITY_FILES}  # fmt: skip
     size = sum(map(len, flat.values()))
     if size > SECRET_LIMIT:
         raise CredentialsError(f"{POOL_SECRET} would hold {size} bytes, over the {SECRET_LIMIT} a Kubernetes Secret "
