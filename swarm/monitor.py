@@ -16,10 +16,10 @@ import threading
 import time
 
 from swarm.core import wire
-from swarm.core.bus import open_client, open_router
+from swarm.core.bus import open_bridge, open_client, open_router
 from swarm.core.credentials import Identity
 from swarm.core.errors import RunError
-from swarm.core.mesh import others
+from swarm.core.mesh import Mesh, listed_others, local, others
 from swarm.core.wire import world_info
 from world_server import progress_keys
 
@@ -39,6 +39,9 @@ def status(connect: str, run_id: str, router_only: bool = False, timeout: float 
         session.close()
 
 
+MESH_LOOK_EVERY = 5.0  # s between looks at the --mesh names for routers found after this one opened
+
+
 def serve_router(listen: str, identity: Identity | None = None, mesh: tuple[str, ...] = ()) -> None:
     """A bare zenoh router until SIGTERM or Ctrl-C; with `identity` (the `router` folder) it checks
     logins and enforces the access rules; linked to every other router each `mesh` name lists."""
@@ -51,10 +54,15 @@ def serve_router(listen: str, identity: Identity | None = None, mesh: tuple[str,
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     linked = f", linked to {', '.join(routers)}" if routers else ""
     print(f"swarm: zenoh router listening on {listen}{linked}", file=sys.stderr, flush=True)
+    keeper = Mesh(session, lambda: [found for name in mesh for found in listed_others(name)], routers,
+                  lambda far: open_bridge(local(listen), far, identity))  # fmt: skip
     try:
-        while not stop.wait(1.0):
-            pass
+        while not stop.wait(MESH_LOOK_EVERY if mesh else 3600.0):
+            for far in keeper.check():
+                print(f"swarm: zenoh router linked to {far}, found after it opened (through a bridge)",
+                      file=sys.stderr, flush=True)  # fmt: skip
     finally:
+        keeper.close()
         session.close()
 
 

@@ -118,7 +118,10 @@ def test_copies_of_an_agent_process_own_answers_change_nothing():
     for got, want in zip(summary["robots"], expected["robots"], strict=True):
         assert got.get("shared") == want.get("shared") and got["path_length"] == want["path_length"]
     assert summary["missed_ticks"] == 0
-    assert summary["rejected_by_reason"].get("act: second action in one tick", 0) > 0  # copies reached the world
+    # copies reached the world and were refused as copies: after the answer in its tick, or late, after it (under
+    # load the per-sender budget may drop most of them before they are read)
+    refused = summary["rejected_by_reason"]
+    assert refused.get("act: second action in one tick", 0) + refused.get("act: not for this tick", 0) > 0, refused
 
 
 def test_nan_and_huge_wheel_speeds_from_an_agent_are_refused():

@@ -11,8 +11,8 @@ import time
 
 import pytest
 
-from swarm.core.bus import open_client, open_router
-from swarm.core.mesh import is_own, others, split
+from swarm.core.bus import open_bridge, open_client, open_router
+from swarm.core.mesh import Mesh, is_own, local, others, split
 from tests.distributed import free_endpoint
 
 
@@ -21,6 +21,9 @@ def test_a_router_links_to_every_address_but_its_own():
     assert others("tcp/localhost:7447", wait=1, settle=0) == []  # lists this host only
     assert others("tcp/192.0.2.7:7447", wait=0.2, settle=0) == ["tcp/192.0.2.7:7447"]
     assert others("tcp/no-such-router.invalid:7447", wait=0.2, settle=0) == []  # not (yet) in the DNS
+    # a bridge reaches its own router where that listens
+    assert local("tcp/0.0.0.0:7447") == "tcp/127.0.0.1:7447" and local("tls/[::]:7447") == "tls/[::1]:7447"
+    assert local("tcp/10.0.0.3:7447") == "tcp/10.0.0.3:7447"
 
 
 def test_a_bad_mesh_endpoint_is_one_line():
@@ -37,7 +40,16 @@ def test_two_linked_routers_carry_messages_between_their_clients():
     later, earlier = free_endpoint(), free_endpoint()
     first = open_router(earlier)
     second = open_router(later, connect=[earlier])  # what --mesh gives the router that starts later
-    a, b = open_client(later), open_client(earlier)
+    try:
+        assert _carries(later, earlier)
+    finally:
+        second.close()
+        first.close()
+
+
+def _carries(near: str, far: str) -> bool:
+    """Whether a put by a client of the router at `near` reaches a subscriber on the router at `far`."""
+    a, b = open_client(near), open_client(far)
     got: list[str] = []
     try:
         sub = b.declare_subscriber("mesh/**", lambda sample: got.append(sample.payload.to_string()))
@@ -46,7 +58,54 @@ def test_two_linked_routers_carry_messages_between_their_clients():
             a.put("mesh/hello", "across")
             time.sleep(0.2)
         sub.undeclare()
-        assert got and got[0] == "across"
+        return got[:1] == ["across"]
     finally:
-        for session in (a, b, second, first):
-            session.close()
+        a.close()
+        b.close()
+
+
+def test_two_routers_that_missed_each_other_are_bridged_once():
+    """Each read the name before it listed the other (no links): the one that looks again bridges them."""
+    near, far = free_endpoint(), free_endpoint()
+    first, second = open_router(near), open_router(far)
+    opened: list[str] = []
+
+    def bridge(to: str):
+        opened.append(to)
+        return open_bridge(near, to)
+
+    keeper = Mesh(first, lambda: [far], [], bridge, grace=0)
+    try:
+        assert keeper.check() == [far] and keeper.linked() == {str(second.zid())}
+        assert _carries(near, far) and _carries(far, near)
+        assert keeper.check() == [] and opened == [far]  # linked: never bridged again
+    finally:
+        keeper.close()
+        second.close()
+        first.close()
+
+
+def test_a_router_waits_out_the_grace_and_bridges_none_it_is_linked_with():
+    """A later router that linked itself is no reason for a bridge, even while a listed one is not up yet."""
+    near, far, absent = free_endpoint(), free_endpoint(), free_endpoint()
+    first = open_router(near)
+    second = open_router(far, connect=[near])  # the later one, which saw the earlier
+    now = [0.0]
+    keeper = Mesh(first, lambda: [far, absent], [], lambda to: open_bridge(near, to), grace=10, clock=lambda: now[0])
+    late = None
+    try:
+        assert keeper.check() == []  # short of one, within the grace
+        now[0] = 11.0
+        assert keeper.check() == [] and keeper.bridges == {}  # far: linked already; absent: not up
+        assert far in keeper.tried and absent not in keeper.tried  # absent: tried again next round
+        late = open_router(absent)
+        now[0] = 15.0
+        assert keeper.check() == []  # the next round waits the grace again
+        now[0] = 22.0
+        assert keeper.check() == [absent] and keeper.linked() == {str(second.zid()), str(late.zid())}
+        assert _carries(absent, far)  # through the first router and its bridge
+    finally:
+        keeper.close()
+        for session in (late, second, first):
+            if session is not None:
+                session.close()

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from swarm.core import credentials, kubernetes_secrets
-from swarm.core.bus import open_client, open_router
+from swarm.core.bus import open_bridge, open_client, open_router
 from swarm.core.credentials import MONITOR, ROUTER, WORLD, agent_name, identity_in
 from swarm.core.wire import Keys
 from swarm.engines.grid import Engine
@@ -335,15 +335,23 @@ def test_replicas_from_a_pool_run_a_secure_run_as_the_engine(tmp_path):
     _ends_as_the_engine(world, procs, expected)
 
 
-def test_a_run_across_two_secure_routers_over_tls_ends_as_the_engine(creds):
-    """The world hosts router A; router B, meshed to A over TLS, serves the agent processes (a second
+@pytest.mark.parametrize("meshed", ["linked", "bridged"])
+def test_a_run_across_two_secure_routers_over_tls_ends_as_the_engine(creds, meshed):
+    """The world hosts router A; router B, meshed to A over TLS (by its own link, or through a bridge, as
+    `swarm router --mesh` links routers found after they opened), serves the agent processes (a second
     host's router): each router lets in only what its rules allow, and they carry the rest to each other."""
     scenario = load_scenario("setup2").with_overrides(agents=2, seed=13)
     expected = Engine(scenario).run().summary
     near, far = (free_endpoint().replace("tcp/", "tls/") for _ in range(2))
     world = ServerThread(scenario, "sec", near, deadline=10.0, start_timeout=COLD_START,
                          identity=identity_in(creds, ROUTER)).start()  # fmt: skip
-    second = open_router(far, identity_in(creds, ROUTER), connect=[near])
+    if meshed == "linked":
+        second = open_router(far, identity_in(creds, ROUTER), connect=[near])
+    else:
+        second, bridge = (
+            open_router(far, identity_in(creds, ROUTER)),
+            open_bridge(near, far, identity_in(creds, ROUTER)),
+        )
     procs = start_agents(far, "sec", scenario.controller, 2, credentials=creds)
     forger = open_client(far, timeout=30.0, identity=identity_in(creds, agent_name(3)))
     watcher = open_client(near, timeout=30.0, identity=identity_in(creds, WORLD))  # on A, beside the world
@@ -359,7 +367,8 @@ def test_a_run_across_two_secure_routers_over_tls_ends_as_the_engine(creds):
         for _ in range(200):  # refused at router B: never crosses to A
             forger.put(KEYS.act(agent_name(1)), forged)
 
-    _ends_as_the_engine(world, procs, expected, closing=(forger, watcher, second), meanwhile=forge)
+    closing = (forger, watcher, second) if meshed == "linked" else (forger, watcher, bridge, second)
+    _ends_as_the_engine(world, procs, expected, closing=closing, meanwhile=forge)
     assert heard and forged not in heard
 
 

@@ -88,6 +88,17 @@ def open_router(listen: str = DEFAULT_ENDPOINT, identity: Identity | None = None
         ) from None
 
 
+def open_bridge(near: str, far: str, identity: Identity | None = None) -> zenoh.Session:
+    """A router with no listener, linked to the routers at `near` and `far`: routers forward through
+    each other, so the two are linked through it (zenoh cannot add a link to an open session)."""
+    c = config("router", connect=[near, far], identity=identity)
+    c.insert_json5("listen/endpoints", "[]")  # not zenoh's default for a router, the port `near` holds
+    try:
+        return zenoh.open(c)
+    except zenoh.ZError as exc:
+        raise ConnectionError(f"cannot open a router linked to {near} and {far} ({_said(exc)})") from None
+
+
 def open_client(connect: str = DEFAULT_ENDPOINT, timeout: float = 30.0, identity: Identity | None = None
                 ) -> zenoh.Session:  # fmt: skip
     """A client session, retried until the router answers or `timeout` passes."""
