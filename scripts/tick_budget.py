@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass, replace
 
 # Measured on this 2-core machine (the commands in docs/scale.md); per core, per robot or per message.
-RAYS_PER_SECOND = 7.5e6  # swarm bench arena (cores table): 7.4-7.7 M rays per CPU-second, whole sensing, one thread
+RAYS_PER_SECOND = 10.4e6  # swarm bench arena (cores table): 10.2-10.6 M rays per CPU-second, whole sensing, one thread
 PHYSICS_SECONDS_PER_ROBOT = 3.3e-6  # swarm bench arena: 3.1-3.4 ms a tick for 1000 robots, one thread, idle machine
 WORLD_SECONDS_PER_ROBOT_MESSAGE = 0.67e-6  # swarm bench distributed: 0.31 + 0.36 ms for 1000 packed agents
 WORLD_SECONDS_PER_PROCESS_MESSAGE = 29e-6  # swarm bench distributed: the world's zenoh thread, 100 processes

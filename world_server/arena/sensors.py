@@ -129,7 +129,8 @@ class Suite:
         """Readings of every robot of the group, sensor by sensor in the registry's order.
         `ranges`, `rgb`, `what` are this group's rays (n, per_robot[, 3]); `state` is the world
         (poses, motion, contacts, zones) indexed by global robot id."""
-        ranges = ranges - self.offsets[None, :]
+        if self.offsets.any():  # (x - 0.0 is x: a suite whose rays start at the centre skips the copy)
+            ranges = ranges - self.offsets[None, :]
         base, out = self.reading(tick, state), {}
         for sensor in self.sensors:
             r = base
