@@ -19,7 +19,9 @@ import math
 from dataclasses import dataclass, replace
 
 # Measured on this 2-core machine (the commands in docs/scale.md); per core, per robot or per message.
-RAYS_PER_SECOND = 10.4e6  # swarm bench arena (cores table): 10.2-10.6 M rays per CPU-second, whole sensing, one thread
+# rays per CPU-second of the whole sensing (noise and read-outs included), one thread, per suite: swarm bench
+# arena (its cores table for the laser, 8.9-10.7 M; its suite table, 1000 animats and 100 e-pucks)
+RAYS_PER_SECOND = {"laser64": 10.4e6, "animat": 6.3e6, "epuck": 4.4e6}
 PHYSICS_SECONDS_PER_ROBOT = 3.3e-6  # swarm bench arena: 3.1-3.4 ms a tick for 1000 robots, one thread, idle machine
 WORLD_SECONDS_PER_ROBOT_MESSAGE = 0.67e-6  # swarm bench distributed: 0.31 + 0.36 ms for 1000 packed agents
 WORLD_SECONDS_PER_PROCESS_MESSAGE = 29e-6  # swarm bench distributed: the world's zenoh thread, 100 processes
@@ -47,7 +49,7 @@ class Setup:
 
 
 def sensing(s: Setup, robots: float, cores: int) -> float:
-    return robots * BEAMS[s.sensor] / (RAYS_PER_SECOND * max(1.0, cores * s.parallel_efficiency))
+    return robots * BEAMS[s.sensor] / (RAYS_PER_SECOND[s.sensor] * max(1.0, cores * s.parallel_efficiency))
 
 
 def message_bytes(s: Setup) -> int:

@@ -18,8 +18,8 @@ import time
 from swarm.core import wire
 from swarm.core.bus import open_bridge, open_client, open_router
 from swarm.core.credentials import Identity
-from swarm.core.errors import RunError
-from swarm.core.mesh import Mesh, listed_others, local, others
+from swarm.core.errors import RunError, one_line
+from swarm.core.mesh import Mesh, listed, local, others
 from swarm.core.wire import world_info
 from world_server import progress_keys
 
@@ -54,13 +54,17 @@ def serve_router(listen: str, identity: Identity | None = None, mesh: tuple[str,
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     linked = f", linked to {', '.join(routers)}" if routers else ""
     print(f"swarm: zenoh router listening on {listen}{linked}", file=sys.stderr, flush=True)
-    keeper = Mesh(session, lambda: [found for name in mesh for found in listed_others(name)], routers,
-                  lambda far: open_bridge(local(listen), far, identity))  # fmt: skip
+    keeper = Mesh(session, lambda: listed(mesh), routers, lambda far: open_bridge(local(listen), far, identity))
     try:
         while not stop.wait(MESH_LOOK_EVERY if mesh else 3600.0):
-            for far in keeper.check():
-                print(f"swarm: zenoh router linked to {far}, found after it opened (through a bridge)",
-                      file=sys.stderr, flush=True)  # fmt: skip
+            try:
+                bridged = keeper.check()
+            except Exception as exc:  # a look that fails is tried again; the router serves on
+                print(f"swarm: could not look for other routers: {one_line(exc)}", file=sys.stderr, flush=True)
+                continue
+            for far in bridged:
+                print(f"swarm: zenoh router bridging to {far}, listed with no link to this router", file=sys.stderr,
+                      flush=True)  # fmt: skip
     finally:
         keeper.close()
         session.close()

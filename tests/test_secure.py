@@ -345,13 +345,10 @@ def test_a_run_across_two_secure_routers_over_tls_ends_as_the_engine(creds, mesh
     near, far = (free_endpoint().replace("tcp/", "tls/") for _ in range(2))
     world = ServerThread(scenario, "sec", near, deadline=10.0, start_timeout=COLD_START,
                          identity=identity_in(creds, ROUTER)).start()  # fmt: skip
-    if meshed == "linked":
-        second = open_router(far, identity_in(creds, ROUTER), connect=[near])
-    else:
-        second, bridge = (
-            open_router(far, identity_in(creds, ROUTER)),
-            open_bridge(near, far, identity_in(creds, ROUTER)),
-        )
+    second = open_router(far, identity_in(creds, ROUTER), connect=[near] if meshed == "linked" else None)
+    closing = [second]
+    if meshed == "bridged":
+        closing.append(open_bridge(near, far, identity_in(creds, ROUTER)))
     procs = start_agents(far, "sec", scenario.controller, 2, credentials=creds)
     forger = open_client(far, timeout=30.0, identity=identity_in(creds, agent_name(3)))
     watcher = open_client(near, timeout=30.0, identity=identity_in(creds, WORLD))  # on A, beside the world
@@ -367,8 +364,7 @@ def test_a_run_across_two_secure_routers_over_tls_ends_as_the_engine(creds, mesh
         for _ in range(200):  # refused at router B: never crosses to A
             forger.put(KEYS.act(agent_name(1)), forged)
 
-    closing = (forger, watcher, second) if meshed == "linked" else (forger, watcher, bridge, second)
-    _ends_as_the_engine(world, procs, expected, closing=closing, meanwhile=forge)
+    _ends_as_the_engine(world, procs, expected, closing=(forger, watcher, *closing[::-1]), meanwhile=forge)
     assert heard and forged not in heard
 
 

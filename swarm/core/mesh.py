@@ -11,9 +11,11 @@ reach the other nodes), and only then reads the others: the later of the two see
 
 Under load a name's records can reach the other nodes later still, and then neither of two routers
 ever links to the other, and their processes never hear each other.  So a router keeps reading the
-name (`Mesh`): when it lists more routers than this one is linked with, for longer than zenoh's
-own retries take, each router found after this one opened gets a bridge, a second router in this
-process with no listener, linked to both (zenoh reads a router's links only when it opens).
+name (`Mesh`): a router it lists whose host has no link with this one, for longer than zenoh's own
+retries take, gets a bridge, a second router in this process with no listener, linked to both
+(zenoh reads a router's links only when it opens).  A look counts only when the name lists this
+router too: a lookup that fails under load, or a name this router has left, says nothing about
+the others.
 """
 
 from __future__ import annotations
@@ -49,30 +51,40 @@ def resolve(host: str, port: int) -> list[str]:
 def is_own(address: str) -> bool:
     """Whether `address` is one of this host's: only those can be bound to."""
     family = socket.AF_INET6 if ":" in address else socket.AF_INET
-    with socket.socket(family, socket.SOCK_STREAM) as probe:
-        try:
+    try:
+        with socket.socket(family, socket.SOCK_STREAM) as probe:
             probe.bind((address, 0))
-        except OSError:
-            return False
-        return True
+    except OSError:  # not ours, or no such family here (IPv6 off)
+        return False
+    return True
 
 
 def others(endpoint: str, wait: float = 20.0, settle: float = 3.0,
            sleep: Callable[[float], None] = time.sleep) -> list[str]:  # fmt: skip
     """The endpoints of every other router the name of `endpoint` lists.  Waits up to `wait` s
     for the name to list this host (it may never: a name that lists the others only), then `settle` s."""
-    _, host, port = split(endpoint)
+    proto, host, port = split(endpoint)
     deadline = time.monotonic() + wait
     while not any(is_own(a) for a in resolve(host, port)) and time.monotonic() < deadline:
         sleep(0.5)
     sleep(settle)
-    return listed_others(endpoint)
-
-
-def listed_others(endpoint: str) -> list[str]:
-    """The endpoints of every other router the name of `endpoint` lists now."""
-    proto, host, port = split(endpoint)
     return [_endpoint(proto, a, port) for a in resolve(host, port) if not is_own(a)]
+
+
+def listed_others(endpoint: str) -> list[str] | None:
+    """The endpoints of every other router the name of `endpoint` lists now; None unless it lists this
+    host too (the lookup failed, or this router has left the name: nothing to tell of the others)."""
+    proto, host, port = split(endpoint)
+    addresses = resolve(host, port)
+    if not any(is_own(a) for a in addresses):
+        return None
+    return [_endpoint(proto, a, port) for a in addresses if not is_own(a)]
+
+
+def listed(names: Iterable[str]) -> list[str] | None:
+    """`listed_others` of every name that lists this router; None when none does."""
+    found = [listed_others(name) for name in names]
+    return None if all(f is None for f in found) else [e for f in found if f is not None for e in f]
 
 
 def _endpoint(proto: str, host: str, port: int) -> str:
@@ -86,60 +98,54 @@ def local(listen: str) -> str:
     return _endpoint(proto, near, port)
 
 
-def _linked(router: zenoh.Session) -> set[str]:
-    """The zids of the routers linked to `router`."""
-    return {str(zid) for zid in router.info.routers_zid()}
+def host_of(locator: str) -> str:
+    """The host of a zenoh endpoint or locator: "10.0.0.3" from "tcp/10.0.0.3:7447"."""
+    return split(locator)[1]
 
 
 class Mesh:
     """Keeps `router` linked to every router `listed()` gives, also those found after it opened
-    (module docstring).  `configured`: the endpoints it was opened with, which zenoh retries itself;
-    `open_bridge(far)`: a router session linked to this one and to `far`."""
+    (module docstring): routers are told apart by host, as a name lists them.  `listed()`: None for a
+    look that tells nothing; `configured`: the endpoints it opened with, which zenoh links (and links
+    again) itself; `open_bridge(far)`: a router session linked to this one and to `far`."""
 
-    def __init__(self, router: zenoh.Session, listed: Callable[[], Iterable[str]], configured: Iterable[str],
+    def __init__(self, router: zenoh.Session, listed: Callable[[], Iterable[str] | None], configured: Iterable[str],
                  open_bridge: Callable[[str], zenoh.Session], grace: float = 10.0,
                  clock: Callable[[], float] = time.monotonic) -> None:  # fmt: skip
-        self.router, self.listed, self.open_bridge = router, listed, open_bridge
+        self.router, self.listed, self.configured, self.open_bridge = router, listed, set(configured), open_bridge
         self.grace, self.clock = grace, clock
-        self.tried = set(configured)  # configured, bridged, or found linked through the other's own link
-        self.bridges: dict[str, zenoh.Session] = {}
-        self.short_since: float | None = None
+        self.bridges: dict[str, zenoh.Session] = {}  # by the endpoint of the router each links to
+        self.missing_since: dict[str, float] = {}  # listed routers with no link, since when
 
-    def linked(self) -> set[str]:
-        """The zids of the other routers this one is linked with, directly or through a bridge."""
-        own = {str(self.router.zid())}
+    def linked_hosts(self) -> set[str]:
+        """The hosts of the routers this one has a link with, its own or a bridge's."""
+        routers = {str(zid) for zid in self.router.info.routers_zid()}
         bridges = {str(b.zid()) for b in self.bridges.values()}
-        behind = set().union(*(_linked(b) for b in self.bridges.values()))
-        return (_linked(self.router) | behind) - bridges - own
+        own = str(self.router.zid())
+        hosts = {host_of(link.dst) for link in self.router.info.links() if str(link.zid) in routers - bridges}
+        for bridge in self.bridges.values():
+            hosts |= {host_of(link.dst) for link in bridge.info.links() if str(link.zid) != own}
+        return hosts
 
     def check(self) -> list[str]:
         """One look at the names: the endpoints bridged by it."""
-        listed = set(self.listed())
-        for gone in set(self.bridges) - listed:  # its router left the name: nothing to link with
-            self.bridges.pop(gone).close()
-        if len(self.linked()) >= len(listed):
-            self.short_since = None
+        found = self.listed()
+        if found is None:
             return []
-        now = self.clock()
-        if self.short_since is None:
-            self.short_since = now
-        if now - self.short_since < self.grace:  # a link still being opened, by either side
-            return []
-        self.short_since = now  # the next round after as long again
+        listed, now, linked = set(found), self.clock(), self.linked_hosts()
+        for far in [f for f in self.bridges if f not in listed and host_of(f) not in linked]:
+            self.bridges.pop(far).close()  # its router left the name and cannot be reached: gone
+        missing = sorted(f for f in listed - self.configured - set(self.bridges) if host_of(f) not in linked)
+        self.missing_since = {far: self.missing_since.get(far, now) for far in missing}
         bridged = []
-        for far in sorted(listed - self.tried):
-            already = self.linked()
+        for far in missing:
+            if now - self.missing_since[far] < self.grace:  # a link still being opened, by either side
+                continue
             try:
-                bridge = self.open_bridge(far)
+                self.bridges[far] = self.open_bridge(far)  # kept: zenoh retries its far link until it holds
             except ConnectionError:
                 continue  # tried again next round
-            beyond = _linked(bridge) - {str(self.router.zid())}
-            if beyond:
-                self.tried.add(far)
-            if not beyond or beyond <= already:
-                bridge.close()  # not up (yet: tried again next round), or its router had linked to this one
-                continue
-            self.bridges[far] = bridge
+            del self.missing_since[far]
             bridged.append(far)
         return bridged
 

@@ -263,6 +263,15 @@ def cast_rays_parallel(pose, ray_robot, ray_cos, ray_sin, ray_range, ray_mask, s
                   seg_on, s_start, d_xyr, d_ids, d_start, x0, y0, cell, nx, ny, out_range, out_hit)  # fmt: skip
 
 
+@njit(cache=True)
+def hit_colours(what, seg_rgb, robot_rgb, out):
+    """The colour each ray's hit shows (`what`: a segment's index, or -2 - a robot's), black for no hit."""
+    for i in range(what.shape[0]):
+        w = what[i]
+        for c in range(3):
+            out[i, c] = seg_rgb[w, c] if w >= 0 else robot_rgb[-2 - w, c] if w <= -2 else 0
+
+
 def brute_force(
     ox: float,
     oy: float,

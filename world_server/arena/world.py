@@ -230,11 +230,8 @@ class ArenaWorld:
             self.rab_next[agent, : len(row)] = row
 
     def hit_colours(self, what: np.ndarray) -> np.ndarray:
-        rgb = np.zeros((len(what), 3), np.uint8)
-        wall = what >= 0
-        rgb[wall] = self.seg_rgb[what[wall]]
-        robot = what <= -2
-        rgb[robot] = self.robot_rgb[-2 - what[robot]]
+        rgb = np.empty((len(what), 3), np.uint8)
+        raycast.hit_colours(np.asarray(what, np.int64), self.seg_rgb, self.robot_rgb, rgb)
         return rgb
 
     def _refusals(self, actions: np.ndarray, robots: np.ndarray) -> np.ndarray:
