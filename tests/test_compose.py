@@ -318,7 +318,9 @@ def _stack_run(nodes: Nodes, tmp_path, files: tuple[str, ...], **settings: str) 
 
 def test_stack_deploy_runs_on_two_nodes_as_compose_does(swarm_nodes, tmp_path):
     logs = _stack_run(swarm_nodes, tmp_path, ("stack.yaml",))
-    assert "linked to tcp/" in logs["router"], logs["router"]  # the later router found the earlier one by name
+    print(logs["router"][-2000:])  # how the routers found each other (pytest shows it when asked: -s, -rA)
+    # the later router found the earlier one by name, or (the name slow to list it) one bridged to the other
+    assert "linked to tcp/" in logs["router"] or "bridging to tcp/" in logs["router"], logs["router"]
 
 
 # Not in the default run: in one CI run under load an agent replica joined, was lost and was replaced while the
@@ -331,5 +333,5 @@ def test_a_secure_stack_over_tls_links_its_routers_and_gives_each_replica_its_ow
 
     creds = credentials.make(tmp_path / "creds", 3, hosts=("host.docker.internal",), pool=True)
     logs = _stack_run(swarm_nodes, tmp_path, ("stack.yaml", "stack.secure.yaml"), LINK="tls", CREDENTIALS=str(creds))
-    assert "linked to tls/" in logs["router"], logs["router"]
+    assert "linked to tls/" in logs["router"] or "bridging to tls/" in logs["router"], logs["router"]
     assert _claimed(logs["agent"]) == ["agent1", "agent2", "agent3"], logs["agent"][-3000:]
