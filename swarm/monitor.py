@@ -56,7 +56,7 @@ def serve_router(listen: str, identity: Identity | None = None, mesh: tuple[str,
     print(f"swarm: zenoh router listening on {listen}{linked}", file=sys.stderr, flush=True)
     keeper = Mesh(session, lambda: listed(mesh), routers, lambda far: open_bridge(local(listen), far, identity))
     try:
-        while not stop.wait(MESH_LOOK_EVERY if mesh else 3600.0):
+        while not stop.wait(MESH_LOOK_EVERY):  # without --mesh names every look tells nothing (None)
             try:
                 bridged = keeper.check()
             except Exception as exc:  # a look that fails is tried again; the router serves on

@@ -119,10 +119,10 @@ class Mesh:
 
     def linked_hosts(self) -> set[str]:
         """The hosts of the routers this one has a link with, its own or a bridge's."""
-        routers = {str(zid) for zid in self.router.info.routers_zid()}
         bridges = {str(b.zid()) for b in self.bridges.values()}
+        routers = {str(zid) for zid in self.router.info.routers_zid()} - bridges
         own = str(self.router.zid())
-        hosts = {host_of(link.dst) for link in self.router.info.links() if str(link.zid) in routers - bridges}
+        hosts = {host_of(link.dst) for link in self.router.info.links() if str(link.zid) in routers}
         for bridge in self.bridges.values():
             hosts |= {host_of(link.dst) for link in bridge.info.links() if str(link.zid) != own}
         return hosts
