@@ -47,6 +47,7 @@ class Stats:
     joins: int = 0
     late_actions: int = 0
     missed_ticks: int = 0
+    clock_slips: int = 0  # real-time ticks that started too late to end on the world's clock
 
     def reject(self, reason: str, count: int = 1) -> None:
         self.rejected[reason] = self.rejected.get(reason, 0) + count
@@ -204,6 +205,7 @@ class WorldServer:
         self.events: queue.SimpleQueue = queue.SimpleQueue()  # bounded by the gate's budgets
         self.gate = Gate(allowances(self.scenario.agents), self.group_index, self.window())
         self.started = 0.0
+        self._due = 0.0  # when the current real-time tick's answers are due (0: the clock has not started)
 
     def _open_session(self, listen: str | None, connect: str | None, identity: Identity | None) -> None:
         """The zenoh session, with the join, info, action, liveliness, shared and state keys declared.
@@ -485,9 +487,9 @@ class WorldServer:
                 if left <= 0:
                     break
                 self.drain(left)
-        else:  # real time: the tick lasts one period, whoever has answered
-            deadline = started + self.period
-            while (left := deadline - time.monotonic()) > 0:
+        else:  # real time: the tick ends on the world's clock, whoever has answered
+            self._due = self._beat(time.monotonic())
+            while (left := self._due - time.monotonic()) > 0:
                 self.drain(left)
         self.kind.barrier_passed()
         answered = self.acted[active]
@@ -516,6 +518,17 @@ class WorldServer:
         if (now := time.monotonic()) >= self._next_state:  # progress for people: ten times a second is plenty
             self._next_state = now + STATE_PERIOD
             self._state_publisher.put(wire.pack({"type": "state", **self.progress()}))
+
+    def _beat(self, now: float) -> float:
+        """When this real-time tick's answers are due: one period after the last tick's, so the world's own
+        work between two ticks (and a stall of the machine) does not slow the rate; the clock slips, and
+        counts it, only where that would leave the agents less than half a period to answer."""
+        due = self._due + self.period
+        if due - now < self.period / 2:
+            if self._due:  # the first tick starts the clock
+                self.stats.clock_slips += 1
+            due = now + (self.period / 2 if self._due else self.period)
+        return due
 
     def _count_dropped(self) -> None:
         """What the gate dropped since the last count, into the run's rejections (on the world's thread)."""
@@ -558,6 +571,7 @@ class WorldServer:
         while not self.kind.done() and self.tick < self.max_iterations:
             if not (self.slots == ACTIVE).any():
                 self._wait_for_any_agent()  # a world with nobody in it does not tick on alone
+                self._due = 0.0  # nor does its clock: it starts again with the next tick
             self.step()
         self.drain(0.0)
         self.kind.finish()
@@ -600,6 +614,7 @@ class WorldServer:
             "rejected_messages": self.stats.rejected_total, "rejected_by_reason": dict(self.stats.rejected),
             "agents_lost": self.stats.agents_lost, "joins": self.stats.joins, "missed_ticks": self.stats.missed_ticks,
             "agents_peak": self.agents_peak,
+            **({"clock_slips": self.stats.clock_slips} if self.mode == "realtime" else {}),
             "ticks_per_second": round(self.tick / elapsed, 2) if elapsed > 0 else 0.0,
             "wall_seconds": round(elapsed, 3), **self._latency(), "recording": self.recording_path,
         }  # fmt: skip

@@ -57,29 +57,35 @@ def flood(kind: str, endpoint: str, run_id: str, family: str, seed: int, rate: f
           sent, seconds) -> None:  # fmt: skip
     """One flooding client: `kind` of KINDS, `rate` messages a second (0: as fast as it can), at `nice`;
     `ready` (a shared semaphore) is released once it listens and floods, `sent` (a shared integer) counts
-    its puts and queries, `seconds` (a shared float) how long it flooded."""
-    os.nice(nice)
+    its puts and queries, `seconds` (a shared float) how long it flooded.  It connects and subscribes at
+    the bench's priority, so that on a loaded machine it hears the run from its first observation, and
+    floods at `nice`."""
     session = open_client(endpoint, timeout=120)
+
+    def flooding() -> None:
+        ready.release()
+        os.nice(nice)
+
     pace = _Pace(sent, rate, stop)
     keys = wire.Keys(run_id)
     rng = np.random.default_rng(seed)
     garbage = [rng.bytes(int(n)) for n in rng.integers(1, 160, 64)]
     try:
         if kind == "garbage":
-            _garbage(session, keys, garbage, pace, ready)
+            _garbage(session, keys, garbage, pace, flooding)
         elif kind == "forged":
-            _forged(session, keys, family, garbage, pace, ready)
+            _forged(session, keys, family, garbage, pace, flooding)
         else:
-            _own(session, keys, garbage, pace, ready)
+            _own(session, keys, garbage, pace, flooding)
     finally:
         seconds.value = time.monotonic() - pace.started if pace.started else 0.0
         session.close()
 
 
-def _garbage(session, keys: wire.Keys, garbage: list[bytes], pace: _Pace, ready) -> None:
+def _garbage(session, keys: wire.Keys, garbage: list[bytes], pace: _Pace, flooding) -> None:
     targets = [keys.act("stranger"), keys.plan("stranger"), keys.record("stranger"), keys.mark("stranger")]
     pubs = [session.declare_publisher(k) for k in targets]
-    ready.release()
+    flooding()
     k = 0
     while True:
         for _ in range(BATCH):
@@ -147,7 +153,7 @@ def _on_their_keys(session, keys: wire.Keys, pace: _Pace, heard: _Heard, what: s
             return
 
 
-def _forged(session, keys: wire.Keys, family: str, garbage: list[bytes], pace: _Pace, ready) -> None:
+def _forged(session, keys: wire.Keys, family: str, garbage: list[bytes], pace: _Pace, flooding) -> None:
     made: dict[int, list[bytes]] = {}
 
     def forged(tick: int, k: int) -> bytes:
@@ -157,16 +163,16 @@ def _forged(session, keys: wire.Keys, family: str, garbage: list[bytes], pace: _
         return made[tick][k % 3]
 
     heard = _Heard(session, keys)
-    ready.release()
+    flooding()
     _on_their_keys(session, keys, pace, heard, "tick", forged)
 
 
-def _own(session, keys: wire.Keys, garbage: list[bytes], pace: _Pace, ready) -> None:
+def _own(session, keys: wire.Keys, garbage: list[bytes], pace: _Pace, flooding) -> None:
     def again(answer: bytes, k: int) -> bytes:
         return answer if k % 2 else garbage[k % len(garbage)]
 
     heard = _Heard(session, keys)
-    ready.release()
+    flooding()
     _on_their_keys(session, keys, pace, heard, "answer", again)
 
 
