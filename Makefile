@@ -41,7 +41,7 @@ docker:
 test: install browser docker
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
-	$(BIN)/python -m pytest -q -n 2 --dist loadfile
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile --durations=25
 
 lint: install
 	$(BIN)/ruff check .
