@@ -10,6 +10,8 @@ anything on pytest 9 (pytest-dev/pytest-xdist#1386).
 
 from __future__ import annotations
 
+import warnings
+
 import pytest
 from xdist.scheduler import LoadScopeScheduling
 
@@ -29,6 +31,26 @@ class SpreadScheduling(LoadScopeScheduling):
     def _split_scope(self, nodeid: str) -> str:
         file = nodeid.split("::", 1)[0]
         return nodeid if file in SPREAD else file
+
+
+def pytest_configure(config):
+    """Build the agents' compiled step (agents/controllers/aot.py) before any test starts agent processes,
+    as `swarm up` does: without it, every agent process of a test compiles its step with numba on its first
+    observation (a minute of CPU each on a fresh source version), which on a loaded machine outlasts a
+    world's wait for joins or holds a real-time run back.  Once, here in the session's controller."""
+    if hasattr(config, "workerinput"):  # an xdist worker: the controller built it before starting it
+        return
+    from agents.controllers import aot
+    from swarm.core.kernels import built
+
+    if built() is None:
+        print("building the agents' compiled step for this source version (about a minute)", flush=True)
+        try:
+            with warnings.catch_warnings():  # numba's pycc, which the build uses, is "pending deprecation"
+                warnings.simplefilter("ignore", PendingDeprecationWarning)
+                aot.build()
+        except Exception as exc:  # no C compiler: agent processes fall back to numba's JIT, as in a run
+            print(f"note: the agents' compiled step did not build ({exc}); agent processes use the JIT")
 
 
 @pytest.hookimpl(tryfirst=True)

@@ -521,13 +521,14 @@ class WorldServer:
 
     def _beat(self, now: float) -> float:
         """When this real-time tick's answers are due: one period after the last tick's, so the world's own
-        work between two ticks (and a stall of the machine) does not slow the rate; the clock slips, and
-        counts it, only where that would leave the agents less than half a period to answer."""
+        work between two ticks (and a short stall of the machine) does not slow the rate.  Where that would
+        leave the agents less than half a period to answer, the clock slips, and counts it: the tick lasts a
+        whole period from now, as the first does, so a world that falls behind never rushes its agents."""
         due = self._due + self.period
         if due - now < self.period / 2:
             if self._due:  # the first tick starts the clock
                 self.stats.clock_slips += 1
-            due = now + (self.period / 2 if self._due else self.period)
+            due = now + self.period
         return due
 
     def _count_dropped(self) -> None:
