@@ -10,6 +10,7 @@ anything on pytest 9 (pytest-dev/pytest-xdist#1386).
 
 from __future__ import annotations
 
+import shutil
 import warnings
 
 import pytest
@@ -38,22 +39,22 @@ def pytest_configure(config):
     as `swarm up` does: without it, every agent process of a test compiles its step with numba on its first
     observation (a minute of CPU each on a fresh source version), which on a loaded machine outlasts a
     world's wait for joins or holds a real-time run back.  Once, here in the session's controller."""
-    if hasattr(config, "workerinput"):  # an xdist worker: the controller built it before starting it
-        return
+    if hasattr(config, "workerinput") or config.option.collectonly or getattr(config.option, "help", False):
+        return  # an xdist worker (the controller built it before starting it), or no test to run
     from agents.controllers import aot
     from swarm.core.kernels import built
 
-    if built() is None:
+    if built() is None and shutil.which("cc"):  # without a C compiler it cannot build: the JIT it is
         print("building the agents' compiled step for this source version (about a minute)", flush=True)
         try:
             with warnings.catch_warnings():  # numba's pycc, which the build uses, is "pending deprecation"
                 warnings.simplefilter("ignore", PendingDeprecationWarning)
                 aot.build()
-        except Exception as exc:  # no C compiler: agent processes fall back to numba's JIT, as in a run
+        except Exception as exc:  # a failed build: agent processes fall back to numba's JIT, as in a run
             print(f"note: the agents' compiled step did not build ({exc}); agent processes use the JIT")
 
 
-@pytest.hookimpl(tryfirst=True)
+@pytest.hookimpl(tryfirst=True, optionalhook=True)
 def pytest_xdist_make_scheduler(config, log):
     if config.getvalue("dist") == "loadfile":
         return SpreadScheduling(config, log)

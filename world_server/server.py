@@ -473,7 +473,7 @@ class WorldServer:
             self.drain(0.05)
 
     def step(self) -> None:
-        started = time.perf_counter()
+        started, begun = time.perf_counter(), time.monotonic()
         tick = self.tick
         active = np.flatnonzero(self.slots == ACTIVE)
         self.acted[:] = False
@@ -488,7 +488,7 @@ class WorldServer:
                     break
                 self.drain(left)
         else:  # real time: the tick ends on the world's clock, whoever has answered
-            self._due = self._beat(time.monotonic())
+            self._due = self._beat(begun)
             while (left := self._due - time.monotonic()) > 0:
                 self.drain(left)
         self.kind.barrier_passed()
@@ -520,10 +520,10 @@ class WorldServer:
             self._state_publisher.put(wire.pack({"type": "state", **self.progress()}))
 
     def _beat(self, now: float) -> float:
-        """When this real-time tick's answers are due: one period after the last tick's, so the world's own
-        work between two ticks (and a short stall of the machine) does not slow the rate.  Where that would
-        leave the agents less than half a period to answer, the clock slips, and counts it: the tick lasts a
-        whole period from now, as the first does, so a world that falls behind never rushes its agents."""
+        """When the real-time tick begun `now` has its answers due: one period after the last tick's, so the
+        world's own work between two ticks (and a short stall of the machine) does not slow the rate.  Where
+        that would leave less than half a period, the clock slips, and counts it: the tick lasts a whole
+        period from its beginning, as the first does, so the agents always have half a period at least."""
         due = self._due + self.period
         if due - now < self.period / 2:
             if self._due:  # the first tick starts the clock
