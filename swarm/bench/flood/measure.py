@@ -25,7 +25,7 @@ RUNS = {
                         "world_args": ["--max-ticks", "2000"]},
 }  # fmt: skip
 # --quick: shorter runs, each still a few seconds long: the forged and own clients flood only once they have
-# heard an observation, and at niceness 19 on a loaded machine that can take a second or more
+# heard an observation, and then at niceness 19: on a loaded machine their first puts can come a second late
 QUICK = {
     wire.FAMILY_GRID: {"scenario_ref": "setup2", "agents": 2, "per_process": 1, "seed": 3},
     wire.FAMILY_ARENA: {"scenario_ref": "office", "agents": 1, "per_process": 1, "seed": 3,
