@@ -71,7 +71,8 @@ def soak(kind: str, minutes: float, kill_every: float, interval: float, folder: 
             "played": played, "recorded": len(recorded), "missing_ticks": checks.missing_ticks(recorded, played),
             "losses": checks.losses(summary, len(watch.kill_times), run["per_process"]), "memory": memory,
             "span_s": [round(t) for t in checks.span(lasted)], "missed_ticks": summary.get("missed_ticks"),
-            "kill_times": watch.kill_times, "samples": watch.samples}  # fmt: skip
+            "clock_slips": summary.get("clock_slips"), "kill_times": watch.kill_times,
+            "samples": watch.samples}  # fmt: skip
 
 
 def _recorded_ticks(path: Path):
