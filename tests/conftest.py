@@ -41,10 +41,11 @@ def pytest_configure(config):
     world's wait for joins or holds a real-time run back.  Once, here in the session's controller."""
     if hasattr(config, "workerinput") or config.option.collectonly or getattr(config.option, "help", False):
         return  # an xdist worker (the controller built it before starting it), or no test to run
-    from agents.controllers import aot
     from swarm.core.kernels import built
 
     if built() is None and shutil.which("cc"):  # without a C compiler it cannot build: the JIT it is
+        from agents.controllers import aot  # every controller: imported only to build
+
         print("building the agents' compiled step for this source version (about a minute)", flush=True)
         try:
             with warnings.catch_warnings():  # numba's pycc, which the build uses, is "pending deprecation"

@@ -63,22 +63,26 @@ def others(endpoint: str, wait: float = 20.0, settle: float = 3.0,
            sleep: Callable[[float], None] = time.sleep) -> list[str]:  # fmt: skip
     """The endpoints of every other router the name of `endpoint` lists.  Waits up to `wait` s
     for the name to list this host (it may never: a name that lists the others only), then `settle` s."""
-    proto, host, port = split(endpoint)
     deadline = time.monotonic() + wait
-    while not any(is_own(a) for a in resolve(host, port)) and time.monotonic() < deadline:
+    while not _look(endpoint)[0] and time.monotonic() < deadline:
         sleep(0.5)
     sleep(settle)
-    return [_endpoint(proto, a, port) for a in resolve(host, port) if not is_own(a)]
+    return _look(endpoint)[1]
 
 
 def listed_others(endpoint: str) -> list[str] | None:
     """The endpoints of every other router the name of `endpoint` lists now; None unless it lists this
     host too (the lookup failed, or this router has left the name: nothing to tell of the others)."""
+    lists_this_host, found = _look(endpoint)
+    return found if lists_this_host else None
+
+
+def _look(endpoint: str) -> tuple[bool, list[str]]:
+    """One lookup of the name of `endpoint`: whether it lists this host, and the endpoints of the others."""
     proto, host, port = split(endpoint)
     addresses = resolve(host, port)
-    if not any(is_own(a) for a in addresses):
-        return None
-    return [_endpoint(proto, a, port) for a in addresses if not is_own(a)]
+    own = [is_own(a) for a in addresses]
+    return any(own), [_endpoint(proto, a, port) for a, mine in zip(addresses, own, strict=True) if not mine]
 
 
 def listed(names: Iterable[str]) -> list[str] | None:

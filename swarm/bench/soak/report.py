@@ -27,7 +27,7 @@ def format_soak_bench(r: dict) -> str:
         f"{'ticks played / recorded':<28}{r['played']} / {r['recorded']}",
         f"{'ticks missing':<28}{len(missing)}{'' if not missing else ' (first ' + str(missing[:5]) + ')'}",
         f"{'missed agent-ticks (world)':<28}{r['missed_ticks']} (an agent's answer not in by its tick's end)",
-        f"{'clock slips (world)':<28}{r.get('clock_slips')} (ticks begun too late to keep the rate: the world behind)",
+        f"{'clock slips (world)':<28}{r['clock_slips']} (ticks begun too late to keep the rate: the world behind)",
         "",
         f"Resident memory (MB, median of the samples near each moment), growth over {start / 60:.1f}..{end / 60:.1f}"
         " min",
