@@ -15,11 +15,11 @@ from pathlib import Path
 
 import pytest
 
-from swarm.bench.executors.head import free_port as _free_port
-from swarm.bench.executors.head import processes as _processes
 from swarm.bench.executors.head import ray_head
 from swarm.cli import main
 from swarm.experiments.executors import LocalExecutor, RayExecutor, use
+from swarm.experiments.ray_head import free_port as _free_port
+from swarm.experiments.ray_head import processes as _processes
 from swarm.experiments.runner import JobFailed, batch_run
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -167,14 +167,35 @@ def test_ray_started_here_takes_only_the_cores_asked_and_leaves_nothing_running(
         "from swarm.experiments.runner import batch_run\n"
         "from tests.test_executors import _square\n"
         "with use(RayExecutor(cpus=1)) as ray:\n"
+        "    print(ray.head.session, flush=True)\n"
         "    rows = batch_run(_square, [1, 2, 3], progress=False)\n"
         "    print(ray.width(None, 10), ray.width(4, 10), [r['square'] for r in rows], {r['pid'] for r in rows})\n"
     )
     python = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stdout=subprocess.PIPE, text=True,
                               start_new_session=True)  # fmt: skip
     out, _ = python.communicate(timeout=120)
-    assert out.startswith("1 1 [1, 4, 9] {") and str(python.pid) not in out.split("{")[1]
-    _none_left(_in_session(python.pid))
+    head, said = out.split("\n", 1)
+    assert said.startswith("1 1 [1, 4, 9] {") and str(python.pid) not in said.split("{")[1]
+    _none_left(lambda ps: _in_session(python.pid)(ps) + _in_session(int(head))(ps))
+
+
+def test_ray_started_here_ends_with_a_command_killed_outright():
+    """SIGKILL gives the command no time to stop its Ray: every process of Ray's session goes with it."""
+    script = (
+        "import time\n"
+        "from swarm.experiments.executors import RayExecutor, use\n"
+        "with use(RayExecutor(cpus=1)) as ray:\n"
+        "    ray.connected()\n"
+        "    print(ray.head.session, flush=True)\n"
+        "    time.sleep(120)\n"
+    )
+    python = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)  # fmt: skip
+    head = int(python.stdout.readline())
+    assert [cmd for _, cmd in _in_session(head)(_processes()) if "raylet" in cmd], "Ray's raylet was not running"
+    python.kill()
+    python.wait(timeout=10)
+    _none_left(_in_session(head))
 
 
 @pytest.mark.parametrize("command", [["sweep", "s.toml"], ["experiment", "table1"], ["reproduce", "simonin2007"]])

@@ -8,8 +8,8 @@ that dies fails the chunk it was running and hands back, untried, the one it hel
 out the jobs, keeps the rows in the jobs' order and retries a failed job once.
 
 - `LocalExecutor`: spawned processes on this machine; one worker is this process itself.
-- `RayExecutor`: actors of one CPU each on the Ray cluster at `address`, or on a Ray instance started
-  here for the command (no dashboard, at most `cpus` CPUs).
+- `RayExecutor`: actors of one CPU each on the Ray cluster at `address`, or on a Ray head started
+  here for the command (swarm/experiments/ray_head.py: no dashboard, at most `cpus` CPUs).
 
 A command chooses one executor for all its runs (`--executor local|ray [--address ADDR]`, see
 `add_executor_options`) and sets it with `use`; batch_run asks `current()`.  In Python:
@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from swarm.core.errors import RunError, one_line
+from swarm.experiments.ray_head import OWN_HEAD, RayHead
 
 IN_HAND = 2  # chunks a worker holds at once: the one it runs and the next
 EXECUTORS = ("local", "ray")
@@ -258,23 +259,33 @@ def _exit(code: int | None) -> str:
 
 class RayExecutor:
     """Actors of one CPU each on the Ray cluster at `address` (HOST:PORT of `ray start --head`; default
-    $RAY_ADDRESS), or, with none, on a Ray instance started here at the first batch and stopped with
-    the command (no dashboard, `cpus` CPUs: default every core).  Its workers import the job's code
-    themselves: on a cluster every host needs this swarm installed; here they are given this process's
-    import path."""
+    $RAY_ADDRESS), or, with none, on a Ray head started here as the executor is made, so that it comes
+    up while the command sets itself up, and stopped with it (`close`; no dashboard, `cpus` CPUs: default
+    every core).  Its workers import the job's code themselves: on a cluster every host needs this swarm
+    installed; here they are given this process's import path."""
 
     name = "ray"
 
     def __init__(self, address: str | None = None, cpus: int | None = None) -> None:
-        self.address, self.cpus = address or os.environ.get("RAY_ADDRESS") or None, cpus
+        self.address = address or os.environ.get("RAY_ADDRESS") or None
         self.ray: Any = None
+        self.head: RayHead | None = None
         if self.address is not None:
             _check_reachable(self.address)
+        else:
+            _use_tokens_as_ray_does()
+            self.head = RayHead(cpus or os.cpu_count() or 1, _import_path())
 
     def connected(self) -> Any:
-        """The ray module, connected (or its instance started) on first use."""
+        """The ray module, connected on first use (to the head started here once its node is registered)."""
         if self.ray is None:
-            self.ray = _connect(self.address, self.cpus)
+            if self.head is None:
+                self.ray = _connect(self.address, mine=False)  # type: ignore[arg-type]
+            else:
+                import ray  # noqa: F401  (a fifth of a second, taken while the head finishes starting)
+
+                with _environ(OWN_HEAD):  # this process's settings as its head's, read as it connects
+                    self.ray = _connect(self.head.address(), mine=True)
         return self.ray
 
     def width(self, jobs: int | None, work: int) -> int:
@@ -288,8 +299,11 @@ class RayExecutor:
 
     def close(self) -> None:
         if self.ray is not None:
-            self.ray.shutdown()
+            self.ray.shutdown()  # a driver's leaving: the cluster goes on
             self.ray = None
+        if self.head is not None:
+            self.head.stop()
+            self.head = None
 
 
 class RayWorker:
@@ -366,26 +380,32 @@ def _check_reachable(address: str) -> None:
                        ) from None  # fmt: skip
 
 
-def _connect(address: str | None, cpus: int | None) -> Any:
+def _use_tokens_as_ray_does(address: str | None = None) -> None:
+    """Ray's own rule for a cluster it starts or finds by itself, said quietly: token authentication,
+    with a token made and kept in ~/.ray/auth_token for a cluster started here where there is none yet."""
     os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
     if "RAY_AUTH_MODE" not in os.environ and (address is None or _token_here()):
-        # Ray's own rule for a cluster it starts or finds by itself, said quietly: use the token.
         os.environ["RAY_AUTH_MODE"] = "token"
+    if address is None and os.environ.get("RAY_AUTH_MODE") == "token" and not _token_here():
+        from ray._private.authentication.authentication_token_setup import generate_and_save_token
+
+        generate_and_save_token()
+
+
+def _connect(address: str, mine: bool) -> Any:
+    """The ray module, connected to the cluster at `address` (`mine`: the head this command started)."""
+    _use_tokens_as_ray_does(None if mine else address)
     import ray
 
     before = signal.getsignal(signal.SIGTERM)
     try:
-        if address is None:
-            with _environ("PYTHONPATH", _import_path()):  # its raylet, and so its workers, inherit it
-                ray.init(num_cpus=cpus or os.cpu_count(), include_dashboard=False, logging_level=logging.WARNING)
-        else:
-            ray.init(address=address, logging_level=logging.WARNING)
+        ray.init(address=address, logging_level=logging.WARNING)
     except Exception as exc:
         causes = " ".join(str(e) for e in _chain(exc))
-        if "InvalidAuthToken" in causes:
+        if "InvalidAuthToken" in causes and not mine:
             raise RunError(f"the Ray cluster at {address} refused this machine's token: copy the head's "
                            "~/.ray/auth_token here (or set RAY_AUTH_TOKEN)") from None  # fmt: skip
-        raise RunError(f"cannot use Ray {'here' if address is None else f'at {address}'}: {one_line(exc)}") from None
+        raise RunError(f"cannot use Ray {'here' if mine else f'at {address}'}: {one_line(exc)}") from None
     finally:  # Ray sets a SIGTERM handler of its own (exit at once): the command's ends it as Ctrl-C does
         with contextlib.suppress(TypeError, ValueError):  # none set from Python; not the main thread
             signal.signal(signal.SIGTERM, before)
@@ -413,16 +433,15 @@ def _import_path() -> str:
 
 
 @contextlib.contextmanager
-def _environ(name: str, value: str) -> Iterator[None]:
-    before = os.environ.get(name)
-    os.environ[name] = value
+def _environ(settings: dict[str, str]) -> Iterator[None]:
+    """`settings` in this process's environment for the block, where it does not set them itself."""
+    added = {name: value for name, value in settings.items() if name not in os.environ}
+    os.environ.update(added)
     try:
         yield
     finally:
-        if before is None:
-            del os.environ[name]
-        else:
-            os.environ[name] = before
+        for name in added:
+            os.environ.pop(name, None)
 
 
 # -------------------------------------------------------------------------------- the command's choice

@@ -1,0 +1,157 @@
+"""A Ray head on this machine, started as a user starts one (`ray start --head --block`) and stopped with
+every process it started: the cluster of a command run with `--executor ray` and no address.
+
+Why not `ray.init()` with no address, which starts the same processes: it starts them only when it is
+called and waits for them inside the call (a second of it Ray's fixed wait before it looks again for the
+raylet's registration), and `ray.shutdown()` then stops them one after another.  This head is started
+when the command begins, comes up while the command sets itself up, is connected to as soon as its
+raylet is registered, and ends as its whole session is killed (docs/commands.md has the seconds).
+
+Its processes are a session of their own, so a Ctrl-C at the terminal reaches only the command, which
+stops them.  The process that started it ending, even killed with SIGKILL, sends `ray start --block` a
+SIGTERM (the kernel's parent-death signal, armed from a thread that lives as long as the process), on
+which it stops every process it started: nothing is left running.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import os
+import queue
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Mapping
+from pathlib import Path
+
+from swarm.core.errors import RunError
+
+RAY = Path(sys.executable).with_name("ray")
+STARTED = "Ray runtime started."  # what `ray start` prints once it has seen its node registered
+# what the raylet logs once the GCS has registered it: usable from then on, a second before `ray start`
+# says so (it looks for the node again only after a fixed second's sleep)
+REGISTERED = re.compile(r"Raylet of id, \w+ started")
+# Ray's settings (RayConfig values, read from RAY_<name>) for a head that serves one command, in its
+# processes and in the command's own:
+OWN_HEAD = {
+    # a process's tries at its raylet and the raylet's at the object store it starts itself: every 50 ms,
+    # 10 s in all (Ray's default, every second, brought the head up a second late one time in three)
+    "RAY_raylet_client_connect_timeout_milliseconds": "50",
+    "RAY_raylet_client_num_connect_attempts": "200",
+    # no task events: they feed the dashboard and `ray list tasks`, which such a head has not, and sending
+    # the last of them holds each process's ray.shutdown a quarter of a second
+    "RAY_task_events_report_interval_ms": "0",
+}
+PR_SET_PDEATHSIG = 1
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def processes() -> dict[int, tuple[int, int, str]]:
+    """Every live process (zombies left out): pid -> (parent, session, command line)."""
+    found = {}
+    for name in filter(str.isdigit, os.listdir("/proc")):
+        with contextlib.suppress(OSError):
+            fields = Path(f"/proc/{name}/stat").read_text().rpartition(")")[2].split()
+            cmd = Path(f"/proc/{name}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+            if fields[0] != "Z":
+                found[int(name)] = (int(fields[1]), int(fields[3]), cmd)
+    return found
+
+
+class RayHead:
+    """`ray start --head` of `cpus` CPUs on 127.0.0.1, no dashboard, its workers importing `pythonpath`
+    first, with Ray's `settings` (`OWN_HEAD`, or none: as a user starts one), started at once in the
+    background; `address()` waits until its node is registered."""
+
+    def __init__(self, cpus: int, pythonpath: str, settings: Mapping[str, str] = OWN_HEAD,
+                 env: Mapping[str, str] | None = None) -> None:  # fmt: skip
+        self.port = free_port()
+        self.temp = tempfile.mkdtemp(prefix="ray", dir="/tmp")  # short: Ray's socket paths fit in 107 bytes
+        self.log = Path(self.temp) / "head.log"
+        environ = {**settings, **(env if env is not None else os.environ)}
+        environ["PYTHONPATH"] = os.pathsep.join(filter(None, [pythonpath, environ.get("PYTHONPATH")]))
+        cmd = [str(RAY), "start", "--head", f"--port={self.port}", f"--num-cpus={cpus}", "--node-ip-address=127.0.0.1",
+               "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={self.temp}", "--block"]  # fmt: skip
+        with open(self.log, "w") as log:
+            self.process = _started_for_life(cmd, env=environ, stdout=log, stderr=subprocess.STDOUT)
+        self.session = self.process.pid  # the session it leads, which all its processes share
+
+    def address(self, timeout: float = 120.0) -> str:
+        """HOST:PORT, once the head's node is registered (so connecting waits for nothing)."""
+        deadline = time.monotonic() + timeout
+        while not self._registered():
+            if self.process.poll() is not None:
+                raise RunError(f"Ray could not start here: `ray start --head` exited ({self._said()})")
+            if time.monotonic() > deadline:
+                raise RunError(f"Ray did not start here in {timeout:.0f} s ({self._said()})")
+            time.sleep(0.02)
+        return f"127.0.0.1:{self.port}"
+
+    def _registered(self) -> bool:
+        raylet = Path(self.temp) / "session_latest" / "logs" / "raylet.out"
+        with contextlib.suppress(OSError):
+            if REGISTERED.search(raylet.read_text(errors="replace")):
+                return True
+        return STARTED in self.log.read_text(errors="replace")
+
+    def _said(self) -> str:
+        lines = [line.strip() for line in self.log.read_text(errors="replace").splitlines() if line.strip()]
+        return lines[-1] if lines else "it said nothing"
+
+    def stop(self) -> None:
+        """Kill every process of the head's session, and remove its folder."""
+        for pid in [p for p, (_, sid, _) in processes().items() if sid == self.session]:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            self.process.wait(timeout=30)
+        shutil.rmtree(self.temp, ignore_errors=True)
+
+    def __enter__(self) -> RayHead:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+def _started_for_life(cmd: list[str], **popen) -> subprocess.Popen:
+    """`cmd` in a session of its own, sent SIGTERM when this process ends.  The kernel sends the
+    parent-death signal when the thread that forked the child ends, so a thread that lives as long as
+    this process (a daemon waiting for the child) forks it."""
+    prctl = ctypes.CDLL(None, use_errno=True).prctl if sys.platform.startswith("linux") else None
+    parent = os.getpid()
+
+    def arm() -> None:  # in the child, between fork and exec: nothing that takes a lock
+        if prctl is not None:
+            prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+            if os.getppid() != parent:  # the parent ended before the signal was armed
+                os._exit(1)
+
+    handed: queue.SimpleQueue = queue.SimpleQueue()
+
+    def keep() -> None:
+        try:
+            child = subprocess.Popen(cmd, start_new_session=True, preexec_fn=arm, **popen)
+        except BaseException as exc:
+            handed.put(exc)
+            return
+        handed.put(child)
+        child.wait()
+
+    threading.Thread(target=keep, name="ray-head", daemon=True).start()
+    child = handed.get()
+    if isinstance(child, BaseException):
+        raise RunError(f"cannot start Ray here: {child}") from None
+    return child
