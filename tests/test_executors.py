@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -162,40 +163,56 @@ def test_an_experiment_through_ray_equals_the_local_pool(cluster, tmp_path):
 
 
 def test_ray_started_here_takes_only_the_cores_asked_and_leaves_nothing_running():
+    """Closing the executor stops its head: the script looks, while it still runs, for its head's
+    processes and folder (its own end would take them with it anyway)."""
     script = (
+        "import os\n"
         "from swarm.experiments.executors import RayExecutor, use\n"
+        "from swarm.experiments.ray_head import processes\n"
         "from swarm.experiments.runner import batch_run\n"
         "from tests.test_executors import _square\n"
         "with use(RayExecutor(cpus=1)) as ray:\n"
-        "    print(ray.head.session, flush=True)\n"
+        "    head = ray.head\n"
         "    rows = batch_run(_square, [1, 2, 3], progress=False)\n"
         "    print(ray.width(None, 10), ray.width(4, 10), [r['square'] for r in rows], {r['pid'] for r in rows})\n"
+        "left = [cmd for _, sid, cmd in processes().values() if sid == head.session]\n"
+        "print(left, os.path.exists(head.temp))\n"
     )
     python = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stdout=subprocess.PIPE, text=True,
                               start_new_session=True)  # fmt: skip
     out, _ = python.communicate(timeout=120)
-    head, said = out.split("\n", 1)
+    said, after = out.splitlines()
     assert said.startswith("1 1 [1, 4, 9] {") and str(python.pid) not in said.split("{")[1]
-    _none_left(lambda ps: _in_session(python.pid)(ps) + _in_session(int(head))(ps))
+    assert after == "[] False"
+    _none_left(_in_session(python.pid))
 
 
 def test_ray_started_here_ends_with_a_command_killed_outright():
-    """SIGKILL gives the command no time to stop its Ray: every process of Ray's session goes with it."""
+    """SIGKILL gives the command no time to stop its Ray: every process of Ray's session goes with it,
+    and the next head started here removes the folder it left."""
     script = (
         "import time\n"
         "from swarm.experiments.executors import RayExecutor, use\n"
         "with use(RayExecutor(cpus=1)) as ray:\n"
         "    ray.connected()\n"
-        "    print(ray.head.session, flush=True)\n"
+        "    print(ray.head.session, ray.head.temp, flush=True)\n"
         "    time.sleep(120)\n"
     )
     python = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stdout=subprocess.PIPE, text=True,
                               start_new_session=True)  # fmt: skip
-    head = int(python.stdout.readline())
-    assert [cmd for _, cmd in _in_session(head)(_processes()) if "raylet" in cmd], "Ray's raylet was not running"
-    python.kill()
-    python.wait(timeout=10)
-    _none_left(_in_session(head))
+    try:
+        assert select.select([python.stdout], [], [], 120)[0], "the command did not connect to its Ray in 120 s"
+        session, temp = python.stdout.readline().split()
+        assert [cmd for _, cmd in _in_session(int(session))(_processes()) if "raylet" in cmd], "no raylet ran"
+    finally:
+        python.kill()
+        python.wait(timeout=10)
+    _none_left(_in_session(int(session)))
+    assert Path(temp).exists()
+    from swarm.experiments.ray_head import RayHead
+
+    RayHead(1, str(ROOT)).stop()
+    assert not Path(temp).exists()
 
 
 @pytest.mark.parametrize("command", [["sweep", "s.toml"], ["experiment", "table1"], ["reproduce", "simonin2007"]])

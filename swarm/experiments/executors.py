@@ -270,6 +270,7 @@ class RayExecutor:
         self.address = address or os.environ.get("RAY_ADDRESS") or None
         self.ray: Any = None
         self.head: RayHead | None = None
+        self.closed = False
         if self.address is not None:
             _check_reachable(self.address)
         else:
@@ -278,14 +279,21 @@ class RayExecutor:
 
     def connected(self) -> Any:
         """The ray module, connected on first use (to the head started here once its node is registered)."""
+        if self.closed:
+            raise RunError("this Ray executor is closed: make another")
         if self.ray is None:
             if self.head is None:
                 self.ray = _connect(self.address, mine=False)  # type: ignore[arg-type]
             else:
-                import ray  # noqa: F401  (a fifth of a second, taken while the head finishes starting)
+                import ray  # (a fifth of a second, taken while the head finishes starting)
 
-                with _environ(OWN_HEAD):  # this process's settings as its head's, read as it connects
-                    self.ray = _connect(self.head.address(), mine=True)
+                try:
+                    with _environ(OWN_HEAD):  # this process's settings as its head's, read as it connects
+                        self.ray = _connect(self.head.address(), mine=True)
+                except BaseException:  # a half-made connection must not outlive the head it was to
+                    with contextlib.suppress(Exception):
+                        ray.shutdown()
+                    raise
         return self.ray
 
     def width(self, jobs: int | None, work: int) -> int:
@@ -298,6 +306,7 @@ class RayExecutor:
         return _Actors(self.connected(), width, (fn, warm_up, warm_args))
 
     def close(self) -> None:
+        self.closed = True
         if self.ray is not None:
             self.ray.shutdown()  # a driver's leaving: the cluster goes on
             self.ray = None

@@ -10,7 +10,8 @@ raylet is registered, and ends as its whole session is killed (docs/commands.md 
 Its processes are a session of their own, so a Ctrl-C at the terminal reaches only the command, which
 stops them.  The process that started it ending, even killed with SIGKILL, sends `ray start --block` a
 SIGTERM (the kernel's parent-death signal, armed from a thread that lives as long as the process), on
-which it stops every process it started: nothing is left running.
+which it stops every process it started: nothing is left running, and the next head started here
+removes the folder (/tmp/swarmray*) left behind.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ import sys
 import tempfile
 import threading
 import time
+import weakref
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -49,6 +51,10 @@ OWN_HEAD = {
     # the last of them holds each process's ray.shutdown a quarter of a second
     "RAY_task_events_report_interval_ms": "0",
 }
+# on the parent-death signal, `ray start --block` stops its processes at once, without first waiting up
+# to 30 s for the node to drain (what a cluster serving traffic needs)
+AT_ONCE = {"RAY_GRACEFUL_SHUTDOWN_DRAIN_TIMEOUT_S": "0"}
+PREFIX = "swarmray"
 PR_SET_PDEATHSIG = 1
 
 
@@ -73,20 +79,29 @@ def processes() -> dict[int, tuple[int, int, str]]:
 class RayHead:
     """`ray start --head` of `cpus` CPUs on 127.0.0.1, no dashboard, its workers importing `pythonpath`
     first, with Ray's `settings` (`OWN_HEAD`, or none: as a user starts one), started at once in the
-    background; `address()` waits until its node is registered."""
+    background; `address()` waits until its node is registered.  Stopped by `stop`, or at the latest
+    when the object is collected or this process ends."""
 
     def __init__(self, cpus: int, pythonpath: str, settings: Mapping[str, str] = OWN_HEAD,
                  env: Mapping[str, str] | None = None) -> None:  # fmt: skip
+        _remove_stale_folders()
         self.port = free_port()
-        self.temp = tempfile.mkdtemp(prefix="ray", dir="/tmp")  # short: Ray's socket paths fit in 107 bytes
+        self.temp = tempfile.mkdtemp(prefix=PREFIX, dir="/tmp")  # short: Ray's socket paths fit in 107 bytes
         self.log = Path(self.temp) / "head.log"
-        environ = {**settings, **(env if env is not None else os.environ)}
+        environ = {**settings, **(env if env is not None else os.environ), **AT_ONCE}
         environ["PYTHONPATH"] = os.pathsep.join(filter(None, [pythonpath, environ.get("PYTHONPATH")]))
         cmd = [str(RAY), "start", "--head", f"--port={self.port}", f"--num-cpus={cpus}", "--node-ip-address=127.0.0.1",
                "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={self.temp}", "--block"]  # fmt: skip
-        with open(self.log, "w") as log:
-            self.process = _started_for_life(cmd, env=environ, stdout=log, stderr=subprocess.STDOUT)
+        try:
+            with open(self.log, "w") as log:
+                self.process = _started_for_life(cmd, env=environ, stdout=log, stderr=subprocess.STDOUT,
+                                                 stdin=subprocess.DEVNULL)  # fmt: skip
+        except BaseException:
+            shutil.rmtree(self.temp, ignore_errors=True)
+            raise
         self.session = self.process.pid  # the session it leads, which all its processes share
+        (Path(self.temp) / "head.pid").write_text(str(self.session))
+        self._stop = weakref.finalize(self, _kill_session, self.session, self.process, self.temp)
 
     def address(self, timeout: float = 120.0) -> str:
         """HOST:PORT, once the head's node is registered (so connecting waits for nothing)."""
@@ -112,18 +127,39 @@ class RayHead:
 
     def stop(self) -> None:
         """Kill every process of the head's session, and remove its folder."""
-        for pid in [p for p, (_, sid, _) in processes().items() if sid == self.session]:
-            with contextlib.suppress(ProcessLookupError):
-                os.kill(pid, signal.SIGKILL)
-        with contextlib.suppress(subprocess.TimeoutExpired):
-            self.process.wait(timeout=30)
-        shutil.rmtree(self.temp, ignore_errors=True)
+        self._stop()
 
     def __enter__(self) -> RayHead:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
+
+
+def _kill_session(session: int, head: subprocess.Popen, temp: str) -> None:
+    """Kill every process of `session` until none is left (the raylet may start a worker meanwhile), and
+    remove `temp`.  Linux hands out no pid that a live process still has as its session."""
+    for _ in range(50):
+        members = [p for p, (_, sid, _) in processes().items() if sid == session]
+        if not members:
+            break
+        for pid in members:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+        time.sleep(0.01)
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        head.wait(timeout=30)
+    shutil.rmtree(temp, ignore_errors=True)
+
+
+def _remove_stale_folders() -> None:
+    """The folders of heads whose command was killed outright (their processes stopped themselves, see
+    above), so that they do not pile up in /tmp."""
+    alive = {sid for _, sid, _ in processes().values()}
+    for folder in Path("/tmp").glob(f"{PREFIX}*"):
+        with contextlib.suppress(OSError, ValueError):
+            if int((folder / "head.pid").read_text()) not in alive:
+                shutil.rmtree(folder, ignore_errors=True)
 
 
 def _started_for_life(cmd: list[str], **popen) -> subprocess.Popen:
@@ -134,6 +170,7 @@ def _started_for_life(cmd: list[str], **popen) -> subprocess.Popen:
     parent = os.getpid()
 
     def arm() -> None:  # in the child, between fork and exec: nothing that takes a lock
+        signal.pthread_sigmask(signal.SIG_SETMASK, ())  # a thread's blocked signals would stay blocked
         if prctl is not None:
             prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
             if os.getppid() != parent:  # the parent ended before the signal was armed
