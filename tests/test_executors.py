@@ -19,6 +19,7 @@ import pytest
 from swarm.bench.executors.head import ray_head
 from swarm.cli import main
 from swarm.experiments.executors import LocalExecutor, RayExecutor, use
+from swarm.experiments.ray_head import RayHead
 from swarm.experiments.ray_head import free_port as _free_port
 from swarm.experiments.ray_head import processes as _processes
 from swarm.experiments.runner import JobFailed, batch_run
@@ -77,6 +78,13 @@ def executor(request):
             yield ray, 2
     else:
         yield LocalExecutor(), 1 if request.param == "here" else 2
+
+
+def _command(script: str) -> subprocess.Popen:
+    """`script` run by Python from this checkout as a command of its own (a session of its own), its
+    output read as text."""
+    return subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stdout=subprocess.PIPE, text=True,
+                            start_new_session=True)  # fmt: skip
 
 
 def _rows(path: Path) -> list[dict]:
@@ -178,8 +186,7 @@ def test_ray_started_here_takes_only_the_cores_asked_and_leaves_nothing_running(
         "left = [cmd for _, sid, cmd in processes().values() if sid == head.session]\n"
         "print(left, os.path.exists(head.temp))\n"
     )
-    python = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stdout=subprocess.PIPE, text=True,
-                              start_new_session=True)  # fmt: skip
+    python = _command(script)
     out, _ = python.communicate(timeout=120)
     said, after = out.splitlines()
     assert said.startswith("1 1 [1, 4, 9] {") and str(python.pid) not in said.split("{")[1]
@@ -198,8 +205,7 @@ def test_ray_started_here_ends_with_a_command_killed_outright():
         "    print(ray.head.session, ray.head.temp, flush=True)\n"
         "    time.sleep(120)\n"
     )
-    python = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stdout=subprocess.PIPE, text=True,
-                              start_new_session=True)  # fmt: skip
+    python = _command(script)
     try:
         assert select.select([python.stdout], [], [], 120)[0], "the command did not connect to its Ray in 120 s"
         session, temp = python.stdout.readline().split()
@@ -209,8 +215,6 @@ def test_ray_started_here_ends_with_a_command_killed_outright():
         python.wait(timeout=10)
     _none_left(_in_session(int(session)))
     assert Path(temp).exists()
-    from swarm.experiments.ray_head import RayHead
-
     RayHead(1, str(ROOT)).stop()
     assert not Path(temp).exists()
 
