@@ -4,20 +4,14 @@ processes, free loopback ports, and cleanup of everything started."""
 from __future__ import annotations
 
 import contextlib
-import socket
 import subprocess
 import sys
 import threading
 from pathlib import Path
 
 from swarm.core.credentials import agent_name
+from swarm.core.mesh import free_endpoint
 from swarm.world_process import make_server
-
-
-def free_endpoint() -> str:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{s.getsockname()[1]}"
 
 
 def start_agents(endpoint: str, run_id: str, controller: str, n: int, count: int = 1,

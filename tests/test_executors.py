@@ -18,9 +18,9 @@ import pytest
 
 from swarm.bench.executors.head import ray_head
 from swarm.cli import main
+from swarm.core.mesh import free_port as _free_port
 from swarm.experiments.executors import LocalExecutor, RayExecutor, use
 from swarm.experiments.ray_head import RayHead
-from swarm.experiments.ray_head import free_port as _free_port
 from swarm.experiments.ray_head import processes as _processes
 from swarm.experiments.runner import JobFailed, batch_run
 

@@ -91,6 +91,18 @@ def listed(names: Iterable[str]) -> list[str] | None:
     return None if all(f is None for f in found) else [e for f in found if f is not None for e in f]
 
 
+def free_port() -> int:
+    """A TCP port of 127.0.0.1 that is free now (the system's pick): for a router, a Ray head or a test."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def free_endpoint(scheme: str = "tcp") -> str:
+    """A zenoh endpoint on 127.0.0.1 at a `free_port`: `tcp/127.0.0.1:PORT` (or `tls/...`)."""
+    return f"{scheme}/127.0.0.1:{free_port()}"
+
+
 def _endpoint(proto: str, host: str, port: int) -> str:
     return f"{proto}/[{host}]:{port}" if ":" in host else f"{proto}/{host}:{port}"
 

@@ -23,7 +23,6 @@ import queue
 import re
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -34,6 +33,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from swarm.core.errors import RunError
+from swarm.core.mesh import free_port
 
 RAY = Path(sys.executable).with_name("ray")
 STARTED = "Ray runtime started."  # what `ray start` prints once it has seen its node registered
@@ -56,12 +56,6 @@ OWN_HEAD = {
 AT_ONCE = {"RAY_GRACEFUL_SHUTDOWN_DRAIN_TIMEOUT_S": "0"}
 PREFIX = "swarmray"
 PR_SET_PDEATHSIG = 1
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def processes() -> dict[int, tuple[int, int, str]]:

@@ -11,10 +11,9 @@ received, the run id): the world's outcome, its counts of joins, losses and miss
 
 from __future__ import annotations
 
-import socket
-
 from swarm.bench.flood.clients import KINDS, Floods
 from swarm.core import wire
+from swarm.core.mesh import free_endpoint
 from swarm.launcher import swarm_up
 from world_server.server import new_run_id
 
@@ -38,16 +37,10 @@ NICE = 19
 TARGET = 2.0  # tick p99 under the flood at most this many times the unflooded run's
 
 
-def _endpoint() -> str:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{s.getsockname()[1]}"
-
-
 def _up(family: str, run: dict, rate: float) -> tuple[dict, dict]:
     """One run's summary, and what the flooding clients sent (none when `rate` is 0): messages by
     client, and per second."""
-    run_id, endpoint = f"flood{new_run_id()}", _endpoint()
+    run_id, endpoint = f"flood{new_run_id()}", free_endpoint()
     floods = Floods(endpoint, run_id, family, kinds=KINDS if rate else (), rate=rate, nice=NICE)
     with floods:
         summary = swarm_up(controller=None, run_id=run_id, listen=endpoint, progress=False, deadline=10.0,

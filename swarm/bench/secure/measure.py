@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import socket
 import tempfile
 import threading
 import time
@@ -17,16 +16,11 @@ import zenoh
 
 from swarm.core import credentials
 from swarm.core.bus import open_client, open_router
+from swarm.core.mesh import free_endpoint
 from swarm.core.wire import Keys
 
 RUN = "bench"
 STREAM = 20_000  # own puts timed per link kind (--quick: a tenth)
-
-
-def _endpoint(scheme: str) -> str:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return f"{scheme}/127.0.0.1:{s.getsockname()[1]}"
 
 
 class _Heard:
@@ -111,7 +105,7 @@ def run(quick: bool = False, forged: int = 1000) -> dict:
         other = credentials.agent_name(2)
         result: dict = {"forged_per_key": forged}
         for scheme in ("tcp", "tls"):
-            endpoint = _endpoint(scheme)
+            endpoint = free_endpoint(scheme)
             router = open_router(endpoint, credentials.identity_in(folder, credentials.ROUTER))
             world = open_client(endpoint, identity=credentials.identity_in(folder, credentials.WORLD))
             heard = _Heard(world)
@@ -149,9 +143,9 @@ def run(quick: bool = False, forged: int = 1000) -> dict:
                     s.close()
         router_id = credentials.identity_in(folder, credentials.ROUTER)
         puts = STREAM // 10 if quick else STREAM
-        result["puts_per_s"] = {"plain tcp": _stream(_endpoint("tcp"), None, None, puts),
-                                "secure tcp": _stream(_endpoint("tcp"), me, router_id, puts),
-                                "secure tls": _stream(_endpoint("tls"), me, router_id, puts)}  # fmt: skip
+        result["puts_per_s"] = {"plain tcp": _stream(free_endpoint("tcp"), None, None, puts),
+                                "secure tcp": _stream(free_endpoint("tcp"), me, router_id, puts),
+                                "secure tls": _stream(free_endpoint("tls"), me, router_id, puts)}  # fmt: skip
     return result
 
 

@@ -6,7 +6,6 @@ kills (swarm.bench.soak.checks)."""
 
 from __future__ import annotations
 
-import socket
 import sys
 import tempfile
 from pathlib import Path
@@ -14,6 +13,7 @@ from pathlib import Path
 from swarm.bench.soak import checks
 from swarm.bench.soak.output import write_files
 from swarm.bench.soak.watch import ROLES, Watch
+from swarm.core.mesh import free_endpoint
 from swarm.launcher import swarm_up
 from swarm.review.report import read_recording
 from world_server import kind_of
@@ -30,12 +30,6 @@ QUICK = {"minutes": 0.2, "kill_every": 4.0, "interval": 1.0}
 INTERVAL = 5.0  # seconds between memory samples of a full soak
 VERDICT = ("world", "launcher")  # the processes that live the whole run; agent processes are replaced
 LAST_KILL_MARGIN = 15.0  # no kill in the run's last seconds: its replacement must join before the world ends
-
-
-def _endpoint() -> str:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{s.getsockname()[1]}"
 
 
 def _length(kind: str, seconds: float) -> dict:
@@ -55,7 +49,7 @@ def soak(kind: str, minutes: float, kill_every: float, interval: float, folder: 
     watch = Watch(run_id, processes, duration, kill_every, kill_until, interval, progress)
     watch.start()
     try:
-        summary = swarm_up(controller=None, run_id=run_id, listen=_endpoint(), progress=False, mode="realtime",
+        summary = swarm_up(controller=None, run_id=run_id, listen=free_endpoint(), progress=False, mode="realtime",
                            rate=RATE, record=str(record), on_loss="respawn", max_respawns=kills, **run,
                            **_length(kind, duration))  # fmt: skip
     finally:
