@@ -117,13 +117,7 @@ def prepare(scenario_ref: str | None = None, progress: bool = True, engine: bool
     up (its world and controller kernels; with `engine` its in-process engine);
     with `every_kind`, every world kind's, on its example scenario.  Returns
     whether the ahead-of-time build exists.  Container images run it at build time."""
-    builder = None
-    if aot.built() is None:  # agent processes run this build without numba (~35 MB instead of ~150)
-        if progress:
-            print("swarm: building the agents' compiled step (once per source version, about a minute)",
-                  file=sys.stderr)  # fmt: skip
-        builder = subprocess.Popen([sys.executable, "-m", "agents.controllers.aot"], stdout=subprocess.DEVNULL,
-                                   stderr=subprocess.PIPE, text=True)  # fmt: skip
+    builder = start_agents_build(progress)
     # once here, so N agents starting together find the kernels in the cache
     if every_kind:
         for kind in WORLD_KINDS:
@@ -131,6 +125,24 @@ def prepare(scenario_ref: str | None = None, progress: bool = True, engine: bool
     else:
         scenario = load_scenario(scenario_ref or world_kind().example)
         resolve(kind_of(scenario).warm_up)(scenario, engine)
+    return finish_agents_build(builder)
+
+
+def start_agents_build(progress: bool = True) -> subprocess.Popen | None:
+    """The agents' ahead-of-time step, built in a subprocess when this source version has none yet (None:
+    it has one); agent processes run it without numba (~35 MB instead of ~150)."""
+    if aot.built() is not None:
+        return None
+    if progress:
+        print("swarm: building the agents' compiled step (once per source version, about a minute)",
+              file=sys.stderr)  # fmt: skip
+    return subprocess.Popen([sys.executable, "-m", "agents.controllers.aot"], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+
+
+def finish_agents_build(builder: subprocess.Popen | None) -> bool:
+    """Wait for `start_agents_build`'s build (a failure is a note: agents fall back to the JIT); whether the
+    step exists."""
     if builder is not None and builder.wait() != 0:
         print(f"swarm: note: the ahead-of-time build failed, agents use the JIT (more memory):\n"
               f"{builder.stderr.read()[-1500:]}", file=sys.stderr)  # fmt: skip

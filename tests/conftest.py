@@ -11,7 +11,6 @@ anything on pytest 9 (pytest-dev/pytest-xdist#1386).
 from __future__ import annotations
 
 import shutil
-import warnings
 
 import pytest
 from xdist.scheduler import LoadScopeScheduling
@@ -41,18 +40,10 @@ def pytest_configure(config):
     world's wait for joins or holds a real-time run back.  Once, here in the session's controller."""
     if hasattr(config, "workerinput") or config.option.collectonly or getattr(config.option, "help", False):
         return  # an xdist worker (the controller built it before starting it), or no test to run
-    from swarm.core.kernels import built
+    if shutil.which("cc"):  # without a C compiler it cannot build: the JIT it is
+        from swarm.launcher import finish_agents_build, start_agents_build
 
-    if built() is None and shutil.which("cc"):  # without a C compiler it cannot build: the JIT it is
-        from agents.controllers import aot  # every controller: imported only to build
-
-        print("building the agents' compiled step for this source version (about a minute)", flush=True)
-        try:
-            with warnings.catch_warnings():  # numba's pycc, which the build uses, is "pending deprecation"
-                warnings.simplefilter("ignore", PendingDeprecationWarning)
-                aot.build()
-        except Exception as exc:  # a failed build: agent processes fall back to numba's JIT, as in a run
-            print(f"note: the agents' compiled step did not build ({exc}); agent processes use the JIT")
+        finish_agents_build(start_agents_build())
 
 
 @pytest.hookimpl(tryfirst=True, optionalhook=True)
