@@ -16,7 +16,6 @@ from pathlib import Path
 
 import pytest
 
-from swarm.bench.executors.head import ray_head
 from swarm.cli import main
 from swarm.core.mesh import free_port as _free_port
 from swarm.experiments.executors import LocalExecutor, RayExecutor, use
@@ -38,7 +37,7 @@ WALL_CLOCK = {"wall_s", "wall_seconds"}  # columns of seconds taken, which no tw
 
 def _in_session(session: int):
     """Which processes of `session` run (a function of the process table)."""
-    return lambda processes: [(p, cmd) for p, (_, sid, cmd) in processes.items() if sid == session]
+    return lambda processes: [(p, cmd) for p, (sid, cmd) in processes.items() if sid == session]
 
 
 def _none_left(which, seconds: float = 30) -> None:
@@ -53,9 +52,9 @@ def _none_left(which, seconds: float = 30) -> None:
 def cluster():
     """A Ray cluster of 2 CPUs on this machine, its workers importing this checkout: its address.
     At the end every process of it (its own session) is killed, and none is left running."""
-    with ray_head(2, str(ROOT)) as (address, session):
-        yield address
-    _none_left(_in_session(session))
+    with RayHead(2, str(ROOT), settings={}) as head:  # Ray's own settings, as a user starts one
+        yield head.address()
+    _none_left(_in_session(head.session))
 
 
 @pytest.fixture(autouse=True)
@@ -183,7 +182,7 @@ def test_ray_started_here_takes_only_the_cores_asked_and_leaves_nothing_running(
         "    head = ray.head\n"
         "    rows = batch_run(_square, [1, 2, 3], progress=False)\n"
         "    print(ray.width(None, 10), ray.width(4, 10), [r['square'] for r in rows], {r['pid'] for r in rows})\n"
-        "left = [cmd for _, sid, cmd in processes().values() if sid == head.session]\n"
+        "left = [cmd for sid, cmd in processes().values() if sid == head.session]\n"
         "print(left, os.path.exists(head.temp))\n"
     )
     python = _command(script)

@@ -402,8 +402,10 @@ def _use_tokens_as_ray_does(address: str | None = None) -> None:
 
 
 def _connect(address: str, mine: bool) -> Any:
-    """The ray module, connected to the cluster at `address` (`mine`: the head this command started)."""
-    _use_tokens_as_ray_does(None if mine else address)
+    """The ray module, connected to the cluster at `address` (`mine`: the head this command started, which
+    set Ray's token rule as it started it)."""
+    if not mine:
+        _use_tokens_as_ray_does(address)
     import ray
 
     before = signal.getsignal(signal.SIGTERM)

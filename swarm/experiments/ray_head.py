@@ -58,15 +58,15 @@ PREFIX = "swarmray"
 PR_SET_PDEATHSIG = 1
 
 
-def processes() -> dict[int, tuple[int, int, str]]:
-    """Every live process (zombies left out): pid -> (parent, session, command line)."""
+def processes() -> dict[int, tuple[int, str]]:
+    """Every live process (zombies left out): pid -> (session, command line)."""
     found = {}
     for name in filter(str.isdigit, os.listdir("/proc")):
         with contextlib.suppress(OSError):
             fields = Path(f"/proc/{name}/stat").read_text().rpartition(")")[2].split()
             cmd = Path(f"/proc/{name}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
             if fields[0] != "Z":
-                found[int(name)] = (int(fields[1]), int(fields[3]), cmd)
+                found[int(name)] = (int(fields[3]), cmd)
     return found
 
 
@@ -134,7 +134,7 @@ def _kill_session(session: int, head: subprocess.Popen, temp: str) -> None:
     """Kill every process of `session` until none is left (the raylet may start a worker meanwhile), and
     remove `temp`.  Linux hands out no pid that a live process still has as its session."""
     for _ in range(50):
-        members = [p for p, (_, sid, _) in processes().items() if sid == session]
+        members = [p for p, (sid, _) in processes().items() if sid == session]
         if not members:
             break
         for pid in members:
@@ -149,7 +149,7 @@ def _kill_session(session: int, head: subprocess.Popen, temp: str) -> None:
 def _remove_stale_folders() -> None:
     """The folders of heads whose command was killed outright (their processes stopped themselves, see
     above), so that they do not pile up in /tmp."""
-    alive = {sid for _, sid, _ in processes().values()}
+    alive = {sid for sid, _ in processes().values()}
     for folder in Path("/tmp").glob(f"{PREFIX}*"):
         with contextlib.suppress(OSError, ValueError):
             if int((folder / "head.pid").read_text()) not in alive:

@@ -22,7 +22,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from statistics import median
 
-from swarm.bench.executors.head import ray_head
+from swarm.experiments.ray_head import RayHead
 
 EXPERIMENT = "carrot"
 JOBS = 2
@@ -43,7 +43,8 @@ def _place(executor: str, here: str) -> Iterator[str | None]:
     if executor != "ray-cluster":
         yield None
         return
-    with ray_head(JOBS, here) as (address, _):
+    with RayHead(JOBS, here, settings={}) as head:  # Ray's own settings, as a user starts one
+        address = head.address()
         time.sleep(HEAD_SETTLE)  # the head starts its workers as it comes up: not the command's cost
         yield address
 
