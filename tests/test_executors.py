@@ -52,7 +52,7 @@ def _none_left(which, seconds: float = 30) -> None:
 def cluster():
     """A Ray cluster of 2 CPUs on this machine, its workers importing this checkout: its address.
     At the end every process of it (its own session) is killed, and none is left running."""
-    with RayHead(2, str(ROOT), settings={}) as head:  # Ray's own settings, as a user starts one
+    with RayHead(2, str(ROOT), own=False) as head:  # Ray's defaults, as a user starts one
         yield head.address()
     _none_left(_in_session(head.session))
 

@@ -51,6 +51,10 @@ OWN_HEAD = {
     # the last of them holds each process's ray.shutdown a quarter of a second
     "RAY_task_events_report_interval_ms": "0",
 }
+# `ray start`'s options for such a head: it has a fixed number of CPUs and nothing to scale, so it starts
+# without the autoscaler's monitor (a hidden option, for clusters whose autoscaler runs elsewhere): one
+# Python process fewer starting beside the command
+OWN_HEAD_OPTIONS = ("--no-monitor",)
 # on the parent-death signal, `ray start --block` stops its processes at once, without first waiting up
 # to 30 s for the node to drain (what a cluster serving traffic needs)
 AT_ONCE = {"RAY_GRACEFUL_SHUTDOWN_DRAIN_TIMEOUT_S": "0"}
@@ -72,20 +76,20 @@ def processes() -> dict[int, tuple[int, str]]:
 
 class RayHead:
     """`ray start --head` of `cpus` CPUs on 127.0.0.1, no dashboard, its workers importing `pythonpath`
-    first, with Ray's `settings` (`OWN_HEAD`, or none: as a user starts one), started at once in the
-    background; `address()` waits until its node is registered.  Stopped by `stop`, or at the latest
-    when the object is collected or this process ends."""
+    first, started at once in the background: a command's own (`OWN_HEAD`, `OWN_HEAD_OPTIONS`), or with
+    `own=False` as a user starts one (Ray's defaults).  `address()` waits until its node is registered.
+    Stopped by `stop`, or at the latest when the object is collected or this process ends."""
 
-    def __init__(self, cpus: int, pythonpath: str, settings: Mapping[str, str] = OWN_HEAD,
-                 env: Mapping[str, str] | None = None) -> None:  # fmt: skip
+    def __init__(self, cpus: int, pythonpath: str, own: bool = True, env: Mapping[str, str] | None = None) -> None:
         _remove_stale_folders()
         self.port = free_port()
         self.temp = tempfile.mkdtemp(prefix=PREFIX, dir="/tmp")  # short: Ray's socket paths fit in 107 bytes
         self.log = Path(self.temp) / "head.log"
-        environ = {**settings, **(env if env is not None else os.environ), **AT_ONCE}
+        environ = {**(OWN_HEAD if own else {}), **(env if env is not None else os.environ), **AT_ONCE}
         environ["PYTHONPATH"] = os.pathsep.join(filter(None, [pythonpath, environ.get("PYTHONPATH")]))
         cmd = [str(RAY), "start", "--head", f"--port={self.port}", f"--num-cpus={cpus}", "--node-ip-address=127.0.0.1",
-               "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={self.temp}", "--block"]  # fmt: skip
+               "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={self.temp}",
+               *(OWN_HEAD_OPTIONS if own else ()), "--block"]  # fmt: skip
         try:
             with open(self.log, "w") as log:
                 self.process = _started_for_life(cmd, env=environ, stdout=log, stderr=subprocess.STDOUT,

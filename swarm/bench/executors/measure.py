@@ -43,7 +43,7 @@ def _place(executor: str, here: str) -> Iterator[str | None]:
     if executor != "ray-cluster":
         yield None
         return
-    with RayHead(JOBS, here, settings={}) as head:  # Ray's own settings, as a user starts one
+    with RayHead(JOBS, here, own=False) as head:  # Ray's defaults, as a user starts one
         address = head.address()
         time.sleep(HEAD_SETTLE)  # the head starts its workers as it comes up: not the command's cost
         yield address
