@@ -208,7 +208,10 @@ def test_ray_started_here_ends_with_a_command_killed_outright():
     try:
         assert select.select([python.stdout], [], [], 120)[0], "the command did not connect to its Ray in 120 s"
         session, temp = python.stdout.readline().split()
-        assert [cmd for _, cmd in _in_session(int(session))(_processes()) if "raylet" in cmd], "no raylet ran"
+        running = [cmd for _, cmd in _in_session(int(session))(_processes())]
+        assert [cmd for cmd in running if "raylet" in cmd], "no raylet ran"
+        # a head of the command's own has nothing to scale: no autoscaler monitor (started before the raylet)
+        assert not [cmd for cmd in running if "autoscaler/_private/monitor.py" in cmd], running
     finally:
         python.kill()
         python.wait(timeout=10)
