@@ -19,8 +19,7 @@ import pytest
 from swarm.cli import main
 from swarm.core.mesh import free_port as _free_port
 from swarm.experiments.executors import LocalExecutor, RayExecutor, use
-from swarm.experiments.ray_head import RayHead
-from swarm.experiments.ray_head import processes as _processes
+from swarm.experiments.ray_head import RayHead, session_members
 from swarm.experiments.runner import JobFailed, batch_run
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,15 +34,10 @@ metrics = ["reached", "distance"]
 WALL_CLOCK = {"wall_s", "wall_seconds"}  # columns of seconds taken, which no two runs share
 
 
-def _in_session(session: int):
-    """Which processes of `session` run (a function of the process table)."""
-    return lambda processes: [(p, cmd) for p, (sid, cmd) in processes.items() if sid == session]
-
-
-def _none_left(which, seconds: float = 30) -> None:
-    """Wait until `which(processes)` lists none of them; fail naming those still running."""
+def _none_left(session: int, seconds: float = 30) -> None:
+    """Wait until no process of `session` runs; fail naming those still running."""
     deadline = time.monotonic() + seconds
-    while (left := which(_processes())) and time.monotonic() < deadline:
+    while (left := session_members(session)) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not left, f"processes outlived the test: {left}"
 
@@ -54,7 +48,7 @@ def cluster():
     At the end every process of it (its own session) is killed, and none is left running."""
     with RayHead(2, str(ROOT), own=False) as head:  # Ray's defaults, as a user starts one
         yield head.address()
-    _none_left(_in_session(head.session))
+    _none_left(head.session)
 
 
 @pytest.fixture(autouse=True)
@@ -175,14 +169,14 @@ def test_ray_started_here_takes_only_the_cores_asked_and_leaves_nothing_running(
     script = (
         "import os\n"
         "from swarm.experiments.executors import RayExecutor, use\n"
-        "from swarm.experiments.ray_head import processes\n"
+        "from swarm.experiments.ray_head import session_members\n"
         "from swarm.experiments.runner import batch_run\n"
         "from tests.test_executors import _square\n"
         "with use(RayExecutor(cpus=1)) as ray:\n"
         "    head = ray.head\n"
         "    rows = batch_run(_square, [1, 2, 3], progress=False)\n"
         "    print(ray.width(None, 10), ray.width(4, 10), [r['square'] for r in rows], {r['pid'] for r in rows})\n"
-        "left = [cmd for sid, cmd in processes().values() if sid == head.session]\n"
+        "left = session_members(head.session)\n"
         "print(left, os.path.exists(head.temp))\n"
     )
     python = _command(script)
@@ -190,7 +184,7 @@ def test_ray_started_here_takes_only_the_cores_asked_and_leaves_nothing_running(
     said, after = out.splitlines()
     assert said.startswith("1 1 [1, 4, 9] {") and str(python.pid) not in said.split("{")[1]
     assert after == "[] False"
-    _none_left(_in_session(python.pid))
+    _none_left(python.pid)
 
 
 def test_ray_started_here_ends_with_a_command_killed_outright():
@@ -208,14 +202,14 @@ def test_ray_started_here_ends_with_a_command_killed_outright():
     try:
         assert select.select([python.stdout], [], [], 120)[0], "the command did not connect to its Ray in 120 s"
         session, temp = python.stdout.readline().split()
-        running = [cmd for _, cmd in _in_session(int(session))(_processes())]
+        running = [cmd for _, cmd in session_members(int(session))]
         assert [cmd for cmd in running if "raylet" in cmd], "no raylet ran"
         # a head of the command's own has nothing to scale: no autoscaler monitor (started before the raylet)
         assert not [cmd for cmd in running if "autoscaler/_private/monitor.py" in cmd], running
     finally:
         python.kill()
         python.wait(timeout=10)
-    _none_left(_in_session(int(session)))
+    _none_left(int(session))
     assert Path(temp).exists()
     RayHead(1, str(ROOT)).stop()
     assert not Path(temp).exists()
@@ -248,9 +242,9 @@ def test_ctrl_c_ends_the_worker_processes():
                               start_new_session=True,
                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # fmt: skip
     deadline = time.monotonic() + 60
-    while len([p for p, cmd in _in_session(python.pid)(_processes()) if "spawn_main" in cmd]) < 2:
+    while len([p for p, cmd in session_members(python.pid) if "spawn_main" in cmd]) < 2:
         assert time.monotonic() < deadline and python.poll() is None, "the two workers did not start"
         time.sleep(0.2)
     os.kill(python.pid, signal.SIGINT)
     assert "KeyboardInterrupt" in python.communicate(timeout=60)[1]
-    _none_left(_in_session(python.pid), seconds=10)
+    _none_left(python.pid, seconds=10)

@@ -74,6 +74,11 @@ def processes() -> dict[int, tuple[int, str]]:
     return found
 
 
+def session_members(session: int) -> list[tuple[int, str]]:
+    """The live processes of `session`: (pid, command line)."""
+    return [(pid, cmd) for pid, (sid, cmd) in processes().items() if sid == session]
+
+
 class RayHead:
     """`ray start --head` of `cpus` CPUs on 127.0.0.1, no dashboard, its workers importing `pythonpath`
     first, started at once in the background: a command's own (`OWN_HEAD`, `OWN_HEAD_OPTIONS`), or with
@@ -138,10 +143,10 @@ def _kill_session(session: int, head: subprocess.Popen, temp: str) -> None:
     """Kill every process of `session` until none is left (the raylet may start a worker meanwhile), and
     remove `temp`.  Linux hands out no pid that a live process still has as its session."""
     for _ in range(50):
-        members = [p for p, (sid, _) in processes().items() if sid == session]
+        members = session_members(session)
         if not members:
             break
-        for pid in members:
+        for pid, _ in members:
             with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
         time.sleep(0.01)
@@ -153,8 +158,9 @@ def _kill_session(session: int, head: subprocess.Popen, temp: str) -> None:
 def _remove_stale_folders() -> None:
     """The folders of heads whose command was killed outright (their processes stopped themselves, see
     above), so that they do not pile up in /tmp."""
-    alive = {sid for sid, _ in processes().values()}
-    for folder in Path("/tmp").glob(f"{PREFIX}*"):
+    folders = list(Path("/tmp").glob(f"{PREFIX}*"))
+    alive = {sid for sid, _ in processes().values()} if folders else set()  # /proc read only when needed
+    for folder in folders:
         with contextlib.suppress(OSError, ValueError):
             if int((folder / "head.pid").read_text()) not in alive:
                 shutil.rmtree(folder, ignore_errors=True)
