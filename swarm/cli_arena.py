@@ -35,8 +35,8 @@ def add_arena_run_args(g) -> None:
     g.add_argument("--noise", choices=["none", "low", "high"], help="sensor noise level (the DFT paper's)")
     g.add_argument("--max-ticks", type=int, metavar="T", help="stop after T control periods")
     g.add_argument("--threads", type=int, metavar="N",
-                   help="cores for the world's sensing pass (default 1; 0: every core); the readings are the same "
-                        "for every N")  # fmt: skip
+                   help="cores for the world's sensing pass and its physics strips (default 1; 0: every core); "
+                        "the run is the same for every N")  # fmt: skip
     g.add_argument("--on-controller-error", choices=ON_ERROR, metavar="{idle,stop}",
                    help="a robot whose controller raises: holds still while the others go on (idle, the default), "
                         "or ends the run (stop); for the controllers in this process (swarm run) or in the agent "

@@ -3,6 +3,7 @@ memory as bytes, and the wire that carries it (the kill -9 runs themselves
 are in test_arena_distributed.py)."""
 
 import tracemalloc
+from dataclasses import replace
 
 import msgpack
 import numpy as np
@@ -31,13 +32,14 @@ def _push(world: ArenaWorld, ticks: range) -> None:
         world.apply(np.random.default_rng(t // 20).uniform(0.02, 0.12, (world.n, 2)))
 
 
-@pytest.mark.parametrize("at", [50, 150])
-def test_a_world_restored_from_a_checkpoint_goes_on_bit_for_bit_with_robots_in_contact(at):
-    a = ArenaWorld(CROWD)
+@pytest.mark.parametrize(("at", "strips"), [(50, 1), (150, 1), (50, 2), (150, 2)])
+def test_a_world_restored_from_a_checkpoint_goes_on_bit_for_bit_with_robots_in_contact(at, strips):
+    crowd = replace(CROWD, physics_strips=strips)  # two: robots cross the edge at x = 0.4 and touch across it
+    a = ArenaWorld(crowd)
     _push(a, range(at))
     saved = a.checkpointed
     assert a.tick % CROWD.checkpoint == 0 and saved is not None and len(saved["contacts_f"]) > 0
-    b = ArenaWorld(CROWD, parked=True)  # as a restarted world server builds it
+    b = ArenaWorld(crowd, parked=True)  # as a restarted world server builds it
     b.restore(saved)
     _push(a, range(at, 3 * at))
     _push(b, range(at, 3 * at))
@@ -46,14 +48,16 @@ def test_a_world_restored_from_a_checkpoint_goes_on_bit_for_bit_with_robots_in_c
     assert a.bodies.collisions.sum() > 20
 
 
-def test_saved_contacts_are_what_keeps_collision_counts():
-    a = ArenaWorld(CROWD)
+@pytest.mark.parametrize("strips", [1, 2])
+def test_saved_contacts_are_what_keeps_collision_counts(strips):
+    crowd = replace(CROWD, physics_strips=strips)
+    a = ArenaWorld(crowd)
     _push(a, range(50))
     saved = {k: v for k, v in a.checkpointed.items() if not k.startswith("contacts")}
     saved["space_clock"] = a.checkpointed["space_clock"]
-    b = ArenaWorld(CROWD, parked=True)
+    b = ArenaWorld(crowd, parked=True)
     b.restore({**saved, "contacts_f": np.zeros((0, 28)), "contacts_i": np.zeros((0, 6), np.int64),
-               "contacts_h": np.zeros((0, 2), np.uint64)})  # fmt: skip
+               "contacts_h": np.zeros((0, 2), np.uint64), "contacts_strip": np.zeros(0, np.int64)})  # fmt: skip
     _push(a, range(50, 60))
     _push(b, range(50, 60))
     assert b.bodies.collisions.sum() > a.bodies.collisions.sum()  # without them, contacts begin again

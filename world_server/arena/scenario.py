@@ -10,6 +10,7 @@ A TOML file with `kind = "arena"` (docs/arena.md lists every field):
     control_period = 0.064            # seconds per tick
     substeps = 4                      # physics steps per tick
     checkpoint = 50                   # ticks between physics checkpoints (exact resume)
+    physics_strips = 1                # the floor cut along x into spaces stepped side by side
     max_ticks = 3000
     [[wall]]   rect = [x0, y0, x1, y1]  (or segment = [x0, y0, x1, y1]), colour = [r, g, b]
     [[zone]]   kind = "goal", rect = [...] or disc = [cx, cy, r]
@@ -119,6 +120,7 @@ class ArenaScenario:
     control_period: float = 0.064
     substeps: int = 4
     checkpoint: int = 50  # ticks: the physics restarts from its saved state here, in every runtime (docs/arena.md)
+    physics_strips: int = 1  # the floor cut along x into this many physics spaces, stepped side by side
     noise: Noise = field(default_factory=Noise)
     max_ticks: int = 3000
     goal_radius: float = 0.07  # a robot has reached its goal within this distance (DFT code: 7 cells)
@@ -204,9 +206,21 @@ class ArenaScenario:
         return {"name": self.name, "kind": "arena", "seed": self.seed, "size": list(self.size),
                 "agents": self.agents, "controller": self.controller, "noise": self.noise.level,
                 "checkpoint": self.checkpoint,
+                # one strip is every run's physics before strips: its description (and saved states) unchanged
+                **({"physics_strips": self.physics_strips} if self.physics_strips > 1 else {}),
                 "walls": len(self.walls), "zones": len(self.zones), "obstacles": len(self.obstacles),
                 "groups": [{"count": g.count, "controller": g.controller, "robot": g.robot.name}
                            for g in self.groups]}  # fmt: skip
+
+    def physics_halo(self) -> float:
+        """How far beyond a physics strip's edges its space holds other strips' robots (as ghosts): two
+        contact reaches, each a diameter of the largest robot and a control period of two robots closing
+        in at twice the top speed (a pushed robot may outrun its own drive).  The first reach holds every
+        robot that may touch one of the strip's own; the second, the robots that push those, so that a
+        ghost moves as its owner does (docs/arena.md has the crowds measured with one reach and two)."""
+        models = [g.robot for g in self.groups]
+        reach = 2 * max(m.radius for m in models) + 4 * max(m.max_speed for m in models) * self.control_period
+        return 2 * reach
 
     # ------------------------------------------------------------ geometry
 
@@ -355,7 +369,7 @@ def parse_arena(data: dict, source: str, default_name: str, controllers: Mapping
         "size": (size[0], size[1]),
         "description": _get(data, "description", str, source, ""),
     }
-    for key in ("seed", "substeps", "checkpoint", "max_ticks", "goal_dwell"):
+    for key in ("seed", "substeps", "checkpoint", "physics_strips", "max_ticks", "goal_dwell"):
         if key in data:
             kw[key] = _get(data, key, int, source)
     for key in ("control_period", "goal_radius"):
@@ -636,6 +650,10 @@ def _check_arena_settings(s: ArenaScenario, source: str) -> None:
         raise ScenarioError(source, "substeps", f"expected 1 to 1000, got {s.substeps}")
     if not 1 <= s.checkpoint <= 1_000_000:
         raise ScenarioError(source, "checkpoint", f"expected 1 to 1000000 ticks, got {s.checkpoint}")
+    if not 1 <= s.physics_strips <= 64 or (s.physics_strips > 1 and w / s.physics_strips < s.physics_halo()):
+        most = max(1, min(64, int(w / s.physics_halo())))
+        raise ScenarioError(source, "physics_strips", f"expected 1 to {most} (a strip at least as wide as its "
+                            f"ghosts' halo, {s.physics_halo():.3g} m), got {s.physics_strips}")  # fmt: skip
     if not 1 <= s.max_ticks <= 100_000_000:
         raise ScenarioError(source, "max_ticks", f"expected 1 to 100000000, got {s.max_ticks}")
     if not 0 < s.goal_radius <= max(w, h) or s.goal_dwell < 1:

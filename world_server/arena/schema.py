@@ -45,6 +45,7 @@ TOP = {
     "control_period": {**NUMBER, "description": "seconds per tick"},
     "substeps": INTEGER,
     "checkpoint": INTEGER,
+    "physics_strips": {**INTEGER, "description": "the floor cut along x into this many physics spaces"},
     "max_ticks": INTEGER,
     "goal_radius": {**NUMBER, "description": "metres"},
     "goal_dwell": {**INTEGER, "description": "ticks inside the goal radius that finish a robot"},

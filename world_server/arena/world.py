@@ -129,7 +129,7 @@ class ArenaWorld:
     def _new_bodies(self, pose: np.ndarray) -> DiffDrive:
         s = self.scenario
         return DiffDrive(pose, self.radius, s.wall_rects(), s.wall_segments(), s.control_period, s.substeps,
-                         self.in_world)  # fmt: skip
+                         self.in_world, s.physics_strips, s.size[0], s.physics_halo())  # fmt: skip
 
     # ------------------------------------------------------------- contract
 

@@ -31,7 +31,8 @@ SIDE = 20.0
 LASER_BOT = RobotModel("laser64", 0.2, 0.3, 0.5, 0.5, 1.0, sensors=Sensors(laser=Laser(beams=64, range=8.0)))
 
 
-def bench_world(robots: int, model: RobotModel, obstacles: int = 100, seed: int = 1, side: float = SIDE) -> ArenaWorld:
+def bench_world(robots: int, model: RobotModel, obstacles: int = 100, seed: int = 1, side: float = SIDE,
+                strips: int = 1) -> ArenaWorld:  # fmt: skip
     rng = np.random.default_rng([seed, 0xBE4C])
     walls = [Wall("rect", (0.0, 0.0, side, 0.1)), Wall("rect", (0.0, side - 0.1, side, side)),
              Wall("rect", (0.0, 0.0, 0.1, side)), Wall("rect", (side - 0.1, 0.0, side, side))]  # fmt: skip
@@ -43,7 +44,8 @@ def bench_world(robots: int, model: RobotModel, obstacles: int = 100, seed: int 
         walls.append(Wall("rect", rects[-1], (int(rng.integers(30, 255)),) * 3))
     starts = _lattice(robots, model.radius, np.array(rects).reshape(-1, 4), rng, side)
     group = Group(robots, "carrot", model, tuple(map(tuple, starts)), 0.0)
-    s = ArenaScenario("bench", "bench", (side, side), (group,), tuple(walls), seed=seed, max_ticks=10**9)
+    s = ArenaScenario("bench", "bench", (side, side), (group,), tuple(walls), seed=seed, max_ticks=10**9,
+                      physics_strips=strips)  # fmt: skip
     return ArenaWorld(s)
 
 
@@ -131,17 +133,23 @@ def bench_arena(quick: bool = False) -> dict:
 
 
 def _cores(quick: bool) -> list[dict]:
-    """Laser robots sensed on one core and on every core (`--threads 0`), 1000 and 10,000 of them (the
-    10,000 with 1000 obstacles in a 63 m square: as dense as the 1000 in 20 m; not with --quick)."""
+    """Laser robots on one core and on every core (`--threads 0`), 1000 and 10,000 of them (the 10,000
+    with 1000 obstacles in a 63 m square: as dense as the 1000 in 20 m; not with --quick).  The
+    10,000 also with their floor in as many physics strips as cores, each strip's space stepped on a
+    core of its own."""
+    import numba
+
     from world_server.arena import raycast
 
+    cores = numba.config.NUMBA_NUM_THREADS
     rows = []
     for n in (1000,) if quick else (1000, 10_000):
-        for threads in (1, 0):  # a fresh world each: the same start, not one run on
-            world = bench_world(n, LASER_BOT, obstacles=n // 10, side=SIDE * math.sqrt(n / 1000))
+        runs = [(1, 1), (0, 1)] + ([(0, cores)] if n > 1000 and cores > 1 else [])
+        for threads, strips in runs:  # a fresh world each: the same start, not one run on
+            world = bench_world(n, LASER_BOT, obstacles=n // 10, side=SIDE * math.sqrt(n / 1000), strips=strips)
             try:
                 used = raycast.set_threads(threads)
-                rows.append({"robots": n, "threads": used, **_measure(world, 10 if quick else 30)})
+                rows.append({"robots": n, "threads": used, "strips": strips, **_measure(world, 10 if quick else 30)})
             finally:
                 raycast.set_threads(1)
     return rows
@@ -161,14 +169,18 @@ def format_arena_bench(result: dict) -> str:
         lines.append(f"| {r['obstacles']} | {r['sense_ms']} | {r['rays_per_second']:,} | {r['physics_ms']} |")
     laser = next(r for r in result["rows"] if r["suite"] == "laser64" and r["robots"] == 1000)
     e = result["epuck100"]
-    lines += ["", "Laser robots on one core and on every core (--threads 0); CPU: all threads' time", "",
-              "| robots | threads | sensing ms | speed-up | physics ms | ticks/s | rays/s | CPU ms | rays/CPU-s |",
-              "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
-    one = {r["robots"]: r["sense_ms"] for r in result["cores"] if r["threads"] == 1}
+    lines += ["", "Laser robots on one core and on every core (--threads 0), the floor in one physics strip or in a "
+              "strip per core; speed-ups against one thread and one strip; CPU: all threads' time of the sensing", "",
+              "| robots | threads | strips | sensing ms | speed-up | physics ms | speed-up | ticks/s | rays/s | CPU ms "
+              "| rays/CPU-s |", "|---|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
+    one = {r["robots"]: r for r in result["cores"] if r["threads"] == 1 and r["strips"] == 1}
     for r in result["cores"]:
-        lines.append(f"| {r['robots']:,} | {r['threads']} | {r['sense_ms']} | {one[r['robots']] / r['sense_ms']:.2f} | "
-                     f"{r['physics_ms']} | {r['ticks_per_second']} | {r['rays_per_second']:,} | "
-                     f"{r.get('sense_cpu_ms', '')} | {r.get('rays_per_cpu_second') or 0:,} |")  # fmt: skip
+        base = one[r["robots"]]
+        lines.append(f"| {r['robots']:,} | {r['threads']} | {r['strips']} | {r['sense_ms']} | "
+                     f"{base['sense_ms'] / r['sense_ms']:.2f} | {r['physics_ms']} | "
+                     f"{base['physics_ms'] / r['physics_ms']:.2f} | {r['ticks_per_second']} | "
+                     f"{r['rays_per_second']:,} | {r['sense_cpu_ms']} | "
+                     f"{r['rays_per_cpu_second'] or 0:,} |")  # fmt: skip
     lines += _reference_lines(result["reference"], result["cores"])
     lines += ["", f"targets: 1000 robots x 64-beam laser sensing {laser['sense_ms']} ms/tick (target <= 10 ms); "
               f"100 e-pucks whole tick {e['ticks_per_second']} ticks/s (target >= 500)"]  # fmt: skip
