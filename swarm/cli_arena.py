@@ -35,7 +35,8 @@ def add_arena_run_args(g) -> None:
     g.add_argument("--noise", choices=["none", "low", "high"], help="sensor noise level (the DFT paper's)")
     g.add_argument("--max-ticks", type=int, metavar="T", help="stop after T control periods")
     g.add_argument("--threads", type=int, metavar="N",
-                   help="cores for the world's sensing pass and its physics strips (default 1; 0: every core); "
+                   help="cores for the world's sensing pass and its physics strips, 0 for every core (default: "
+                        "every core for swarm run; 1 for swarm world and swarm up, whose agents share the machine); "
                         "the run is the same for every N")  # fmt: skip
     g.add_argument("--on-controller-error", choices=ON_ERROR, metavar="{idle,stop}",
                    help="a robot whose controller raises: holds still while the others go on (idle, the default), "
@@ -45,8 +46,13 @@ def add_arena_run_args(g) -> None:
 
 def arena_overrides(scenario, args, common: dict):
     """The scenario with the command line's values (`common`: agents, controller, seed); --threads is set
-    for this process's sensing pass (it is not part of the scenario: it changes no reading)."""
-    if (threads := getattr(args, "threads", None)) is not None:
+    for this process's sensing pass and physics strips (it is not part of the scenario: it changes no
+    bit).  `swarm run` has the machine to itself: every core unless told; a world with agent processes
+    beside it keeps to one."""
+    threads = getattr(args, "threads", None)
+    if threads is None and getattr(args, "command", None) == "run":
+        threads = 0
+    if threads is not None:
         if threads < 0:
             raise ScenarioError("command line", "--threads", "0 (every core) or a number of cores")
         from world_server.arena.raycast import set_threads

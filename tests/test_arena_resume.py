@@ -21,6 +21,7 @@ from swarm.scenario import load_scenario
 from tests.arena_helpers import arena
 from world_server.arena.face import wire as arena_proto
 from world_server.arena.scenario import controller_params
+from world_server.arena.strips import owners
 from world_server.arena.world import ArenaWorld
 
 CROWD = arena('[[group]]\ncount = 12\ncontroller = "wander"\n', w=0.8, h=0.8, max_ticks=100_000)
@@ -39,6 +40,11 @@ def test_a_world_restored_from_a_checkpoint_goes_on_bit_for_bit_with_robots_in_c
     _push(a, range(at))
     saved = a.checkpointed
     assert a.tick % CROWD.checkpoint == 0 and saved is not None and len(saved["contacts_f"]) > 0
+    if strips > 1:  # some saved contact is a robot's with another strip's robot, its ghost there
+        robot = saved["contacts_i"][:, :2] - a.bodies.strips[0].walls
+        owner = owners(saved["pose"][:, 0], a.bodies.edges)
+        ghost = (robot >= 0) & (owner[np.clip(robot, 0, a.n - 1)] != saved["contacts_strip"][:, None])
+        assert ghost.any()
     b = ArenaWorld(crowd, parked=True)  # as a restarted world server builds it
     b.restore(saved)
     _push(a, range(at, 3 * at))

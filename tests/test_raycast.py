@@ -164,3 +164,32 @@ def test_the_sensing_pass_over_every_core_reads_what_the_serial_pass_reads():
     assert bad.returncode == 2 and bad.stderr.strip().splitlines() == [
         "swarm: error: command line: --threads: 0 (every core) or a number of cores"
     ]
+
+
+@pytest.mark.parametrize(("command", "given", "used"), [("run", None, "every"), ("up", None, 1), ("world", None, 1),
+                                                        ("run", 1, 1), ("up", 0, "every")])  # fmt: skip
+def test_swarm_run_senses_on_every_core_unless_told_and_a_world_beside_agents_on_one(command, given, used):
+    from argparse import Namespace
+
+    from swarm.cli_arena import arena_overrides
+    from swarm.scenario import load_scenario
+    from world_server.arena import raycast
+
+    args = Namespace(command=command, threads=given, start=None, goal=None, noise=None, max_ticks=None)
+    try:
+        arena_overrides(load_scenario("zmaze"), args, {"agents": None, "controller": None, "seed": None})
+        assert raycast.threads() == (raycast.numba.config.NUMBA_NUM_THREADS if used == "every" else used)
+    finally:
+        raycast.set_threads(1)
+
+
+def test_a_pass_too_small_to_pay_for_the_threads_stays_on_one():
+    from world_server.arena import raycast
+
+    try:
+        raycast.set_threads(2)
+        several = raycast.threads() > 1
+        assert raycast.parallel(raycast.PARALLEL_RAYS, raycast.PARALLEL_RAYS) is several
+        assert not raycast.parallel(raycast.PARALLEL_RAYS - 1, raycast.PARALLEL_RAYS)
+    finally:
+        raycast.set_threads(1)

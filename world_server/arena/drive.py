@@ -89,6 +89,8 @@ class DiffDrive:
         self.motion = np.zeros((self.n, 2))  # forward distance and turn of the last period
         self.sim_seconds = 0.0
         self.parked = np.zeros(self.n, np.bool_) if in_world is None else ~np.asarray(in_world, np.bool_)
+        if strips > 1 and not (width > 0 and halo > 0):
+            raise ValueError(f"{strips} physics strips need the floor's width and their halo, got {width} and {halo}")
         self.edges = np.linspace(0.0, float(width), strips + 1)
         self.halo = float(halo)
         self.strips = [Strip(pymunk, pymunk.batch, k, float(self.edges[k]), float(self.edges[k + 1]), rects,
@@ -141,7 +143,8 @@ class DiffDrive:
                 strip.remove_robot(i)
             for i in come.tolist():
                 strip.add_robot(i, state[i], self.radius[i], bool(self.parked[i]))
-            for i in (*come.tolist(), *taken.tolist()):
+                strip.bodies[i].velocity = (float(state[i, 2]), float(state[i, 3]))
+            for i in taken.tolist():
                 strip.bodies[i].position = (float(state[i, 0]), float(state[i, 1]))
                 strip.bodies[i].velocity = (float(state[i, 2]), float(state[i, 3]))
             strip.reindex(new)
@@ -225,7 +228,12 @@ class DiffDrive:
 
     def contacts(self) -> dict[str, np.ndarray]:
         """The spaces' cached contacts and clocks (world_server.arena.contacts); with several strips,
-        each contact's strip (`contacts_strip`) and a clock per strip."""
+        each contact's strip (`contacts_strip`) and a clock per strip.  Robots placed since the last
+        period are first found their strips, as the next period would: spaces rebuilt from the poses
+        then hold the same bodies."""
+        if len(self.strips) > 1 and self._placed:
+            self._repartition()
+            self._placed = False
         saved = [contacts.save(s.space, lambda shape: shape.key) for s in self.strips]
         if len(saved) == 1:
             return saved[0]

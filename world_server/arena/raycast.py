@@ -32,6 +32,10 @@ from numba import njit, prange
 NO_HIT = -1
 SOLID, MARK = 1, 2
 _threads = 1  # of the sensing pass in this process (set_threads)
+# The size of a pass from which the cores share it: below it, waking the sleeping threads (about 35 us on
+# this 2-core machine) costs more than they save (docs/arena.md, "Every core").
+PARALLEL_RAYS = 4096
+PARALLEL_NORMALS = 8192
 
 
 def set_threads(threads: int) -> int:
@@ -50,6 +54,12 @@ def set_threads(threads: int) -> int:
 
 def threads() -> int:
     return _threads
+
+
+def parallel(items: int, least: int) -> bool:
+    """Whether a pass over `items` (rays, noise draws) runs over the cores: more than one is set, and
+    there are at least `least` of them to pay for waking the threads."""
+    return _threads > 1 and items >= least
 
 
 def grid_shape(extent: tuple[float, float, float, float], cell: float) -> tuple[int, int]:

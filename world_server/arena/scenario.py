@@ -206,7 +206,8 @@ class ArenaScenario:
         return {"name": self.name, "kind": "arena", "seed": self.seed, "size": list(self.size),
                 "agents": self.agents, "controller": self.controller, "noise": self.noise.level,
                 "checkpoint": self.checkpoint,
-                # one strip is every run's physics before strips: its description (and saved states) unchanged
+                # named only when more than one: a default run's description (which its saved states are
+                # checked against) lists no physics option
                 **({"physics_strips": self.physics_strips} if self.physics_strips > 1 else {}),
                 "walls": len(self.walls), "zones": len(self.zones), "obstacles": len(self.obstacles),
                 "groups": [{"count": g.count, "controller": g.controller, "robot": g.robot.name}

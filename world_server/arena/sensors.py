@@ -118,7 +118,8 @@ class Suite:
 
     def _normal(self, stream: int, k: int, tick: int) -> np.ndarray:
         out = np.empty((len(self.robots), k))
-        fill = fill_normal_parallel if raycast.threads() > 1 else fill_normal  # the same numbers either way
+        parallel = raycast.parallel(out.size, raycast.PARALLEL_NORMALS)
+        fill = fill_normal_parallel if parallel else fill_normal  # the same numbers either way
         fill(np.int64(self.seed), self.robots, np.int64(tick), np.int64(stream), out)
         return out
 

@@ -37,6 +37,7 @@ class Strip:
         self.index, self.lo, self.hi = index, lo, hi
         self.space = pm.Space()
         self.space.collision_slop = 0.0005
+        self.walls_body = self.space.static_body  # pymunk adds it on first use: body rows end with it, walls or none
         self.keyed: dict[int, object] = {}
         for rect in rects:
             self.add_static(box=rect)
@@ -47,14 +48,8 @@ class Strip:
         self.discs: dict[int, object] = {}
         self.body_id = np.zeros(robots, np.int64)  # each robot's body's id here, 0 where it has none
         self.obstacles: dict[int, list] = {}
-        self.ghosts = np.zeros(0, np.int64)  # robots of other strips in this space, in robot order
-        self.robot_of_row = np.zeros(0, np.int64)  # the robot of each body, in the space's own order
-        self.owned_row = np.zeros(0, np.bool_)
-        self.ghost_row = np.zeros(0, np.int64)
-        self.own_rows = self.own_robots = np.zeros(0, np.int64)  # the rows of its own robots, and who they are
-        self.state = np.zeros((0, 4))  # each row's position and velocity, as last read
-        self._arbiters, self._set, self._get = batch.Buffer(), batch.Buffer(), batch.Buffer()
-        self.force = np.zeros(2)
+        self._arbiters, self._get = batch.Buffer(), batch.Buffer()
+        self.reindex(np.zeros(robots, np.int64))
 
     # ------------------------------------------------------------- shapes
 
@@ -109,9 +104,9 @@ class Strip:
         del self.keyed[disc.key]
 
     def reindex(self, owner: np.ndarray) -> None:
-        """Which robot each body row is (the space's order changes as bodies come and go).  Chipmunk
-        visits the space's static body (the walls') after the robots: its row is kept last, read and
-        written back as it is."""
+        """Which robot each body row is (the space's order changes as bodies come and go), which rows are
+        its own robots' and which are ghosts, and the buffers of a row each.  Chipmunk visits the space's
+        static body (the walls') after the robots: its row is kept last, read and written back as it is."""
         robots = np.flatnonzero(self.body_id)
         ids = self.body_id[robots]
         order = np.argsort(ids)
@@ -126,12 +121,11 @@ class Strip:
         self.ghost_row = np.flatnonzero(~self.owned_row)
         self.own_rows = np.flatnonzero(self.owned_row)
         self.own_robots = self.robot_of_row[self.own_rows]
-        self.ghosts = robots[owner[robots] != self.index]
         self.force = np.zeros(2 * len(robots) + 2)  # the static body's last
         self._set = self._batch.Buffer()
         self._set.set_float_buf(self.force)
         self._bodies = np.zeros((len(robots) + 1, 4))
-        self.state = self._bodies[:-1]
+        self.state = self._bodies[:-1]  # each robot row's position and velocity, as last read
         self._put = self._batch.Buffer()
         self._put.set_float_buf(self._bodies.ravel())
         self._sorted_ids, self._robot_of_sorted = ids[order], robots[order]
@@ -177,7 +171,7 @@ class Strip:
             return np.zeros(0, np.int64)
         at = np.minimum(np.searchsorted(self._sorted_ids, body_ids), n - 1)
         robots = self._robot_of_sorted[at[self._sorted_ids[at] == body_ids]]
-        return robots[self._owns[robots]] if len(self.ghosts) else robots
+        return robots[self._owns[robots]] if len(self.ghost_row) else robots
 
 
 __all__ = ["ROBOT_TYPE", "WALL_TYPE", "Strip", "owners"]

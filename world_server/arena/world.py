@@ -206,7 +206,7 @@ class ArenaWorld:
             mask = np.full(len(robot), SOLID | MARK, np.uint8)
         ranges = np.empty(len(robot))
         what = np.empty(len(robot), np.int64)
-        cast = raycast.cast_rays_parallel if raycast.threads() > 1 else raycast.cast_rays
+        cast = raycast.cast_rays_parallel if raycast.parallel(len(robot), raycast.PARALLEL_RAYS) else raycast.cast_rays
         cast(self.pose, np.asarray(robot, np.int64), c, s, max_range, mask, self.s_coords, self.s_items, self.seg_on,
              self.s_start, self.d_xyr, self.d_items, self.d_start, 0.0, 0.0, self.cell, self.nx, self.ny,
              ranges, what)  # fmt: skip
