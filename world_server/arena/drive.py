@@ -171,8 +171,8 @@ class DiffDrive:
             out[strip.robot_of_row[strip.owned_row]] = state[strip.owned_row]
         return out
 
-    def _substep(self, strip: Strip, v: np.ndarray, w: np.ndarray, cos: np.ndarray, sin: np.ndarray,
-                 state: np.ndarray, after: np.ndarray, forward: np.ndarray, pinned_at: dict) -> np.ndarray:  # fmt: skip
+    def _substep(self, v: np.ndarray, w: np.ndarray, cos: np.ndarray, sin: np.ndarray, state: np.ndarray,
+                 after: np.ndarray, forward: np.ndarray, pinned_at: dict, strip: Strip) -> np.ndarray:  # fmt: skip
         """One substep of one strip's space: its ghosts put where their owners are (`state`), its bodies
         pushed, stepped, its own robots' bookkeeping done (their rows only, so strips run side by side).
         Returns its own robots' contacts begun."""
@@ -209,12 +209,15 @@ class DiffDrive:
             heading = self.pose[:, 2]
             cos, sin = np.cos(heading), np.sin(heading)  # numpy's (its SIMD values), once a substep
             after = np.empty((self.n, 4))
-            step = functools.partial(self._substep, v=v, w=w, cos=cos, sin=sin, state=state, after=after,
-                                     forward=forward, pinned_at=pinned_at)  # fmt: skip
-            results = list(_pool(workers).map(step, self.strips)) if workers > 1 else [step(s) for s in self.strips]
+            args = (v, w, cos, sin, state, after, forward, pinned_at)
+            if workers > 1:
+                results = list(_pool(workers).map(functools.partial(self._substep, *args), self.strips))
+            else:
+                results = [self._substep(*args, strip) for strip in self.strips]
             for begun in results:
-                np.add.at(self.collisions, begun, 1)
-                self.contact[begun] = True
+                if len(begun):  # np.add.at costs microseconds even for nothing: most substeps begin none
+                    np.add.at(self.collisions, begun, 1)
+                    self.contact[begun] = True
             state = after
         if several:
             self._repartition()

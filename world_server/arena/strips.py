@@ -49,6 +49,10 @@ class Strip:
         self.body_id = np.zeros(robots, np.int64)  # each robot's body's id here, 0 where it has none
         self.obstacles: dict[int, list] = {}
         self._arbiters, self._get = batch.Buffer(), batch.Buffer()
+        # the batches' fields, combined once (an enum's | costs as much as a small read)
+        self._state_fields = batch.BodyFields.POSITION | batch.BodyFields.VELOCITY
+        arbiter = batch.ArbiterFields
+        self._begun_fields = arbiter.BODY_A_ID | arbiter.BODY_B_ID | arbiter.IS_FIRST_CONTACT
         self.reindex(np.zeros(robots, np.int64))
 
     # ------------------------------------------------------------- shapes
@@ -136,8 +140,7 @@ class Strip:
     def read(self) -> np.ndarray:
         """Every body's position and velocity, by row (into `state`)."""
         self._get.clear()
-        fields = self._batch.BodyFields
-        self._batch.get_space_bodies(self.space, fields.POSITION | fields.VELOCITY, self._get)
+        self._batch.get_space_bodies(self.space, self._state_fields, self._get)
         self._bodies[...] = np.frombuffer(self._get.float_buf(), dtype=np.float64).reshape(-1, 4)
         return self.state
 
@@ -146,8 +149,7 @@ class Strip:
         set in one batch; the others (and the walls' static body) get back what they hold."""
         if len(self.ghost_row):
             self.state[self.ghost_row] = state[self.robot_of_row[self.ghost_row]]
-            fields = self._batch.BodyFields
-            self._batch.set_space_bodies(self.space, fields.POSITION | fields.VELOCITY, self._put)
+            self._batch.set_space_bodies(self.space, self._state_fields, self._put)
 
     def push(self) -> None:
         """The forces in `force` (row order) onto the bodies."""
@@ -158,9 +160,7 @@ class Strip:
         counts for both).  Chipmunk marks a contact's first step;
         reading them in one batch costs what a `begin` callback into Python costs for a handful."""
         self._arbiters.clear()
-        fields = self._batch.ArbiterFields
-        self._batch.get_space_arbiters(self.space, fields.BODY_A_ID | fields.BODY_B_ID | fields.IS_FIRST_CONTACT,
-                                       self._arbiters)  # fmt: skip
+        self._batch.get_space_arbiters(self.space, self._begun_fields, self._arbiters)
         pairs = np.frombuffer(self._arbiters.int_buf(), np.int64).reshape(-1, 3)
         return self._robots(pairs[pairs[:, 2] != 0, :2].ravel())
 
