@@ -48,8 +48,8 @@ class Setup:
     speed_m_per_tick: float = 0.02  # how far a robot moves in a tick (hand-overs)
     physics_strips: int = 1  # the world's floor in physics strips stepped side by side (docs/arena.md)
     # Amdahl's serial share with strips: swarm bench arena's 10,000 laser robots on two threads, two
-    # strips taking 0.65-0.87 (mean 0.751) of one space's time over seven runs, their ghosts 7% of the robots
-    physics_serial_share: float = 0.47
+    # strips taking 0.63-0.89 (mean 0.748) of one space's time over eleven runs, their ghosts 7% of the robots
+    physics_serial_share: float = 0.46
     physics_halo_m: float = 1.06  # a strip's ghost band each side: a laser robot's physics_halo
 
 
