@@ -128,27 +128,34 @@ class DiffDrive:
         """Each robot to the strip its centre is in now, each strip's ghosts to those within its halo.
         A body that comes into a space, or a ghost that becomes its robot's own body, starts where the
         robot's owner left it (a ghost holds its own last step, which is dropped)."""
-        state = self._positions()
         new = self._owners()
+        changes = []
         for strip in self.strips:
-            k = strip.index
-            have = strip.body_id != 0
-            want = self._members(strip, new)
+            have, want = strip.body_id != 0, self._members(strip, new)
+            switched = have & want & ((self.owner == strip.index) != (new == strip.index))
             gone, come = np.flatnonzero(have & ~want), np.flatnonzero(want & ~have)
-            taken = np.flatnonzero(have & want & (self.owner != k) & (new == k))
-            handed = np.flatnonzero(have & want & (self.owner == k) & (new != k))
-            if not (len(gone) or len(come) or len(taken) or len(handed)):
-                continue
-            for i in gone.tolist():
-                strip.remove_robot(i)
-            for i in come.tolist():
-                strip.add_robot(i, state[i], self.radius[i], bool(self.parked[i]))
-                strip.bodies[i].velocity = (float(state[i, 2]), float(state[i, 3]))
-            for i in taken.tolist():
-                strip.bodies[i].position = (float(state[i, 0]), float(state[i, 1]))
-                strip.bodies[i].velocity = (float(state[i, 2]), float(state[i, 3]))
-            strip.reindex(new)
+            if len(gone) or len(come) or switched.any():
+                changes.append((strip, gone, come, np.flatnonzero(switched & (new == strip.index))))
+        if changes:
+            state = self._positions()  # read before any space changes: each robot as its owner left it
+            for strip, gone, come, taken in changes:
+                for i in gone.tolist():
+                    strip.remove_robot(i)
+                for i in come.tolist():
+                    strip.add_robot(i, state[i], self.radius[i], bool(self.parked[i]))
+                    strip.bodies[i].velocity = (float(state[i, 2]), float(state[i, 3]))
+                for i in taken.tolist():
+                    strip.bodies[i].position = (float(state[i, 0]), float(state[i, 1]))
+                    strip.bodies[i].velocity = (float(state[i, 2]), float(state[i, 3]))
+                strip.reindex(new)
         self.owner = new
+
+    def _place_placed(self) -> None:
+        """Robots put somewhere since the last period (`place`) to their strips, as a period begins or
+        before a snapshot: spaces rebuilt from the poses then hold the same bodies."""
+        if len(self.strips) > 1 and self._placed:
+            self._repartition()
+        self._placed = False
 
     def _copies(self, i: int) -> list:
         """A robot's bodies and discs: its own and its ghosts."""
@@ -200,9 +207,7 @@ class DiffDrive:
         start = self.pose.copy()
         forward = np.zeros(self.n)
         pinned_at = {} if pinned is None else {int(i): self.pose[i, :2].copy() for i in np.flatnonzero(pinned)}
-        several = len(self.strips) > 1
-        if several and self._placed:
-            self._repartition()
+        self._place_placed()
         state = self._positions()
         workers = min(raycast.threads(), len(self.strips))
         for _ in range(self.substeps):
@@ -219,9 +224,8 @@ class DiffDrive:
                     np.add.at(self.collisions, begun, 1)
                     self.contact[begun] = True
             state = after
-        if several:
+        if len(self.strips) > 1:
             self._repartition()
-        self._placed = False
         self.motion[:, 0] = forward
         self.motion[:, 1] = (self.pose[:, 2] - start[:, 2] + math.pi) % (2 * math.pi) - math.pi
         self.sim_seconds += self.period
@@ -231,12 +235,8 @@ class DiffDrive:
 
     def contacts(self) -> dict[str, np.ndarray]:
         """The spaces' cached contacts and clocks (world_server.arena.contacts); with several strips,
-        each contact's strip (`contacts_strip`) and a clock per strip.  Robots placed since the last
-        period are first found their strips, as the next period would: spaces rebuilt from the poses
-        then hold the same bodies."""
-        if len(self.strips) > 1 and self._placed:
-            self._repartition()
-            self._placed = False
+        each contact's strip (`contacts_strip`) and a clock per strip."""
+        self._place_placed()
         saved = [contacts.save(s.space, lambda shape: shape.key) for s in self.strips]
         if len(saved) == 1:
             return saved[0]

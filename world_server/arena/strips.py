@@ -65,10 +65,10 @@ class Strip:
         pm = self._pm
         if box is not None:
             x0, y0, x1, y1 = (float(v) for v in box)
-            shape = pm.Poly(self.space.static_body, [(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+            shape = pm.Poly(self.walls_body, [(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
         else:
             x0, y0, x1, y1 = (float(v) for v in segment)
-            shape = pm.Segment(self.space.static_body, (x0, y0), (x1, y1), 0.002)
+            shape = pm.Segment(self.walls_body, (x0, y0), (x1, y1), 0.002)
         shape.friction = 0.0
         shape.collision_type = WALL_TYPE
         self.space.add(shape)
@@ -112,15 +112,16 @@ class Strip:
         its own robots' and which are ghosts, and the buffers of a row each.  Chipmunk visits the space's
         static body (the walls') after the robots: its row is kept last, read and written back as it is."""
         robots = np.flatnonzero(self.body_id)
-        ids = self.body_id[robots]
-        order = np.argsort(ids)
+        order = np.argsort(self.body_id[robots])
+        self._robot_of_sorted = robots[order]
+        self._sorted_ids = self.body_id[self._robot_of_sorted]
         self._get.clear()
         self._batch.get_space_bodies(self.space, self._batch.BodyFields.BODY_ID, self._get)
         rows = np.frombuffer(self._get.int_buf(), np.int64)
-        if len(rows) != len(robots) + 1 or rows[-1] != self.space.static_body.id:
+        if len(rows) != len(robots) + 1 or rows[-1] != self.walls_body.id:
             raise RuntimeError(f"a physics strip's space holds {len(rows)} bodies, not its {len(robots)} robots' "
                                "and its walls': a body was added outside world_server.arena.strips")  # fmt: skip
-        self.robot_of_row = robots[order[np.searchsorted(ids[order], rows[:-1])]]
+        self.robot_of_row = self._robots_of(rows[:-1])
         self.owned_row = owner[self.robot_of_row] == self.index
         self.ghost_row = np.flatnonzero(~self.owned_row)
         self.own_rows = np.flatnonzero(self.owned_row)
@@ -132,7 +133,6 @@ class Strip:
         self.state = self._bodies[:-1]  # each robot row's position and velocity, as last read
         self._put = self._batch.Buffer()
         self._put.set_float_buf(self._bodies.ravel())
-        self._sorted_ids, self._robot_of_sorted = ids[order], robots[order]
         self._owns = owner == self.index
 
     # ------------------------------------------------------------- stepping
@@ -162,16 +162,16 @@ class Strip:
         self._arbiters.clear()
         self._batch.get_space_arbiters(self.space, self._begun_fields, self._arbiters)
         pairs = np.frombuffer(self._arbiters.int_buf(), np.int64).reshape(-1, 3)
-        return self._robots(pairs[pairs[:, 2] != 0, :2].ravel())
+        robots = self._robots_of(pairs[pairs[:, 2] != 0, :2].ravel())
+        return robots[self._owns[robots]] if len(self.ghost_row) else robots  # ghosts count in their own strip
 
-    def _robots(self, body_ids: np.ndarray) -> np.ndarray:
-        """The owned robots among these bodies (walls' static body and ghosts left out)."""
+    def _robots_of(self, body_ids: np.ndarray) -> np.ndarray:
+        """The robots of these bodies, in their order (the walls' static body left out)."""
         n = len(self._sorted_ids)
         if len(body_ids) == 0 or n == 0:
             return np.zeros(0, np.int64)
         at = np.minimum(np.searchsorted(self._sorted_ids, body_ids), n - 1)
-        robots = self._robot_of_sorted[at[self._sorted_ids[at] == body_ids]]
-        return robots[self._owns[robots]] if len(self.ghost_row) else robots
+        return self._robot_of_sorted[at[self._sorted_ids[at] == body_ids]]
 
 
 __all__ = ["ROBOT_TYPE", "WALL_TYPE", "Strip", "owners"]

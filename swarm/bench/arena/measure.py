@@ -144,11 +144,11 @@ def _cores(quick: bool) -> list[dict]:
     rows = []
     for n in (1000,) if quick else (1000, 10_000):
         side = SIDE * math.sqrt(n / 1000)
-        world = bench_world(n, LASER_BOT, obstacles=n // 10, side=side)
-        strips = min(numba.config.NUMBA_NUM_THREADS, 64, int(side / world.scenario.physics_halo()))
+        one = bench_world(n, LASER_BOT, obstacles=n // 10, side=side)  # its halo says how many strips fit
+        strips = min(numba.config.NUMBA_NUM_THREADS, 64, int(side / one.scenario.physics_halo()))
         for threads, k in [(1, 1), (0, 1)] + ([(0, strips)] if strips > 1 else []):
-            if rows and rows[-1]["robots"] == n:  # a fresh world each: the same start, not one run on
-                world = bench_world(n, LASER_BOT, obstacles=n // 10, side=side, strips=k)
+            # a fresh world each: the same start, not one run on
+            world = one if threads == 1 else bench_world(n, LASER_BOT, obstacles=n // 10, side=side, strips=k)
             try:
                 used = raycast.set_threads(threads)
                 rows.append({"robots": n, "threads": used, "strips": k, **_measure(world, 10 if quick else 30)})
